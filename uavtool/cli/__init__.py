@@ -1,0 +1,58 @@
+"""The ``uavtool`` command line: parse, call one library function, map errors to exit codes.
+
+Each command group lives in its own module here and is registered in ``_COMMANDS``; the
+library below never imports click and never prints.
+"""
+
+from __future__ import annotations
+
+import importlib
+import logging
+import sys
+from typing import Any
+
+import click
+
+from uavtool import __version__
+from uavtool.errors import UavtoolError
+
+# (module, attribute) of every top-level command, in the order `--help` lists them.
+_COMMANDS: tuple[tuple[str, str], ...] = (("uavtool.cli.sitl", "sitl"),)
+
+
+class _Group(click.Group):
+    """Turns library errors into one-line messages and exit codes (2 input, 1 failure)."""
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except UavtoolError as exc:
+            if ctx.obj and ctx.obj.get("debug"):
+                raise
+            click.echo(f"uavtool: error: {exc}", err=True)
+            ctx.exit(exc.exit_code)
+        except KeyboardInterrupt:
+            click.echo("uavtool: interrupted", err=True)
+            ctx.exit(130)
+
+
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="uavtool")
+@click.option("--debug", is_flag=True, help="Show tracebacks instead of one-line errors.")
+@click.option("-v", "--verbose", count=True, help="More log output (-v info, -vv debug).")
+@click.pass_context
+def cli(ctx: click.Context, debug: bool, verbose: int) -> None:
+    """Fly, record, replay and view vision missions for MAVLink drones."""
+    ctx.ensure_object(dict)
+    ctx.obj["debug"] = debug
+    level = logging.WARNING - 10 * min(verbose, 2)
+    logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
+
+
+for _module, _attr in _COMMANDS:
+    cli.add_command(getattr(importlib.import_module(_module), _attr))
+
+
+def main() -> None:
+    """Console-script entry point."""
+    sys.exit(cli.main(prog_name="uavtool", standalone_mode=True))
