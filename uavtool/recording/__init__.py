@@ -1,0 +1,59 @@
+"""Recordings: one MCAP file per mission — write, read (even when cut), inspect, recover,
+and bridge to MAVProxy's ``.tlog``. The topic list is in README.md, "Recording format"."""
+
+from uavtool.recording.errors import (
+    NotMcapError,
+    RecordingError,
+    TlogError,
+    TopicNotFoundError,
+    UnknownSchemaError,
+)
+from uavtool.recording.info import RecordingInfo, summarize
+from uavtool.recording.reader import Message, RecordingReader
+from uavtool.recording.recover import recover
+from uavtool.recording.tlog import export_tlog, import_tlog
+from uavtool.recording.values import (
+    CameraCalibration,
+    CompressedImage,
+    Direction,
+    Entry,
+    FrameTransform,
+    JsonDocument,
+    LocationFix,
+    LogEntry,
+    LogLevel,
+    MavlinkFrame,
+    Model3D,
+    Pose,
+    PosesInFrame,
+)
+from uavtool.recording.writer import RecordingWriter
+
+__all__ = [
+    "CameraCalibration",
+    "CompressedImage",
+    "Direction",
+    "Entry",
+    "FrameTransform",
+    "JsonDocument",
+    "LocationFix",
+    "LogEntry",
+    "LogLevel",
+    "MavlinkFrame",
+    "Message",
+    "Model3D",
+    "NotMcapError",
+    "Pose",
+    "PosesInFrame",
+    "RecordingError",
+    "RecordingInfo",
+    "RecordingReader",
+    "RecordingWriter",
+    "TlogError",
+    "TopicNotFoundError",
+    "UnknownSchemaError",
+    "export_tlog",
+    "import_tlog",
+    "recover",
+    "summarize",
+]

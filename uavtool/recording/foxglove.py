@@ -1,0 +1,168 @@
+"""Foxglove's Protobuf schemas: our value types to and from `foxglove.*` messages.
+
+Foxglove Studio and Rerun's MCAP importer display these natively. Each message's
+``timestamp`` is the message's log time, so transforms, images and calibrations line up on
+one clock in every viewer.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from foxglove_schemas_protobuf.CameraCalibration_pb2 import (
+    CameraCalibration as PbCameraCalibration,
+)
+from foxglove_schemas_protobuf.CompressedImage_pb2 import CompressedImage as PbCompressedImage
+from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform as PbFrameTransform
+from foxglove_schemas_protobuf.LocationFix_pb2 import LocationFix as PbLocationFix
+from foxglove_schemas_protobuf.Log_pb2 import Log as PbLog
+from foxglove_schemas_protobuf.PosesInFrame_pb2 import PosesInFrame as PbPosesInFrame
+from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate as PbSceneUpdate
+from mcap_protobuf.schema import build_file_descriptor_set
+
+from uavtool.recording.values import (
+    CameraCalibration,
+    CompressedImage,
+    FrameTransform,
+    LocationFix,
+    LogEntry,
+    LogLevel,
+    Model3D,
+    Pose,
+    PosesInFrame,
+)
+
+FoxgloveValue = (
+    CompressedImage
+    | CameraCalibration
+    | FrameTransform
+    | LocationFix
+    | PosesInFrame
+    | LogEntry
+    | Model3D
+)
+
+_GLB_MEDIA_TYPE = "model/gltf-binary"
+
+# our value type -> the Protobuf class that carries it
+_PB_CLASS: dict[type, Any] = {
+    CompressedImage: PbCompressedImage,
+    CameraCalibration: PbCameraCalibration,
+    FrameTransform: PbFrameTransform,
+    LocationFix: PbLocationFix,
+    PosesInFrame: PbPosesInFrame,
+    LogEntry: PbLog,
+    Model3D: PbSceneUpdate,
+}
+_SCHEMA_DATA: dict[type, bytes] = {}
+SCHEMA_NAMES: frozenset[str] = frozenset(c.DESCRIPTOR.full_name for c in _PB_CLASS.values())
+
+
+def schema_name(value_type: type) -> str:
+    """The Protobuf full name (e.g. ``foxglove.CompressedImage``) for one of our value types."""
+    return str(_PB_CLASS[value_type].DESCRIPTOR.full_name)
+
+
+def schema_data(value_type: type) -> bytes:
+    """The serialized FileDescriptorSet MCAP stores as the channel's schema."""
+    data = _SCHEMA_DATA.get(value_type)
+    if data is None:
+        fds = build_file_descriptor_set(_PB_CLASS[value_type])
+        data = _SCHEMA_DATA[value_type] = bytes(fds.SerializeToString(deterministic=True))
+    return data
+
+
+def _stamp(pb: Any, t_ns: int) -> None:
+    pb.timestamp.seconds, pb.timestamp.nanos = divmod(t_ns, 1_000_000_000)
+
+
+def _pose_pb(pose: Pose, pb: Any) -> None:
+    pb.position.x, pb.position.y, pb.position.z = pose.position_m
+    q = pb.orientation
+    q.x, q.y, q.z, q.w = pose.orientation_xyzw
+
+
+def _pose(pb: Any) -> Pose:
+    p, q = pb.position, pb.orientation
+    return Pose((p.x, p.y, p.z), (q.x, q.y, q.z, q.w))
+
+
+def encode(value: FoxgloveValue, t_ns: int) -> bytes:
+    """Serialize ``value`` as its Foxglove message with ``timestamp`` = ``t_ns``."""
+    pb: Any = _PB_CLASS[type(value)]()
+    if isinstance(value, CompressedImage):
+        _stamp(pb, t_ns)
+        pb.frame_id, pb.data, pb.format = value.frame_id, value.data, value.format
+    elif isinstance(value, CameraCalibration):
+        _stamp(pb, t_ns)
+        pb.frame_id, pb.width, pb.height = value.frame_id, value.width_px, value.height_px
+        pb.distortion_model = value.distortion_model
+        pb.D.extend(value.d)
+        pb.K.extend(value.k)
+        pb.R.extend(value.r)
+        pb.P.extend(value.p)
+    elif isinstance(value, FrameTransform):
+        _stamp(pb, t_ns)
+        pb.parent_frame_id, pb.child_frame_id = value.parent_frame_id, value.child_frame_id
+        pb.translation.x, pb.translation.y, pb.translation.z = value.translation_m
+        r = pb.rotation
+        r.x, r.y, r.z, r.w = value.rotation_xyzw
+    elif isinstance(value, LocationFix):
+        _stamp(pb, t_ns)
+        pb.frame_id = value.frame_id
+        pb.latitude, pb.longitude, pb.altitude = (
+            value.latitude_deg,
+            value.longitude_deg,
+            value.altitude_m,
+        )
+    elif isinstance(value, PosesInFrame):
+        _stamp(pb, t_ns)
+        pb.frame_id = value.frame_id
+        for pose in value.poses:
+            _pose_pb(pose, pb.poses.add())
+    elif isinstance(value, LogEntry):
+        _stamp(pb, t_ns)
+        pb.level = int(value.level)
+        pb.message, pb.name, pb.file, pb.line = value.message, value.name, value.file, value.line
+    else:  # Model3D: one scene entity holding one embedded glTF model
+        entity = pb.entities.add()
+        _stamp(entity, t_ns)
+        entity.frame_id, entity.id = value.frame_id, value.entity_id
+        model = entity.models.add()
+        _pose_pb(value.pose, model.pose)
+        model.scale.x = model.scale.y = model.scale.z = 1.0
+        model.media_type, model.data = _GLB_MEDIA_TYPE, value.glb
+    return bytes(pb.SerializeToString(deterministic=True))
+
+
+def decode(name: str, data: bytes) -> FoxgloveValue:
+    """Parse a message of Foxglove schema ``name``; `KeyError` if it is not one of ours."""
+    cls = next(c for v, c in _PB_CLASS.items() if schema_name(v) == name)
+    pb: Any = cls.FromString(data)
+    if cls is PbCompressedImage:
+        return CompressedImage(pb.data, pb.format, pb.frame_id)
+    if cls is PbCameraCalibration:
+        return CameraCalibration(
+            pb.width,
+            pb.height,
+            tuple(pb.K),
+            tuple(pb.P),
+            tuple(pb.R),
+            tuple(pb.D),
+            pb.distortion_model,
+            pb.frame_id,
+        )
+    if cls is PbFrameTransform:
+        t, r = pb.translation, pb.rotation
+        return FrameTransform(
+            pb.parent_frame_id, pb.child_frame_id, (t.x, t.y, t.z), (r.x, r.y, r.z, r.w)
+        )
+    if cls is PbLocationFix:
+        return LocationFix(pb.latitude, pb.longitude, pb.altitude, pb.frame_id)
+    if cls is PbPosesInFrame:
+        return PosesInFrame(tuple(_pose(p) for p in pb.poses), pb.frame_id)
+    if cls is PbLog:
+        return LogEntry(LogLevel(pb.level), pb.message, pb.name, pb.file, pb.line)
+    entity = pb.entities[0]
+    model = entity.models[0]
+    return Model3D(model.data, entity.id, entity.frame_id, _pose(model.pose))

@@ -1,0 +1,122 @@
+"""What `uavtool info` reports: duration, topics, frames, mission outcome, file health."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from uavtool.recording import foxglove
+from uavtool.recording.reader import RecordingReader
+from uavtool.recording.values import CompressedImage
+
+OUTCOME_METADATA = "outcome"  # the record the mission runner writes when it finishes
+
+
+@dataclass(frozen=True, slots=True)
+class TopicInfo:
+    topic: str
+    schema_name: str
+    message_encoding: str
+    count: int
+    rate_hz: float
+
+
+@dataclass(frozen=True, slots=True)
+class RecordingInfo:
+    path: str
+    size_bytes: int
+    whole: bool
+    problem: str  # "" when whole
+    readable_bytes: int
+    partial_chunk: bool  # messages were rescued from a cut chunk
+    library: str
+    start_ns: int
+    end_ns: int
+    message_count: int
+    frame_count: int
+    topics: tuple[TopicInfo, ...]
+    metadata_names: tuple[str, ...]
+    outcome: dict[str, str] | None
+
+    @property
+    def duration_s(self) -> float:
+        return (self.end_ns - self.start_ns) / 1e9
+
+
+def summarize(path: str | Path) -> RecordingInfo:
+    """Inspect a recording; never fails on a truncated file (it says so instead).
+
+    Raises `NotMcapError` if the file is missing, empty or not MCAP.
+    """
+    with RecordingReader(path) as reader:
+        health = reader.health
+        start_ns, end_ns = reader.time_range_ns
+        duration_s = (end_ns - start_ns) / 1e9
+        counts = reader.message_counts
+        schemas = reader.schemas
+        kinds: dict[str, tuple[str, str]] = {}  # topic -> (schema name, message encoding)
+        totals: dict[str, int] = {}
+        frames = 0
+        image_schema = foxglove.schema_name(CompressedImage)
+        for cid, channel in sorted(reader.channels.items()):
+            schema = schemas.get(channel.schema_id)
+            name = schema.name if schema else ""
+            count = counts.get(cid, 0)
+            if name == image_schema:
+                frames += count
+            kinds.setdefault(channel.topic, (name, channel.message_encoding))
+            totals[channel.topic] = totals.get(channel.topic, 0) + count
+        topics = tuple(
+            TopicInfo(topic, *kinds[topic], n, n / duration_s if duration_s > 0 else 0.0)
+            for topic, n in sorted(totals.items())
+        )
+        metadata = reader.metadata
+        outcome = next(
+            (dict(r) for name, r in reversed(metadata) if name == OUTCOME_METADATA), None
+        )
+        return RecordingInfo(
+            path=str(path),
+            size_bytes=health.size_bytes,
+            whole=health.whole,
+            problem=health.problem,
+            readable_bytes=health.readable_bytes,
+            partial_chunk=health.partial_chunk,
+            library=reader.library,
+            start_ns=start_ns,
+            end_ns=end_ns,
+            message_count=sum(counts.values()),
+            frame_count=frames,
+            topics=topics,
+            metadata_names=tuple(name for name, _ in metadata),
+            outcome=outcome,
+        )
+
+
+def format_info(info: RecordingInfo) -> str:
+    """The human-readable report `uavtool info` prints."""
+    lines = [f"file:      {info.path} ({info.size_bytes} bytes, written by {info.library or '?'})"]
+    if info.whole:
+        lines.append("health:    whole, indexed")
+    else:
+        rescued = " (some from a cut chunk)" if info.partial_chunk else ""
+        lines.append(f"health:    TRUNCATED — {info.problem}")
+        lines.append(
+            f"           {info.message_count} messages readable{rescued} from the first "
+            f"{info.readable_bytes} bytes; "
+            f"recover them with: uavtool info --recover {info.path} -o fixed.mcap"
+        )
+    lines.append(f"duration:  {info.duration_s:.3f} s")
+    lines.append(f"messages:  {info.message_count}")
+    lines.append(f"frames:    {info.frame_count}")
+    if info.outcome is None:
+        lines.append("outcome:   unknown (no 'outcome' record: the mission did not finish)")
+    else:
+        lines.append("outcome:   " + ", ".join(f"{k}={v}" for k, v in info.outcome.items()))
+    if info.metadata_names:
+        lines.append("metadata:  " + ", ".join(info.metadata_names))
+    lines.append("topics:")
+    width = max((len(t.topic) for t in info.topics), default=0)
+    for t in info.topics:
+        kind = t.schema_name or t.message_encoding
+        lines.append(f"  {t.topic:<{width}}  {t.count:>8} msgs  {t.rate_hz:9.2f} Hz  {kind}")
+    return "\n".join(lines)

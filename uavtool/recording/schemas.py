@@ -1,0 +1,189 @@
+"""Topic names, channel encodings and the JSON view of MAVLink messages.
+
+Every decoded MAVLink message type gets its own JSON schema, generated from pymavlink's
+message definitions (field types, array lengths, units, enums, the message description), so
+Foxglove lists and plots every field. Non-finite floats (MAVLink's "NaN = unchanged") become
+``null``: JSON has no NaN, and the exact bytes stay in ``/mavlink/raw``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import math
+from functools import cache
+from types import ModuleType
+from typing import Any
+
+from uavtool.recording.values import Direction
+
+# --- topics ---------------------------------------------------------------------------------
+
+MAVLINK_RAW = "/mavlink/raw"
+CAMERA_IMAGE = "/camera/image"
+CAMERA_CALIBRATION = "/camera/calibration"
+CAMERA_POSE = "/camera/pose"
+VEHICLE_FIX = "/vehicle/fix"
+VEHICLE_POSE = "/vehicle/pose"
+MISSION_EVENTS = "/mission/events"
+MISSION_MODEL = "/mission/model"
+
+
+def mavlink_topic(direction: Direction, msg_name: str) -> str:
+    """``/mavlink/in/HEARTBEAT``: the decoded-JSON channel of one message type and direction."""
+    return f"/mavlink/{direction.value}/{msg_name}"
+
+
+# --- encodings ------------------------------------------------------------------------------
+
+MAVLINK_ENCODING = "mavlink"  # message data = one whole MAVLink frame, as on the wire
+JSON_ENCODING = "json"
+JSONSCHEMA_ENCODING = "jsonschema"
+PROTOBUF_ENCODING = "protobuf"
+DEFAULT_DIALECT = "ardupilotmega"
+
+_JSON = json.JSONEncoder(ensure_ascii=False, allow_nan=False, separators=(",", ":"))
+
+
+def dumps(obj: Any) -> bytes:
+    """Compact, deterministic UTF-8 JSON; `ValueError` on NaN/Infinity (JSON has none)."""
+    return _JSON.encode(obj).encode()
+
+
+# --- MAVLink --------------------------------------------------------------------------------
+
+_INT_TYPES = {
+    "int8_t",
+    "uint8_t",
+    "int16_t",
+    "uint16_t",
+    "int32_t",
+    "uint32_t",
+    "int64_t",
+    "uint64_t",
+}
+_FLOAT_TYPES = {"float", "double"}
+
+_HEADER_SCHEMA = {
+    "type": "object",
+    "description": "MAVLink frame header",
+    "properties": {
+        "sysid": {"type": "integer", "description": "sender system id"},
+        "compid": {"type": "integer", "description": "sender component id"},
+        "seq": {"type": "integer", "description": "link sequence number"},
+    },
+}
+
+
+@cache
+def dialect_module(dialect: str) -> ModuleType:
+    """pymavlink's MAVLink 2 module of ``dialect`` (``ardupilotmega``); `ValueError` if none."""
+    if not dialect.isidentifier():
+        raise ValueError(f"not a MAVLink dialect name: {dialect!r}")
+    try:
+        return importlib.import_module(f"pymavlink.dialects.v20.{dialect}")
+    except ImportError as exc:
+        raise ValueError(f"pymavlink has no MAVLink 2 dialect {dialect!r}") from exc
+
+
+def _field_schema(
+    field_type: str, length: int, units: str, enum: str, display: str
+) -> dict[str, Any]:
+    base = field_type.split("[", maxsplit=1)[0]
+    item: dict[str, Any]
+    if base == "char":
+        item = {"type": "string"}
+    elif base in _FLOAT_TYPES:
+        item = {"type": ["number", "null"]}
+    elif base in _INT_TYPES:
+        item = {"type": "integer"}
+    else:  # pragma: no cover - every MAVLink wire type is listed above
+        raise ValueError(f"unknown MAVLink field type {field_type!r}")
+    notes = [f"{base}"]
+    if units:
+        notes.append(f"units: {units}")
+    if enum:
+        notes.append(f"enum: {enum}")
+    if display:
+        notes.append(display)
+    if length and base != "char":
+        return {"type": "array", "items": item, "maxItems": length, "description": ", ".join(notes)}
+    return {**item, "description": ", ".join(notes)}
+
+
+@cache
+def mavlink_schema(dialect: str, msgid: int) -> tuple[str, bytes]:
+    """Schema name (``ardupilotmega.HEARTBEAT``) and JSON schema bytes of one message type."""
+    cls = dialect_module(dialect).mavlink_map[msgid]
+    properties: dict[str, Any] = {"header": _HEADER_SCHEMA}
+    for name, ftype, length in zip(cls.fieldnames, cls.fieldtypes, cls.array_lengths, strict=True):
+        properties[name] = _field_schema(
+            ftype,
+            length,
+            cls.fieldunits_by_name.get(name, ""),
+            cls.fieldenums_by_name.get(name, ""),
+            cls.fielddisplays_by_name.get(name, ""),
+        )
+    description = " ".join((cls.__doc__ or "").split())
+    schema = {
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": f"{dialect}.{cls.msgname}",
+        "description": f"MAVLink message {cls.msgname} (id {msgid}). {description}".strip(),
+        "type": "object",
+        "properties": properties,
+        "required": ["header", *cls.fieldnames],
+    }
+    return f"{dialect}.{cls.msgname}", dumps(schema)
+
+
+@cache
+def _float_fields(dialect: str, msgid: int) -> tuple[tuple[str, bool], ...]:
+    cls = dialect_module(dialect).mavlink_map[msgid]
+    return tuple(
+        (name, length > 0)
+        for name, ftype, length in zip(
+            cls.fieldnames, cls.fieldtypes, cls.array_lengths, strict=True
+        )
+        if ftype in _FLOAT_TYPES
+    )
+
+
+def _finite_or_none(x: float) -> float | None:
+    return x if math.isfinite(x) else None
+
+
+class MavlinkDecoder:
+    """Decodes whole MAVLink frames of one dialect into JSON-ready dicts (not thread-safe)."""
+
+    def __init__(self, dialect: str = DEFAULT_DIALECT) -> None:
+        self.dialect = dialect
+        module = dialect_module(dialect)
+        self._known = module.mavlink_map
+        self._mav = module.MAVLink(None)
+        self._error = module.MAVError
+
+    def decode(self, frame: bytes) -> tuple[int, str, dict[str, Any]] | None:
+        """``(msgid, MSGNAME, payload)`` of a frame, or None if it is unknown or corrupt."""
+        try:
+            msg = self._mav.decode(bytearray(frame))
+        except (self._error, IndexError, ValueError):
+            return None
+        msgid = msg.get_msgId()
+        if msgid not in self._known:
+            return None
+        payload: dict[str, Any] = {
+            "header": {
+                "sysid": msg.get_srcSystem(),
+                "compid": msg.get_srcComponent(),
+                "seq": msg.get_seq(),
+            }
+        }
+        for name in msg.fieldnames:
+            payload[name] = msg.format_attr(name)
+        for name, is_array in _float_fields(self.dialect, msgid):
+            value = payload[name]
+            if is_array:
+                payload[name] = [_finite_or_none(v) for v in value]
+            else:
+                payload[name] = _finite_or_none(value)
+        return msgid, msg.get_type(), payload

@@ -1,0 +1,300 @@
+"""`RecordingWriter`: one thread-safe, crash-safe, deterministic MCAP writer per mission.
+
+Crash safety: the open chunk lives in memory until it is closed, so the writer closes it and
+hands the bytes to the OS whenever it spans ``chunk_interval_ns`` of log time (default 1 s;
+then, with ``fsync=True``, also asks the OS to put it on disk) or reaches ``chunk_bytes``.
+A SIGKILL or power cut therefore loses at most about one interval of data.
+
+Determinism: the writer never reads a clock or a random source; every time comes from the
+caller, so identical calls give a byte-identical file (the header names the uavtool and
+mcap versions).
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from collections.abc import Mapping
+from pathlib import Path
+from types import TracebackType
+from typing import Any, BinaryIO
+
+from mcap.writer import LIBRARY_IDENTIFIER, CompressionType
+from mcap.writer import Writer as McapWriter
+
+from uavtool import __version__
+from uavtool.recording import foxglove
+from uavtool.recording.errors import create_file
+from uavtool.recording.schemas import (
+    DEFAULT_DIALECT,
+    JSON_ENCODING,
+    JSONSCHEMA_ENCODING,
+    MAVLINK_ENCODING,
+    MAVLINK_RAW,
+    PROTOBUF_ENCODING,
+    MavlinkDecoder,
+    dumps,
+    mavlink_schema,
+    mavlink_topic,
+)
+from uavtool.recording.values import Direction
+
+LIBRARY = f"uavtool/{__version__}; {LIBRARY_IDENTIFIER}"
+TOOL_METADATA = "uavtool"  # name of the metadata record the writer adds itself
+
+_NEVER = 1 << 62  # chunk size given to mcap: we decide when chunks close
+_RECORD_OVERHEAD = 31  # bytes a Message record adds around its data inside a chunk
+
+
+def _check_topic(topic: str) -> None:
+    if not topic.startswith("/") or topic.startswith("/mavlink/"):
+        raise ValueError(f"topic {topic!r}: must start with '/' and not with '/mavlink/'")
+
+
+class RecordingWriter:
+    """Writes one recording. Use as a context manager; safe to share between threads.
+
+    ``metadata`` maps record names (``mission``, ``scene``, ``seeds``, ``command_line`` …) to
+    string key/value pairs, written first after a ``uavtool`` record (tool version, dialect).
+    Every ``write_*`` takes ``log_time_ns`` (receive time, > 0, one epoch per file) and
+    optionally ``publish_time_ns`` (vehicle time; defaults to the log time). Raises
+    `ValueError` on misuse (time ≤ 0, unregistered topic, NaN in JSON, writing after close).
+    """
+
+    def __init__(
+        self,
+        path: str | Path,
+        *,
+        metadata: Mapping[str, Mapping[str, str]] | None = None,
+        dialect: str = DEFAULT_DIALECT,
+        chunk_interval_ns: int = 1_000_000_000,
+        chunk_bytes: int = 1 << 20,
+        fsync: bool = True,
+    ) -> None:
+        self._decoder = MavlinkDecoder(dialect)  # checks the dialect before creating a file
+        self.dialect = dialect
+        self.path = Path(path)
+        self._file: BinaryIO = create_file(path)
+        self._mcap: Any = McapWriter(
+            self._file, chunk_size=_NEVER, compression=CompressionType.ZSTD
+        )
+        self._lock = threading.Lock()
+        self._interval_ns = chunk_interval_ns
+        self._budget = chunk_bytes
+        self._fsync = fsync
+        self._chunk_start_ns: int | None = None
+        self._chunk_size = 0
+        self._closed = False
+        self._message_count = 0
+        self._schemas: dict[tuple[str, bytes], int] = {}
+        self._channels: dict[Any, int] = {}  # key -> channel id
+        self._topic_kind: dict[str, Any] = {}  # topic -> value type or JSON schema name
+        self._sequence: dict[int, int] = {}
+        self._mcap.start(profile="", library=LIBRARY)
+        tool = {"version": __version__, "dialect": dialect, "mavlink": "2.0"}
+        self._mcap.add_metadata(TOOL_METADATA, tool)
+        for name, record in (metadata or {}).items():
+            self.add_metadata(name, record)
+
+    # --- lifecycle ---------------------------------------------------------------------------
+
+    def __enter__(self) -> RecordingWriter:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
+
+    @property
+    def message_count(self) -> int:
+        return self._message_count
+
+    def flush(self) -> None:
+        """Close the open chunk and hand everything to the OS now (e.g. before a long pause)."""
+        with self._lock:
+            self._check_open()
+            self._close_chunk(sync=self._fsync)
+
+    def close(self) -> None:
+        """Write the summary (indexes, statistics) and close the file. Idempotent."""
+        with self._lock:
+            if self._closed:
+                return
+            self._closed = True
+            self._mcap.finish()
+            self._file.flush()
+            if self._fsync:
+                os.fsync(self._file.fileno())
+            self._file.close()
+
+    # --- metadata and channels ---------------------------------------------------------------
+
+    def add_metadata(self, name: str, record: Mapping[str, str]) -> None:
+        """Add a named metadata record (e.g. the mission outcome at the end)."""
+        if name == TOOL_METADATA:
+            raise ValueError(f"metadata name {name!r} is reserved for the writer")
+        if not all(isinstance(k, str) and isinstance(v, str) for k, v in record.items()):
+            raise ValueError(f"metadata {name!r}: keys and values must be str")
+        with self._lock:
+            self._check_open()
+            self._mcap.add_metadata(name, dict(record))
+
+    def add_json_topic(self, topic: str, *, schema_name: str, schema: Mapping[str, Any]) -> None:
+        """Declare a JSON topic with its JSON schema; `write_json` then writes to it."""
+        _check_topic(topic)
+        with self._lock:
+            self._check_open()
+            known = self._topic_kind.get(topic)
+            if known is not None:
+                if known != schema_name:
+                    raise ValueError(f"topic {topic!r} already carries {known!r}")
+                return
+            schema_id = self._schema(schema_name, JSONSCHEMA_ENCODING, dumps(schema))
+            self._channel(topic, topic, JSON_ENCODING, schema_id)
+            self._topic_kind[topic] = schema_name
+
+    # --- writes ------------------------------------------------------------------------------
+
+    def write_json(
+        self,
+        topic: str,
+        payload: Mapping[str, Any],
+        *,
+        log_time_ns: int,
+        publish_time_ns: int | None = None,
+    ) -> None:
+        """Write a dict to a topic declared with `add_json_topic`."""
+        try:
+            data = dumps(payload)
+        except (ValueError, TypeError) as exc:
+            raise ValueError(f"topic {topic!r}: payload is not JSON: {exc}") from exc
+        with self._lock:
+            self._check_open()
+            channel_id = self._channels.get(topic)
+            if channel_id is None or not isinstance(self._topic_kind.get(topic), str):
+                raise ValueError(f"topic {topic!r} is not a JSON topic: call add_json_topic first")
+            self._add(channel_id, log_time_ns, publish_time_ns, data)
+
+    def write(
+        self,
+        topic: str,
+        value: foxglove.FoxgloveValue,
+        *,
+        log_time_ns: int,
+        publish_time_ns: int | None = None,
+    ) -> None:
+        """Write an image, calibration, transform, fix, poses, log entry or model (Foxglove)."""
+        _check_topic(topic)
+        kind = type(value)
+        data = foxglove.encode(value, log_time_ns)
+        with self._lock:
+            self._check_open()
+            channel_id = self._channels.get(topic)
+            if channel_id is None:
+                schema_id = self._schema(
+                    foxglove.schema_name(kind), PROTOBUF_ENCODING, foxglove.schema_data(kind)
+                )
+                channel_id = self._channel(topic, topic, PROTOBUF_ENCODING, schema_id)
+                self._topic_kind[topic] = kind
+            elif self._topic_kind.get(topic) is not kind:
+                raise ValueError(
+                    f"topic {topic!r} carries {self._topic_kind.get(topic)!r}, not {kind}"
+                )
+            self._add(channel_id, log_time_ns, publish_time_ns, data)
+
+    def write_mavlink(
+        self,
+        frame: bytes,
+        *,
+        direction: Direction,
+        log_time_ns: int,
+        publish_time_ns: int | None = None,
+    ) -> None:
+        """Write one whole MAVLink frame to ``/mavlink/raw`` and, if it decodes, its JSON view
+        to ``/mavlink/<in|out>/<MSGNAME>``. Unknown or corrupt frames are kept raw only."""
+        frame = bytes(frame)
+        with self._lock:
+            self._check_open()
+            raw_id = self._channels.get(direction)
+            if raw_id is None:
+                meta = {"direction": direction.value, "dialect": self.dialect}
+                raw_id = self._channel(direction, MAVLINK_RAW, MAVLINK_ENCODING, 0, meta)
+            self._add(raw_id, log_time_ns, publish_time_ns, frame)
+            decoded = self._decoder.decode(frame)
+            if decoded is None:
+                return
+            msgid, msg_name, payload = decoded
+            key = (direction, msgid)
+            channel_id = self._channels.get(key)
+            if channel_id is None:
+                name, schema = mavlink_schema(self.dialect, msgid)
+                schema_id = self._schema(name, JSONSCHEMA_ENCODING, schema)
+                topic = mavlink_topic(direction, msg_name)
+                channel_id = self._channel(key, topic, JSON_ENCODING, schema_id)
+                self._topic_kind[topic] = name
+            self._add(channel_id, log_time_ns, publish_time_ns, dumps(payload))
+
+    # --- internals (called with the lock held) -----------------------------------------------
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise ValueError(f"{self.path}: the recording is closed")
+
+    def _schema(self, name: str, encoding: str, data: bytes) -> int:
+        schema_id = self._schemas.get((name, data))
+        if schema_id is None:
+            schema_id = self._mcap.register_schema(name=name, encoding=encoding, data=data)
+            self._schemas[(name, data)] = schema_id
+        return int(schema_id)
+
+    def _channel(
+        self,
+        key: Any,
+        topic: str,
+        encoding: str,
+        schema_id: int,
+        meta: dict[str, str] | None = None,
+    ) -> int:
+        channel_id = int(
+            self._mcap.register_channel(
+                topic=topic, message_encoding=encoding, schema_id=schema_id, metadata=meta or {}
+            )
+        )
+        self._channels[key] = channel_id
+        self._sequence[channel_id] = 0
+        return channel_id
+
+    def _add(
+        self, channel_id: int, log_time_ns: int, publish_time_ns: int | None, data: bytes
+    ) -> None:
+        if not isinstance(log_time_ns, int) or log_time_ns <= 0:
+            raise ValueError(f"log_time_ns must be a positive int, got {log_time_ns!r}")
+        publish = log_time_ns if publish_time_ns is None else publish_time_ns
+        sequence = self._sequence[channel_id]
+        self._sequence[channel_id] = sequence + 1
+        self._mcap.add_message(
+            channel_id=channel_id,
+            log_time=log_time_ns,
+            data=data,
+            publish_time=publish,
+            sequence=sequence,
+        )
+        self._message_count += 1
+        self._chunk_size += len(data) + _RECORD_OVERHEAD
+        if self._chunk_start_ns is None:
+            self._chunk_start_ns = log_time_ns
+        if abs(log_time_ns - self._chunk_start_ns) >= self._interval_ns:
+            self._close_chunk(sync=self._fsync)
+        elif self._chunk_size >= self._budget:
+            self._close_chunk(sync=False)
+
+    def _close_chunk(self, *, sync: bool) -> None:
+        self._mcap.flush()  # closes the chunk, writes it and its indexes, flushes the stream
+        if sync:
+            os.fsync(self._file.fileno())
+        self._chunk_start_ns = None
+        self._chunk_size = 0
