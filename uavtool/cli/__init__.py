@@ -17,7 +17,12 @@ from uavtool import __version__
 from uavtool.errors import UavtoolError
 
 # (module, attribute) of every top-level command, in the order `--help` lists them.
-_COMMANDS: tuple[tuple[str, str], ...] = (("uavtool.cli.sitl", "sitl"),)
+_COMMANDS: tuple[tuple[str, str], ...] = (
+    ("uavtool.cli.sitl", "sitl"),
+    ("uavtool.cli.recording", "info"),
+    ("uavtool.cli.recording", "export"),
+    ("uavtool.cli.recording", "import_"),
+)
 
 
 class _Group(click.Group):

@@ -1,0 +1,83 @@
+"""``uavtool info``, ``uavtool export`` and ``uavtool import``: inspect, repair and convert
+recordings. Heavy imports happen inside the commands so ``uavtool --help`` stays fast."""
+
+# ruff: noqa: PLC0415  (the lazy imports above are deliberate)
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+_PATH = click.Path(dir_okay=False, path_type=Path)
+
+
+@click.command()
+@click.argument("rec", type=_PATH)
+@click.option("--recover", is_flag=True, help="Rewrite everything readable as a whole file.")
+@click.option("-o", "--output", type=_PATH, help="Where --recover writes (required with it).")
+def info(rec: Path, recover: bool, output: Path | None) -> None:
+    """Show a recording's duration, topics, frames, outcome and file health.
+
+    A truncated file (the recorder crashed) is reported, not refused; --recover copies
+    what it still holds into a whole, indexed file.
+
+    \b
+    Example:
+      uavtool info recordings/2024-05-01T10-00-00.mcap
+      uavtool info --recover crashed.mcap -o fixed.mcap
+    """
+    if recover != (output is not None):
+        raise click.UsageError("--recover and -o/--output go together")
+    from uavtool.recording import info as recording_info
+
+    click.echo(recording_info.format_info(recording_info.summarize(rec)))
+    if recover and output is not None:
+        from uavtool.recording.recover import recover as do_recover
+
+        result = do_recover(rec, output)
+        click.echo(
+            f"recovered {result.messages} messages on {result.channels} channels to {output}"
+        )
+
+
+@click.command()
+@click.argument("rec", type=_PATH)
+@click.option("--tlog", "tlog", type=_PATH, required=True, help="Write /mavlink/raw as a .tlog.")
+def export(rec: Path, tlog: Path) -> None:
+    """Export a recording's MAVLink frames to a telemetry log.
+
+    The .tlog opens in MAVProxy, MAVExplorer and mavlogdump.py.
+
+    \b
+    Example:
+      uavtool export flight.mcap --tlog flight.tlog && mavlogdump.py flight.tlog
+    """
+    from uavtool.recording.tlog import export_tlog
+
+    result = export_tlog(rec, tlog)
+    click.echo(f"wrote {result.frames} MAVLink frames to {tlog}")
+
+
+@click.command(name="import")
+@click.argument("tlog", type=_PATH)
+@click.option("-o", "--output", type=_PATH, required=True, help="The recording to write.")
+@click.option(
+    "--gcs-sysid",
+    type=click.IntRange(0, 255),
+    default=255,
+    show_default=True,
+    help="System id of the ground station: its frames are recorded as sent ('out').",
+)
+def import_(tlog: Path, output: Path, gcs_sysid: int) -> None:
+    """Turn a telemetry log (MAVProxy, QGroundControl) into a recording.
+
+    \b
+    Example:
+      uavtool import 2024-05-01_flight.tlog -o flight.mcap && uavtool info flight.mcap
+    """
+    from uavtool.recording.tlog import import_tlog
+
+    result = import_tlog(tlog, output, gcs_sysid=gcs_sysid)
+    skipped = f" (skipped {result.skipped_bytes} unreadable bytes)" if result.skipped_bytes else ""
+    click.echo(f"imported {result.frames} MAVLink frames to {output}{skipped}")
