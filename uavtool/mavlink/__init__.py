@@ -1,0 +1,10 @@
+"""MAVLink 2 (ardupilotmega dialect) plumbing shared by the SITL vehicle and the client link.
+
+The dialect is chosen explicitly by importing pymavlink's generated module; nothing here
+touches environment variables or pymavlink's ``mavutil`` globals.
+"""
+
+from uavtool.mavlink.framing import Frame, FrameParser, new_encoder
+from uavtool.mavlink.dialect import DIALECT, mavlink
+
+__all__ = ["DIALECT", "Frame", "FrameParser", "mavlink", "new_encoder"]

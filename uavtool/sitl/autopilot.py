@@ -1,0 +1,414 @@
+"""The vehicle's brain: flight modes, arming, guided targets, failsafes, battery and gimbal.
+
+It knows nothing of sockets or MAVLink framing: the protocol layer (``gcs.py``) turns
+messages into calls here, and ``telemetry.py`` reads the state back out. Everything is
+driven by ``tick(now_ns)`` on the simulation clock, so a flight is the same at any speed-up.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from collections import deque
+
+from uavtool.geo import GeoPoint, enu_from_geo, geo_from_enu
+from uavtool.mavlink.dialect import mavlink
+from uavtool.sitl.auto import AutoMission
+from uavtool.sitl.params import ParamStore
+from uavtool.sitl.physics import Multicopter, Target, wrap_180
+from uavtool.sitl.state import (
+    ACCEPTED,
+    ARMABLE_MODES,
+    Gimbal,
+    Mode,
+    Result,
+    denied,
+    failed,
+)
+
+FORCE_MAGIC = 21196  # ArduPilot's "force" value for ARM_DISARM param2
+_NS = 1_000_000_000
+_SEV = mavlink  # severities: MAV_SEVERITY_*
+
+
+class Autopilot:
+    """An ArduCopter-like autopilot around a :class:`Multicopter`."""
+
+    def __init__(self, *, home: GeoPoint, home_heading_deg: float, params: ParamStore, seed: int) -> None:
+        self.params = params
+        self.home = home
+        self.rng = random.Random(seed)
+        self.vehicle = Multicopter(yaw_deg=home_heading_deg % 360.0, rng=self.rng)
+        self.mode = Mode.STABILIZE
+        self.armed = False
+        self.now_ns = 0
+        self.gimbal = Gimbal(pitch_deg=0.0, target_pitch_deg=0.0)
+        self.gimbal_owner = (0, 0)  # (sysid, compid) in primary control of the gimbal
+        self.mission = AutoMission(self)
+        self.events: deque[tuple[int, str]] = deque()  # (MAV_SEVERITY, text) to send as STATUSTEXT
+        self.failsafe_gcs = False
+        self.failsafe_battery = False
+        self.last_gcs_heartbeat_ns: int | None = None
+        self.speed_override_ms: float | None = None
+        self.taking_off = False
+        self._landed_since_ns: int | None = 0
+        self._rtl_stage = ""
+        self._rtl_alt = 0.0
+        self.land_ne = (0.0, 0.0)
+        self._velocity_deadline_ns = 0
+        self.battery_used_mah = 0.0
+        self.apply_params()
+
+    # ------------------------------------------------------------------ params
+    def apply_params(self) -> None:
+        """Refresh limits, wind and noise from the parameter table."""
+        p = self.params
+        lim = self.vehicle.limits
+        lim.speed_xy_ms = max(p["WPNAV_SPEED"], 20.0) / 100.0
+        if self.speed_override_ms is not None:
+            lim.speed_xy_ms = self.speed_override_ms
+        lim.speed_up_ms = max(p["WPNAV_SPEED_UP"], 10.0) / 100.0
+        lim.speed_dn_ms = max(p["WPNAV_SPEED_DN"], 10.0) / 100.0
+        lim.accel_xy_mss = max(p["WPNAV_ACCEL"], 50.0) / 100.0
+        lim.accel_z_mss = max(p["WPNAV_ACCEL_Z"], 50.0) / 100.0
+        lim.yaw_rate_dps = max(p["ATC_SLEW_YAW"], 500.0) / 100.0
+        lim.lean_max_deg = max(p["ANGLE_MAX"], 1000.0) / 100.0
+        wind_from = math.radians(p["SIM_WIND_DIR"])
+        speed = p["SIM_WIND_SPD"]
+        self.vehicle.wind_ned_ms = (-speed * math.cos(wind_from), -speed * math.sin(wind_from), 0.0)
+        self.vehicle.turbulence_ms = p["SIM_WIND_TURB"]
+
+    # ------------------------------------------------------------------ state read-outs
+    @property
+    def state(self):  # noqa: ANN201 - physics.State, re-exported for telemetry
+        return self.vehicle.state
+
+    @property
+    def on_ground(self) -> bool:
+        return self.vehicle.state.on_ground
+
+    def alt_rel_m(self) -> float:
+        return -self.vehicle.state.pos_ned_m[2]
+
+    def position_geo(self) -> GeoPoint:
+        n, e, d = self.vehicle.state.pos_ned_m
+        return geo_from_enu(self.home, e, n, -d)
+
+    def ned_of(self, point: GeoPoint) -> tuple[float, float, float]:
+        east, north, up = enu_from_geo(self.home, point)
+        return (north, east, -up)
+
+    def say(self, severity: int, text: str) -> None:
+        self.events.append((severity, text[:50]))
+
+    # ------------------------------------------------------------------ commands
+    def arm(self, *, force: bool) -> Result:
+        if self.armed:
+            return ACCEPTED
+        if not force and self.params["ARMING_CHECK"] != 0:
+            if self.mode not in ARMABLE_MODES:
+                return failed(f"Arm: Mode not armable ({self.mode.name})")
+            if self.battery_voltage() < self.params["BATT_LOW_VOLT"]:
+                return failed("PreArm: Battery below minimum arming voltage")
+        self.armed = True
+        self.vehicle.motors_on = True
+        self.vehicle.set_target(Target(yaw_deg=None))
+        self._landed_since_ns = self.now_ns
+        self.say(mavlink.MAV_SEVERITY_INFO, "Arming motors")
+        return ACCEPTED
+
+    def disarm(self, *, force: bool, reason: str = "Disarming motors") -> Result:
+        if not self.armed:
+            return ACCEPTED
+        if not force and not self.on_ground:
+            return denied("Disarm: vehicle is flying (use force)")
+        self.armed = False
+        self.taking_off = False
+        self.vehicle.motors_on = False
+        self.mission.stop()
+        self.say(mavlink.MAV_SEVERITY_INFO, reason)
+        return ACCEPTED
+
+    def set_mode(self, mode: Mode) -> Result:
+        if mode == Mode.AUTO and not self.mission.has_nav_items():
+            return failed("Mode change to AUTO failed: no mission")
+        if mode == Mode.AUTO and self.armed and self.on_ground and not self.mission.starts_with_takeoff():
+            return failed("Auto: Missing Takeoff Cmd")
+        if mode == self.mode:
+            return ACCEPTED
+        self.mode = mode
+        self.taking_off = False
+        self.speed_override_ms = None
+        self.apply_params()
+        if mode == Mode.AUTO:
+            self.mission.start()
+        else:
+            self.mission.stop()
+        if mode == Mode.RTL:
+            self._rtl_stage = "climb"
+        if mode == Mode.LAND:
+            self.land_ne = (self.state.pos_ned_m[0], self.state.pos_ned_m[1])
+        if mode in (Mode.LOITER, Mode.BRAKE, Mode.GUIDED, Mode.STABILIZE, Mode.ALT_HOLD, Mode.POSHOLD):
+            self.vehicle.set_target(Target(yaw_deg=None))  # brake and hold
+        return ACCEPTED
+
+    def takeoff(self, alt_m: float) -> Result:
+        if self.mode != Mode.GUIDED:
+            return failed(f"Takeoff: needs GUIDED mode, not {self.mode.name}")
+        if not self.armed:
+            return failed("Takeoff: vehicle not armed")
+        if not self.on_ground:
+            return failed("Takeoff: already flying")
+        if not 0.0 < alt_m:
+            return denied(f"Takeoff: altitude must be above 0 m, got {alt_m:g}")
+        fence = self.fence_check((self.state.pos_ned_m[0], self.state.pos_ned_m[1], -alt_m))
+        if fence is not None:
+            return fence
+        self.start_takeoff(alt_m)
+        return ACCEPTED
+
+    def start_takeoff(self, alt_m: float) -> None:
+        n, e, _ = self.state.pos_ned_m
+        self.taking_off = True
+        self.vehicle.set_target(Target(pos_ned_m=(n, e, -alt_m)))
+
+    def fence_check(self, pos_ned_m: tuple[float, float, float]) -> Result | None:
+        """DENIED if ``pos_ned_m`` lies outside the geofence (when FENCE_ENABLE)."""
+        if not self.params["FENCE_ENABLE"]:
+            return None
+        alt = -pos_ned_m[2]
+        if alt > self.params["FENCE_ALT_MAX"]:
+            return denied(f"Fence: altitude {alt:.0f} m above FENCE_ALT_MAX")
+        if math.hypot(pos_ned_m[0], pos_ned_m[1]) > self.params["FENCE_RADIUS"]:
+            return denied("Fence: target outside FENCE_RADIUS")
+        return None
+
+    def guided_position(
+        self, pos_ned_m: tuple[float, float, float], *, yaw_deg: float | None = None, switch_mode: bool = False
+    ) -> Result:
+        if self.mode != Mode.GUIDED:
+            if not switch_mode:
+                return failed(f"Guided: not in GUIDED mode ({self.mode.name})")
+            self.set_mode(Mode.GUIDED)
+        if not self.armed or (self.on_ground and not self.taking_off):
+            return failed("Guided: vehicle is not flying")
+        fence = self.fence_check(pos_ned_m)
+        if fence is not None:
+            return fence
+        yaw = yaw_deg if yaw_deg is not None else self.vehicle.target.yaw_deg
+        self.taking_off = False
+        self.vehicle.set_target(Target(pos_ned_m=pos_ned_m, yaw_deg=yaw))
+        return ACCEPTED
+
+    def guided_velocity(self, vel_ned_ms: tuple[float, float, float], *, yaw_deg: float | None = None) -> Result:
+        if self.mode != Mode.GUIDED:
+            return failed("Guided: not in GUIDED mode")
+        if not self.armed:
+            return failed("Guided: vehicle not armed")
+        self.taking_off = False
+        self._velocity_deadline_ns = self.now_ns + 3 * _NS  # ArduCopter: stop after 3 s without an update
+        self.vehicle.set_target(
+            Target(vel_ned_ms=vel_ned_ms, yaw_deg=yaw_deg if yaw_deg is not None else self.vehicle.target.yaw_deg)
+        )
+        return ACCEPTED
+
+    def condition_yaw(self, angle_deg: float, rate_dps: float, direction: int, relative: bool) -> Result:
+        if self.mode not in (Mode.GUIDED, Mode.AUTO):
+            return failed(f"Yaw: needs GUIDED or AUTO, not {self.mode.name}")
+        if not self.armed:
+            return failed("Yaw: vehicle not armed")
+        current = self.state.yaw_deg
+        if relative:
+            step = abs(angle_deg) * (-1.0 if direction < 0 else 1.0)
+            target = (current + step) % 360.0
+        else:
+            target = angle_deg % 360.0
+        t = self.vehicle.target
+        self.vehicle.target = Target(
+            pos_ned_m=t.pos_ned_m, vel_ned_ms=t.vel_ned_ms, yaw_deg=target, yaw_rate_dps=rate_dps if rate_dps > 0 else None
+        )
+        return ACCEPTED
+
+    def change_speed(self, speed_type: int, speed_ms: float) -> Result:
+        if speed_ms < 0:  # -1 means "no change"
+            return ACCEPTED
+        if speed_type in (0, 1):
+            self.speed_override_ms = max(0.2, speed_ms)
+            self.vehicle.limits.speed_xy_ms = self.speed_override_ms
+        elif speed_type == 2:
+            self.vehicle.limits.speed_up_ms = max(0.1, speed_ms)
+        elif speed_type == 3:
+            self.vehicle.limits.speed_dn_ms = max(0.1, speed_ms)
+        else:
+            return denied(f"Change speed: unknown speed type {speed_type}")
+        return ACCEPTED
+
+    def set_gimbal(self, *, pitch_deg: float | None, yaw_deg: float | None, yaw_locked: bool = False) -> Result:
+        g = self.gimbal
+        if pitch_deg is not None and not math.isnan(pitch_deg):
+            low, high = self.params["MNT1_PITCH_MIN"], self.params["MNT1_PITCH_MAX"]
+            g.target_pitch_deg = min(max(pitch_deg, low), high)
+        if yaw_deg is not None and not math.isnan(yaw_deg):
+            if yaw_locked:
+                # Earth-frame heading: keep it relative internally, re-evaluated as the vehicle turns.
+                g.yaw_locked = True
+                g.target_yaw_deg = yaw_deg % 360.0
+            else:
+                g.yaw_locked = False
+                low, high = self.params["MNT1_YAW_MIN"], self.params["MNT1_YAW_MAX"]
+                g.target_yaw_deg = min(max(wrap_180(yaw_deg), low), high)
+        return ACCEPTED
+
+    def gcs_heartbeat(self) -> None:
+        self.last_gcs_heartbeat_ns = self.now_ns
+        if self.failsafe_gcs:
+            self.failsafe_gcs = False
+            self.say(mavlink.MAV_SEVERITY_CRITICAL, "GCS Failsafe Cleared")
+
+    # ------------------------------------------------------------------ simulation
+    def tick(self, now_ns: int, dt_s: float) -> None:
+        """Advance the vehicle to ``now_ns`` (one physics step of ``dt_s``)."""
+        self.now_ns = now_ns
+        if self.armed:
+            self._run_mode()
+        self.vehicle.step(dt_s)
+        self._update_gimbal(dt_s)
+        self._update_battery(dt_s)
+        self._check_failsafes()
+        self._check_landed()
+
+    def _run_mode(self) -> None:
+        mode = self.mode
+        if mode == Mode.GUIDED:
+            t = self.vehicle.target
+            if t.vel_ned_ms is not None and self.now_ns > self._velocity_deadline_ns:
+                self.vehicle.set_target(Target(yaw_deg=t.yaw_deg))  # stale velocity stream: stop
+            if self.taking_off and self.alt_rel_m() >= -(t.pos_ned_m or (0, 0, 0))[2] - 0.1:
+                self.taking_off = False
+        elif mode == Mode.AUTO:
+            self.mission.update()
+        elif mode == Mode.RTL:
+            self._run_rtl()
+        elif mode == Mode.LAND:
+            self._descend()
+
+    def _descend(self) -> None:
+        speed = self.params["LAND_SPEED"] / 100.0
+        if self.alt_rel_m() > 10.0:
+            high = self.params["LAND_SPEED_HIGH"] or self.params["WPNAV_SPEED_DN"]
+            speed = high / 100.0
+        t = self.vehicle.target
+        n, e, _ = self.state.pos_ned_m
+        # Hold the horizontal position where landing began, descend at the landing rate.
+        land_n, land_e = self.land_ne
+        vn = max(-2.0, min(2.0, land_n - n))
+        ve = max(-2.0, min(2.0, land_e - e))
+        self.vehicle.target = Target(vel_ned_ms=(vn, ve, speed), yaw_deg=t.yaw_deg)
+
+    def _run_rtl(self) -> None:
+        rtl_alt = max(self.params["RTL_ALT"] / 100.0, 2.0)
+        n, e, d = self.state.pos_ned_m
+        speed = self.params["RTL_SPEED"] / 100.0
+        if speed > 0:
+            self.vehicle.limits.speed_xy_ms = speed
+        if self._rtl_stage == "climb":
+            alt = max(-d, rtl_alt)
+            self._rtl_alt = alt
+            if self.vehicle.target.pos_ned_m != (n, e, -alt):
+                self.vehicle.set_target(Target(pos_ned_m=(n, e, -alt)))
+            self._rtl_stage = "climbing"
+        if self._rtl_stage == "climbing" and -d >= self._rtl_alt - 0.2:
+            self.vehicle.set_target(Target(pos_ned_m=(0.0, 0.0, -self._rtl_alt)))
+            self._rtl_stage = "return"
+        if self._rtl_stage == "return" and math.hypot(n, e) < 0.5 and abs(self.state.vel_ned_ms[0]) < 0.2:
+            self._rtl_stage = "land"
+            self.land_ne = (0.0, 0.0)
+            self.say(mavlink.MAV_SEVERITY_INFO, "RTL: landing at home")
+        if self._rtl_stage == "land":
+            self._descend()
+
+    def _update_gimbal(self, dt_s: float) -> None:
+        g = self.gimbal
+        step = g.rate_dps * dt_s
+        g.pitch_deg += max(-step, min(step, g.target_pitch_deg - g.pitch_deg))
+        target_yaw = g.target_yaw_deg
+        if g.yaw_locked:
+            target_yaw = wrap_180(g.target_yaw_deg - self.state.yaw_deg)
+        g.yaw_deg += max(-step, min(step, wrap_180(target_yaw - g.yaw_deg)))
+
+    def battery_voltage(self) -> float:
+        full = self.params["SIM_BATT_VOLTAGE"]
+        capacity = max(self.params["BATT_CAPACITY"], 1.0)
+        remaining = max(0.0, 1.0 - self.battery_used_mah / capacity)
+        return full * (0.786 + 0.214 * remaining)  # 4S: 16.8 V full … 13.2 V empty
+
+    def battery_current_a(self) -> float:
+        if not self.armed:
+            return 0.3
+        s = self.vehicle.state
+        return 12.0 + 3.0 * math.hypot(s.accel_ned_mss[0], s.accel_ned_mss[1]) + 4.0 * max(0.0, -s.vel_ned_ms[2])
+
+    def battery_remaining_pct(self) -> int:
+        capacity = max(self.params["BATT_CAPACITY"], 1.0)
+        return max(0, min(100, round(100.0 * (1.0 - self.battery_used_mah / capacity))))
+
+    def _update_battery(self, dt_s: float) -> None:
+        self.battery_used_mah += self.battery_current_a() * dt_s * 1000.0 / 3600.0
+
+    def _check_failsafes(self) -> None:
+        p = self.params
+        action = int(p["FS_GCS_ENABLE"])
+        if (
+            action
+            and self.armed
+            and not self.failsafe_gcs
+            and self.last_gcs_heartbeat_ns is not None
+            and self.now_ns - self.last_gcs_heartbeat_ns > p["FS_GCS_TIMEOUT"] * _NS
+        ):
+            self.failsafe_gcs = True
+            self.say(mavlink.MAV_SEVERITY_CRITICAL, "GCS Failsafe")
+            self._failsafe_action(Mode.LAND if action in (4, 5) else Mode.RTL, keep_auto=action == 2)
+        if self.armed and not self.failsafe_battery and self.battery_voltage() < p["BATT_LOW_VOLT"]:
+            self.failsafe_battery = True
+            self.say(mavlink.MAV_SEVERITY_CRITICAL, "Battery 1 is low")
+            act = int(p["BATT_FS_LOW_ACT"])
+            if act:
+                self._failsafe_action(Mode.LAND if act == 1 else Mode.RTL, keep_auto=False)
+
+    def _failsafe_action(self, mode: Mode, *, keep_auto: bool) -> None:
+        if self.on_ground:
+            self.disarm(force=True, reason="Failsafe: disarming on the ground")
+            return
+        if keep_auto and self.mode == Mode.AUTO:
+            return
+        if self.mode not in (Mode.RTL, Mode.LAND) or mode == Mode.LAND:
+            self.set_mode(mode)
+
+    def _check_landed(self) -> None:
+        if not self.armed:
+            self._landed_since_ns = None
+            return
+        if not self.on_ground or self.taking_off:
+            self._landed_since_ns = None
+            return
+        if self._landed_since_ns is None:
+            self._landed_since_ns = self.now_ns
+            if self.mode in (Mode.LAND, Mode.RTL) or self.mission.landing():
+                self.disarm(force=True, reason="Land complete: disarming")
+            return
+        delay = self.params["DISARM_DELAY"]
+        if delay > 0 and self.now_ns - self._landed_since_ns > delay * _NS:
+            self.disarm(force=True, reason="Auto disarm: landed")
+
+    @property
+    def in_failsafe(self) -> bool:
+        return self.failsafe_gcs or self.failsafe_battery
+
+    def landed_state(self) -> int:
+        if not self.armed or (self.on_ground and not self.taking_off):
+            return mavlink.MAV_LANDED_STATE_ON_GROUND
+        if self.taking_off:
+            return mavlink.MAV_LANDED_STATE_TAKEOFF
+        if self.mode == Mode.LAND or (self.mode == Mode.RTL and self._rtl_stage == "land") or self.mission.landing():
+            return mavlink.MAV_LANDED_STATE_LANDING
+        return mavlink.MAV_LANDED_STATE_IN_AIR

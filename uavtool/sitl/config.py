@@ -1,0 +1,66 @@
+"""The SITL vehicle's start-up configuration (what ``uavtool sitl`` options set)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from uavtool.errors import InputError
+from uavtool.geo import GeoPoint
+
+DEFAULT_ENDPOINTS = ("tcpin:127.0.0.1:5760", "udpout:127.0.0.1:14550")
+# ArduPilot SITL's default home: Canberra Model Aircraft Club field.
+DEFAULT_HOME = (-35.363261, 149.165230, 584.0, 353.0)
+
+
+@dataclass(frozen=True, slots=True)
+class SitlConfig:
+    """How to start a vehicle. ``speedup`` ≥ 1000 means "as fast as the CPU allows"."""
+
+    endpoints: tuple[str, ...] = DEFAULT_ENDPOINTS
+    home: GeoPoint = field(default_factory=lambda: GeoPoint(*DEFAULT_HOME[:3]))
+    home_heading_deg: float = DEFAULT_HOME[3]
+    speedup: float = 1.0
+    sysid: int = 1
+    compid: int = 1
+    instance: int = 0
+    wind_speed_ms: float = 0.0
+    wind_dir_deg: float = 0.0
+    seed: int = 0
+    signing_key: bytes | None = None
+    params: tuple[tuple[str, float], ...] = ()
+
+    def __post_init__(self) -> None:
+        if not 1 <= self.sysid + self.instance <= 254:
+            raise InputError(f"sysid {self.sysid} + instance {self.instance} must be in 1-254")
+        if self.instance < 0:
+            raise InputError(f"instance must be ≥ 0, got {self.instance}")
+        if not self.speedup > 0:
+            raise InputError(f"speedup must be > 0, got {self.speedup}")
+        if self.signing_key is not None and len(self.signing_key) != 32:
+            raise InputError("signing key must be 32 bytes (64 hex digits)")
+        if self.wind_speed_ms < 0:
+            raise InputError(f"wind speed must be ≥ 0, got {self.wind_speed_ms}")
+
+
+def parse_home(text: str) -> tuple[GeoPoint, float]:
+    """``LAT,LON,ALT,HDG`` → (home, heading). Raises InputError naming the bad part."""
+    parts = text.split(",")
+    if len(parts) != 4:
+        raise InputError(f"--home {text!r}: expected LAT,LON,ALT,HDG")
+    try:
+        lat, lon, alt, hdg = (float(p) for p in parts)
+    except ValueError:
+        raise InputError(f"--home {text!r}: all four values must be numbers") from None
+    if not (-90 <= lat <= 90 and -180 <= lon <= 180):
+        raise InputError(f"--home {text!r}: latitude/longitude out of range")
+    return GeoPoint(lat, lon, alt), hdg % 360.0
+
+
+def parse_signing_key(text: str) -> bytes:
+    try:
+        key = bytes.fromhex(text)
+    except ValueError:
+        raise InputError("--signing-key: not a hex string") from None
+    if len(key) != 32:
+        raise InputError(f"--signing-key: need 32 bytes (64 hex digits), got {len(key)}")
+    return key

@@ -1,0 +1,236 @@
+"""The simulation loop: sim clock, physics steps, links, and pacing against wall time.
+
+One thread owns everything (sockets, autopilot, telemetry), so there are no locks on the
+hot path. Simulation time advances in fixed steps (``SIM_RATE_HZ``); wall time only
+decides *when* a step runs (``speedup``), never what it computes, so a flight is the same
+at ``--speedup 1`` and ``--speedup 50`` for the same commands at the same sim times.
+"""
+
+from __future__ import annotations
+
+import logging
+import selectors
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+from uavtool.mavlink.dialect import mavlink as M
+from uavtool.sitl.autopilot import Autopilot
+from uavtool.sitl.config import SitlConfig
+from uavtool.sitl.gcs import GcsSession
+from uavtool.sitl.links import (
+    FrameTap,
+    Link,
+    TcpClient,
+    TcpConnection,
+    TcpListener,
+    UdpSocket,
+    _Socketed,
+    parse_endpoint,
+)
+from uavtool.sitl.params import ParamStore
+
+log = logging.getLogger(__name__)
+_NS = 1_000_000_000
+_MAX_LAG_S = 0.25  # at real-time-ish speed-ups, drop lag beyond this instead of bursting
+
+
+class Sitl:
+    """A simulated ArduCopter with its MAVLink endpoints.
+
+    Use as a context manager to run it in a background thread::
+
+        with Sitl(SitlConfig(endpoints=("tcpin:127.0.0.1:0",), speedup=20)) as sitl:
+            port = sitl.ports[0]
+    """
+
+    def __init__(self, config: SitlConfig, *, frame_tap: FrameTap | None = None) -> None:
+        self.config = config
+        self.sysid = config.sysid + config.instance
+        self.compid = config.compid
+        self.signing_key = config.signing_key
+        self.frame_tap = frame_tap
+        params = ParamStore()
+        params.set("SYSID_THISMAV", self.sysid)
+        params.set("SIM_SPEEDUP", config.speedup)
+        params.set("SIM_WIND_SPD", config.wind_speed_ms)
+        params.set("SIM_WIND_DIR", config.wind_dir_deg)
+        for name, value in config.params:
+            params.set(name, value)
+        self.speedup = params["SIM_SPEEDUP"]
+        self.dt_ns = _NS // max(int(params["SIM_RATE_HZ"]), 1)
+        self.autopilot = Autopilot(
+            home=config.home, home_heading_deg=config.home_heading_deg, params=params, seed=config.seed
+        )
+        from uavtool.sitl.telemetry import Telemetry  # after autopilot: telemetry reads it
+
+        self.telemetry = Telemetry(
+            self.autopilot, sysid=self.sysid, instance=config.instance, start_unix_us=int(time.time() * 1e6)
+        )
+        self.sessions: list[GcsSession] = []
+        self._selector = selectors.DefaultSelector()
+        self._sockets: list[_Socketed] = []
+        self._link_counter = 0
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._pacing_reset = True
+        self.steps = 0
+        self.error: BaseException | None = None
+        try:
+            for text in config.endpoints:
+                self._open(parse_endpoint(text).offset(config.instance))
+        except Exception:
+            self.close()
+            raise
+
+    # ------------------------------------------------------------------ endpoints
+    def _make_link(self, name: str, send: Callable[[bytes], None]) -> Link:
+        self._link_counter += 1
+        link = Link(
+            name, send, sysid=self.sysid, compid=self.compid, signing_key=self.signing_key,
+            link_id=self._link_counter & 0xFF, tap=self.frame_tap,
+        )  # fmt: skip
+        session = GcsSession(self, link)
+        link.session = session
+        self.sessions.append(session)
+        return link
+
+    def _open(self, endpoint: Any) -> None:
+        sock: _Socketed
+        if endpoint.kind == "tcpin":
+            sock = TcpListener(endpoint, self._make_link)
+        elif endpoint.kind == "tcp":
+            sock = TcpClient(endpoint, self._make_link)
+        else:
+            sock = UdpSocket(endpoint, self._make_link)
+        self._register(sock)
+
+    def _register(self, sock: _Socketed) -> None:
+        self._sockets.append(sock)
+        self._selector.register(sock.sock, selectors.EVENT_READ, sock)
+
+    @property
+    def ports(self) -> list[int]:
+        """The local port of each endpoint, in order (resolves ``:0`` ephemeral ports)."""
+        return [int(s.sock.getsockname()[1]) for s in self._sockets if isinstance(s, (TcpListener, UdpSocket))]
+
+    def describe_endpoints(self) -> list[str]:
+        out = []
+        for s in self._sockets:
+            ep = getattr(s, "endpoint", None)
+            if ep is None:
+                continue
+            port = s.sock.getsockname()[1] if ep.kind in ("tcpin", "udpin") else ep.port
+            out.append(f"{ep.kind}:{ep.host}:{port}")
+        return out
+
+    # ------------------------------------------------------------------ parameters
+    def set_param(self, name: str, value: float) -> float:
+        stored = self.autopilot.params.set(name, value)
+        if name == "SIM_SPEEDUP" and stored > 0:
+            self.speedup = stored
+            self._pacing_reset = True
+        self.autopilot.apply_params()
+        return stored
+
+    # ------------------------------------------------------------------ running
+    @property
+    def now_ns(self) -> int:
+        return self.autopilot.now_ns
+
+    def broadcast(self, msg: Any) -> None:
+        for session in self.sessions:
+            session.send(msg)
+
+    def step(self) -> None:
+        """Advance the simulation by one physics step and send what is due."""
+        ap = self.autopilot
+        now = ap.now_ns + self.dt_ns
+        ap.tick(now, self.dt_ns / _NS)
+        self.steps += 1
+        while ap.events:
+            severity, text = ap.events.popleft()
+            self.broadcast(M.MAVLink_statustext_message(severity, text.encode()))
+        mission = ap.mission
+        if mission.changed:
+            mission.changed = False
+            self.broadcast(self.telemetry.mission_current())
+        while mission.reached:
+            self.broadcast(M.MAVLink_mission_item_reached_message(mission.reached.pop(0)))
+        for session in self.sessions:
+            session.tick(now)
+
+    def poll(self, timeout_s: float) -> None:
+        """Serve sockets for up to ``timeout_s`` (0: only what is already waiting)."""
+        for conn in self._tcp_connections():
+            if conn.wants_write():
+                conn.on_writable()
+        for key, _ in self._selector.select(max(timeout_s, 0.0)):
+            owner: _Socketed = key.data
+            for link, data in owner.on_readable():
+                for frame in link.receive(data):
+                    try:
+                        link.session.handle(frame)
+                    except Exception:  # a bug must not let one peer take the vehicle down
+                        log.exception("error handling %s from %s", frame.msg.get_type(), link.name)
+            if isinstance(owner, TcpListener):
+                while owner.accepted:
+                    self._register(owner.accepted.pop())
+        self._reap()
+
+    def _tcp_connections(self) -> list[TcpConnection]:
+        return [s for s in self._sockets if isinstance(s, TcpConnection)]
+
+    def _reap(self) -> None:
+        for sock in self._tcp_connections():
+            if sock.link.closed:
+                self._selector.unregister(sock.sock)
+                sock.close()
+                self._sockets.remove(sock)
+                self.sessions.remove(sock.link.session)
+
+    def run(self, *, duration_s: float | None = None) -> None:
+        """Run in this thread until ``stop()`` (or for ``duration_s`` of sim time)."""
+        end_ns = None if duration_s is None else self.now_ns + int(duration_s * _NS)
+        wall0 = sim0 = 0.0
+        while not self._stop.is_set() and (end_ns is None or self.now_ns < end_ns):
+            if self._pacing_reset:
+                wall0, sim0, self._pacing_reset = time.perf_counter(), self.now_ns / _NS, False
+            self.step()
+            due = wall0 + (self.now_ns / _NS - sim0) / self.speedup
+            wait = due - time.perf_counter()
+            if wait < -_MAX_LAG_S and self.speedup < 100:
+                self._pacing_reset = True  # we were starved; don't burst to catch up
+            self.poll(wait)
+
+    def start(self) -> Sitl:
+        """Run in a daemon thread; returns self."""
+        self._thread = threading.Thread(target=self._run_guarded, name=f"sitl-{self.sysid}", daemon=True)
+        self._thread.start()
+        return self
+
+    def _run_guarded(self) -> None:
+        try:
+            self.run()
+        except BaseException as exc:
+            self.error = exc
+            log.exception("SITL vehicle stopped")
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread is not None and self._thread is not threading.current_thread():
+            self._thread.join(timeout=5.0)
+        self.close()
+
+    def close(self) -> None:
+        for sock in self._sockets:
+            sock.close()
+        self._sockets.clear()
+        self._selector.close()
+
+    def __enter__(self) -> Sitl:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
