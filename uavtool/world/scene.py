@@ -1,0 +1,450 @@
+"""Scenes: buildings made of extruded blocks around home, plus ground, sky and sun.
+
+A scene file (YAML, TOML or JSON) holds the same data as :func:`scene_to_dict`::
+
+    version: 1
+    name: paper
+    origin: {lat_deg: 50.06, lon_deg: 19.94, alt_amsl_m: 220.0, heading_deg: 0.0}
+    ground: {color: [128, 128, 128]}
+    sky: {color: [205, 218, 232]}
+    lighting: {sun_azimuth_deg: 150.0, sun_elevation_deg: 60.0, ambient: 0.55}
+    target: red
+    buildings:
+      - name: red
+        color: [210, 40, 40]
+        blocks:
+          - {footprint: [[0, 0], [4, 0], [4, 3], [0, 3]], base_m: 0.0, top_m: 6.0}
+
+Footprints are metres east/north of home; they are stored counter-clockwise (a clockwise
+footprint is reversed on load). A building is the union of its blocks, so stacked blocks
+make stepped towers and a block resting on two others makes a through-hole.
+"""
+
+from __future__ import annotations
+
+import difflib
+import json
+import math
+import tomllib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any, NoReturn
+
+import shapely  # type: ignore[import-untyped]
+import yaml
+
+from uavtool.geo import GeoPoint
+from uavtool.world.errors import SceneError
+from uavtool.world.polygon import normalise_ring, signed_area
+
+FORMAT_VERSION = 1
+_MIN_AREA_M2 = 1e-4
+_OVERLAP_M2 = 1e-6
+
+KeyPath = tuple[str | int, ...]
+RGB = tuple[int, int, int]
+
+DEFAULT_GROUND_RGB: RGB = (128, 128, 128)
+DEFAULT_SKY_RGB: RGB = (205, 218, 232)
+
+
+@dataclass(frozen=True, slots=True)
+class Block:
+    """A prism: a simple counter-clockwise footprint extruded from ``base_m`` up to ``top_m``."""
+
+    footprint_enu_m: tuple[tuple[float, float], ...]
+    base_m: float
+    top_m: float
+
+
+@dataclass(frozen=True, slots=True)
+class Building:
+    """A named, single-coloured union of blocks."""
+
+    name: str
+    color_rgb: RGB
+    blocks: tuple[Block, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class Lighting:
+    """A directional sun (azimuth clockwise from north) plus an ambient share in [0, 1]."""
+
+    sun_azimuth_deg: float = 150.0
+    sun_elevation_deg: float = 60.0
+    ambient: float = 0.55
+
+
+@dataclass(frozen=True, slots=True)
+class Scene:
+    """Everything the renderer and the evaluation need; buildings in ENU metres around home."""
+
+    name: str
+    home: GeoPoint
+    home_heading_deg: float
+    buildings: tuple[Building, ...]
+    target: str
+    ground_rgb: RGB = DEFAULT_GROUND_RGB
+    sky_rgb: RGB = DEFAULT_SKY_RGB
+    lighting: Lighting = Lighting()
+    description: str = ""
+
+    def building(self, name: str) -> Building:
+        """The building called ``name``; raises SceneError if there is none."""
+        for b in self.buildings:
+            if b.name == name:
+                return b
+        raise SceneError(f"scene {self.name!r} has no building {name!r}")
+
+    @property
+    def target_building(self) -> Building:
+        return self.building(self.target)
+
+
+# --------------------------------------------------------------------------- to dict
+
+
+def scene_to_dict(scene: Scene) -> dict[str, Any]:
+    """Plain data (str, int, float, list, dict) that :func:`scene_from_dict` reads back."""
+    return {
+        "version": FORMAT_VERSION,
+        "name": scene.name,
+        "description": scene.description,
+        "origin": {
+            "lat_deg": scene.home.lat_deg,
+            "lon_deg": scene.home.lon_deg,
+            "alt_amsl_m": scene.home.alt_amsl_m,
+            "heading_deg": scene.home_heading_deg,
+        },
+        "ground": {"color": list(scene.ground_rgb)},
+        "sky": {"color": list(scene.sky_rgb)},
+        "lighting": {
+            "sun_azimuth_deg": scene.lighting.sun_azimuth_deg,
+            "sun_elevation_deg": scene.lighting.sun_elevation_deg,
+            "ambient": scene.lighting.ambient,
+        },
+        "target": scene.target,
+        "buildings": [
+            {
+                "name": b.name,
+                "color": list(b.color_rgb),
+                "blocks": [
+                    {
+                        "footprint": [[x, y] for x, y in blk.footprint_enu_m],
+                        "base_m": blk.base_m,
+                        "top_m": blk.top_m,
+                    }
+                    for blk in b.blocks
+                ],
+            }
+            for b in scene.buildings
+        ],
+    }
+
+
+# --------------------------------------------------------------------------- from dict
+
+
+def _format_path(path: KeyPath) -> str:
+    out = ""
+    for part in path:
+        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else part)
+    return out
+
+
+class _Reader:
+    """Type-checked access to parsed data; every failure names the source, line and key path."""
+
+    def __init__(self, source: str, lines: Mapping[KeyPath, int]) -> None:
+        self.source = source
+        self.lines = lines
+
+    def fail(self, path: KeyPath, message: str) -> NoReturn:
+        line = None
+        for n in range(len(path), -1, -1):
+            line = self.lines.get(path[:n])
+            if line is not None:
+                break
+        where = f"{self.source}:{line}" if line is not None else self.source
+        key = _format_path(path)
+        raise SceneError(f"{where}: {key}: {message}" if key else f"{where}: {message}")
+
+    def mapping(
+        self, value: object, path: KeyPath, required: Sequence[str], optional: Sequence[str] = ()
+    ) -> dict[str, Any]:
+        if not isinstance(value, Mapping):
+            self.fail(path, f"expected a mapping, got {_kind(value)}")
+        allowed = [*required, *optional]
+        for key in value:
+            if key not in allowed:
+                hint = difflib.get_close_matches(str(key), allowed, n=1)
+                extra = f" (did you mean {hint[0]!r}?)" if hint else ""
+                self.fail((*path, str(key)), f"unknown key{extra}; allowed: {', '.join(allowed)}")
+        for key in required:
+            if key not in value:
+                self.fail(path, f"missing key {key!r}")
+        return dict(value)
+
+    def number(self, value: object, path: KeyPath) -> float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            self.fail(path, f"expected a number, got {_kind(value)}")
+        out = float(value)
+        if not math.isfinite(out):
+            self.fail(path, f"expected a finite number, got {value}")
+        return out
+
+    def text(self, value: object, path: KeyPath) -> str:
+        if not isinstance(value, str):
+            self.fail(path, f"expected a string, got {_kind(value)}")
+        return value
+
+    def sequence(self, value: object, path: KeyPath) -> list[Any]:
+        if not isinstance(value, list | tuple):
+            self.fail(path, f"expected a list, got {_kind(value)}")
+        return list(value)
+
+    def color(self, value: object, path: KeyPath) -> RGB:
+        items = self.sequence(value, path)
+        ok = len(items) == 3 and all(
+            isinstance(c, int) and not isinstance(c, bool) and 0 <= c <= 255 for c in items
+        )
+        if not ok:
+            self.fail(path, f"expected [r, g, b] with integers 0-255, got {value!r}")
+        return (items[0], items[1], items[2])
+
+
+def _kind(value: object) -> str:
+    return "nothing" if value is None else type(value).__name__
+
+
+def scene_from_dict(data: object, *, source: str = "<scene>") -> Scene:
+    """Validate plain data and build a Scene; raises SceneError naming ``source`` and the key."""
+    return _scene_from(data, _Reader(source, {}), default_name=Path(source).stem)
+
+
+def _scene_from(data: object, r: _Reader, *, default_name: str) -> Scene:
+    top = r.mapping(
+        data,
+        (),
+        required=("target", "buildings"),
+        optional=("version", "name", "description", "origin", "ground", "sky", "lighting"),
+    )
+    version = top.get("version", FORMAT_VERSION)
+    if version != FORMAT_VERSION:
+        r.fail(
+            ("version",), f"unsupported scene format version {version!r} (this is {FORMAT_VERSION})"
+        )
+    name = r.text(top.get("name", default_name), ("name",))
+    description = r.text(top.get("description", ""), ("description",))
+
+    origin = r.mapping(
+        top.get("origin", {}), ("origin",), (), ("lat_deg", "lon_deg", "alt_amsl_m", "heading_deg")
+    )
+    lat = r.number(origin.get("lat_deg", 0.0), ("origin", "lat_deg"))
+    lon = r.number(origin.get("lon_deg", 0.0), ("origin", "lon_deg"))
+    if not -90.0 <= lat <= 90.0:
+        r.fail(("origin", "lat_deg"), f"latitude must be in [-90, 90], got {lat}")
+    if not -180.0 <= lon <= 180.0:
+        r.fail(("origin", "lon_deg"), f"longitude must be in [-180, 180], got {lon}")
+    home = GeoPoint(lat, lon, r.number(origin.get("alt_amsl_m", 0.0), ("origin", "alt_amsl_m")))
+    heading = r.number(origin.get("heading_deg", 0.0), ("origin", "heading_deg"))
+
+    ground = r.mapping(top.get("ground", {}), ("ground",), (), ("color",))
+    sky = r.mapping(top.get("sky", {}), ("sky",), (), ("color",))
+    ground_rgb = r.color(ground.get("color", list(DEFAULT_GROUND_RGB)), ("ground", "color"))
+    sky_rgb = r.color(sky.get("color", list(DEFAULT_SKY_RGB)), ("sky", "color"))
+    lighting = _lighting_from(top.get("lighting", {}), r)
+
+    raw_buildings = r.sequence(top["buildings"], ("buildings",))
+    if not raw_buildings:
+        r.fail(("buildings",), "a scene needs at least one building")
+    buildings = tuple(_building_from(b, ("buildings", i), r) for i, b in enumerate(raw_buildings))
+    names = [b.name for b in buildings]
+    for i, n in enumerate(names):
+        if n in names[:i]:
+            r.fail(("buildings", i, "name"), f"duplicate building name {n!r}")
+    _check_buildings_apart(buildings, r)
+
+    target = r.text(top["target"], ("target",))
+    if target not in names:
+        r.fail(("target",), f"no building named {target!r}; buildings: {', '.join(names)}")
+    return Scene(
+        name=name,
+        home=home,
+        home_heading_deg=heading,
+        buildings=buildings,
+        target=target,
+        ground_rgb=ground_rgb,
+        sky_rgb=sky_rgb,
+        lighting=lighting,
+        description=description,
+    )
+
+
+def _lighting_from(value: object, r: _Reader) -> Lighting:
+    d = r.mapping(value, ("lighting",), (), ("sun_azimuth_deg", "sun_elevation_deg", "ambient"))
+    default = Lighting()
+    az = r.number(
+        d.get("sun_azimuth_deg", default.sun_azimuth_deg), ("lighting", "sun_azimuth_deg")
+    )
+    el_path: KeyPath = ("lighting", "sun_elevation_deg")
+    el = r.number(d.get("sun_elevation_deg", default.sun_elevation_deg), el_path)
+    if not 0.0 < el <= 90.0:
+        r.fail(el_path, f"sun elevation must be in (0, 90] degrees, got {el}")
+    amb = r.number(d.get("ambient", default.ambient), ("lighting", "ambient"))
+    if not 0.0 <= amb <= 1.0:
+        r.fail(("lighting", "ambient"), f"ambient must be in [0, 1], got {amb}")
+    return Lighting(az, el, amb)
+
+
+def _building_from(value: object, path: KeyPath, r: _Reader) -> Building:
+    d = r.mapping(value, path, ("name", "color", "blocks"))
+    name = r.text(d["name"], (*path, "name"))
+    if not name.strip() or any(c in name for c in "\n\r\t"):
+        r.fail((*path, "name"), f"building name must be a non-empty single line, got {name!r}")
+    color = r.color(d["color"], (*path, "color"))
+    raw_blocks = r.sequence(d["blocks"], (*path, "blocks"))
+    if not raw_blocks:
+        r.fail((*path, "blocks"), "a building needs at least one block")
+    blocks = tuple(_block_from(b, (*path, "blocks", i), r) for i, b in enumerate(raw_blocks))
+    for i in range(len(blocks)):
+        for j in range(i):
+            if _blocks_overlap(blocks[i], blocks[j]):
+                r.fail((*path, "blocks", i), f"overlaps blocks[{j}] of the same building")
+    return Building(name, color, blocks)
+
+
+def _block_from(value: object, path: KeyPath, r: _Reader) -> Block:
+    d = r.mapping(value, path, ("footprint", "top_m"), ("base_m",))
+    fp_path: KeyPath = (*path, "footprint")
+    raw = r.sequence(d["footprint"], fp_path)
+    pts: list[tuple[float, float]] = []
+    for k, p in enumerate(raw):
+        xy = r.sequence(p, (*fp_path, k))
+        if len(xy) != 2:
+            r.fail((*fp_path, k), f"expected [east_m, north_m], got {p!r}")
+        pts.append((r.number(xy[0], (*fp_path, k, 0)), r.number(xy[1], (*fp_path, k, 1))))
+    if len(pts) > 1 and pts[0] == pts[-1]:
+        pts.pop()
+    if len(pts) < 3:
+        r.fail(fp_path, f"a footprint needs at least 3 vertices, got {len(pts)}")
+    for k in range(len(pts)):
+        if pts[k] == pts[k - 1]:
+            r.fail((*fp_path, k), "repeated vertex")
+    if abs(signed_area(pts)) < _MIN_AREA_M2:
+        r.fail(fp_path, "polygon has zero area")
+    if not shapely.LinearRing(pts).is_simple:
+        r.fail(fp_path, "self-intersecting polygon")
+    ring = normalise_ring(pts)
+    base = r.number(d.get("base_m", 0.0), (*path, "base_m"))
+    top = r.number(d["top_m"], (*path, "top_m"))
+    if base < 0.0:
+        r.fail((*path, "base_m"), f"base must be >= 0, got {base}")
+    if top <= base:
+        r.fail((*path, "top_m"), f"top ({top}) must be above base ({base})")
+    return Block(ring, base, top)
+
+
+def _blocks_overlap(a: Block, b: Block) -> bool:
+    if min(a.top_m, b.top_m) - max(a.base_m, b.base_m) <= 0.0:
+        return False
+    inter = shapely.Polygon(a.footprint_enu_m).intersection(shapely.Polygon(b.footprint_enu_m))
+    return bool(inter.area > _OVERLAP_M2)
+
+
+def _check_buildings_apart(buildings: Sequence[Building], r: _Reader) -> None:
+    shapes = [
+        shapely.unary_union([shapely.Polygon(blk.footprint_enu_m) for blk in b.blocks])
+        for b in buildings
+    ]
+    for i in range(len(shapes)):
+        for j in range(i):
+            if shapes[i].intersection(shapes[j]).area > _OVERLAP_M2:
+                r.fail(
+                    ("buildings", i),
+                    f"building {buildings[i].name!r} overlaps building {buildings[j].name!r}",
+                )
+
+
+# --------------------------------------------------------------------------- files
+
+
+def builtin_scene_names() -> tuple[str, ...]:
+    """Names of the scenes shipped with uavtool, sorted."""
+    folder = resources.files("uavtool.world") / "scenes"
+    return tuple(sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".yaml")))
+
+
+def load_scene(name_or_path: str | Path) -> Scene:
+    """Load a built-in scene by name (``"paper"``) or a YAML/TOML/JSON scene file.
+
+    Raises SceneError (exit code 2) for a missing file or any invalid content.
+    """
+    text_name = str(name_or_path)
+    if isinstance(name_or_path, str) and text_name in builtin_scene_names():
+        ref = resources.files("uavtool.world") / "scenes" / f"{text_name}.yaml"
+        return _parse(ref.read_text(encoding="utf-8"), source=f"{text_name}.yaml", suffix=".yaml")
+    path = Path(name_or_path)
+    if not path.is_file():
+        known = ", ".join(builtin_scene_names())
+        raise SceneError(f"{path}: no such scene file (built-in scenes: {known})")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SceneError(f"{path}: cannot read scene file: {exc}") from exc
+    return _parse(text, source=str(path), suffix=path.suffix.lower())
+
+
+def parse_scene(text: str, *, source: str, suffix: str = ".yaml") -> Scene:
+    """Parse scene file content; ``suffix`` (.yaml/.yml/.toml/.json) picks the syntax."""
+    return _parse(text, source=source, suffix=suffix)
+
+
+def _parse(text: str, *, source: str, suffix: str) -> Scene:
+    lines: dict[KeyPath, int] = {}
+    data: object
+    if suffix == ".toml":
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise SceneError(f"{source}: invalid TOML: {exc}") from exc
+    elif suffix == ".json":
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise SceneError(f"{source}:{exc.lineno}: invalid JSON: {exc.msg}") from exc
+    else:
+        data = _load_yaml(text, source, lines)
+    return _scene_from(data, _Reader(source, lines), default_name=Path(source).stem)
+
+
+def _load_yaml(text: str, source: str, lines: dict[KeyPath, int]) -> object:
+    loader = yaml.SafeLoader(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            raise SceneError(f"{source}: empty scene file")
+        _record_lines(node, (), lines)
+        return loader.construct_document(node)
+    except yaml.MarkedYAMLError as exc:
+        line = exc.problem_mark.line + 1 if exc.problem_mark is not None else "?"
+        raise SceneError(f"{source}:{line}: invalid YAML: {exc.problem}") from exc
+    except yaml.YAMLError as exc:
+        raise SceneError(f"{source}: invalid YAML: {exc}") from exc
+    finally:
+        loader.dispose()
+
+
+def _record_lines(node: yaml.Node, path: KeyPath, lines: dict[KeyPath, int]) -> None:
+    lines[path] = node.start_mark.line + 1
+    if isinstance(node, yaml.MappingNode):
+        for key_node, value_node in node.value:
+            key = str(key_node.value)
+            lines[(*path, key)] = key_node.start_mark.line + 1
+            _record_lines(value_node, (*path, key), lines)
+            lines[(*path, key)] = key_node.start_mark.line + 1
+    elif isinstance(node, yaml.SequenceNode):
+        for i, item in enumerate(node.value):
+            _record_lines(item, (*path, i), lines)
