@@ -1,0 +1,84 @@
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from uavtool.vision import VectorizeParams, vectorize
+from uavtool.vision.errors import ImageError, VisionParamError
+
+from .synth import draw, family_shape, place
+
+RED = (210, 40, 40)
+BLUE = (40, 60, 210)
+YELLOW = (230, 210, 40)
+
+
+def _scene(noise: float = 0.0) -> np.ndarray:
+    rect = place(family_shape("rect", 0.6, 0.3), angle_deg=0, size_px=160, centre=(150, 150))
+    ell = place(family_shape("L", 1.0, 0.4), angle_deg=30, size_px=150, centre=(430, 170))
+    tri = np.array([[300.0, 330.0], [420.0, 460.0], [250.0, 440.0]])
+    hole = place(family_shape("rect", 1.0, 0.3), angle_deg=0, size_px=40, centre=(150, 150))
+    return draw([(rect, BLUE), (ell, RED), (tri, YELLOW)], noise_sigma=noise, holes=[hole])
+
+
+def test_finds_each_coloured_region_with_its_colour_corners_and_holes() -> None:
+    shapes = vectorize(_scene())
+    assert len(shapes) == 3
+    by_colour = {s.colour_rgb: s for s in shapes}
+    blue = next(s for c, s in by_colour.items() if c[2] > 150)
+    red = next(s for c, s in by_colour.items() if c[0] > 150 and c[1] < 100)
+    yellow = next(s for c, s in by_colour.items() if c[0] > 150 and c[1] > 150)
+    assert len(blue.polygon_px) == 4
+    assert len(blue.holes_px) == 1
+    assert len(red.polygon_px) == 6
+    assert len(yellow.polygon_px) in (3, 4)  # the acute corner may be split in two
+    # Area: a 160×96 rectangle with a 40×40 hole, within a few percent.
+    assert blue.area_px == pytest.approx(160 * 96 - 40 * 40, rel=0.03)
+    assert blue.centroid_px == pytest.approx((150, 150), abs=1.0)
+    assert not any(s.cut_by_border for s in shapes)
+    # The kept colour is the region's colour (lit or shaded half), not the ground's.
+    assert blue.colour_rgb in (BLUE, tuple(int(c * 0.85) for c in BLUE))
+
+
+def test_noise_does_not_change_the_shapes() -> None:
+    clean = vectorize(_scene())
+    noisy = vectorize(_scene(noise=8.0))
+    assert [len(s.polygon_px) for s in clean] == [len(s.polygon_px) for s in noisy]
+    for a, b in zip(clean, noisy, strict=True):
+        assert b.area_px == pytest.approx(a.area_px, rel=0.02)
+
+
+def test_is_deterministic_bit_for_bit() -> None:
+    frame = _scene(noise=8.0)
+    a = vectorize(frame)
+    b = vectorize(frame.copy())
+    for s, t in zip(a, b, strict=True):
+        assert s.polygon_px.tobytes() == t.polygon_px.tobytes()
+        assert s.area_px == t.area_px
+
+
+def test_flags_shapes_cut_by_the_border_and_drops_tiny_blobs() -> None:
+    cut = np.array([[-20.0, 100.0], [100.0, 100.0], [100.0, 200.0], [-20.0, 200.0]])
+    speck = np.array([[300.0, 300.0], [305.0, 300.0], [305.0, 305.0], [300.0, 305.0]])
+    shapes = vectorize(draw([(cut, RED), (speck, BLUE)]))
+    assert len(shapes) == 1
+    assert shapes[0].cut_by_border
+
+
+def test_palette_extracts_only_the_listed_colour() -> None:
+    shapes = vectorize(_scene(noise=5.0), VectorizeParams(palette_rgb=(RED,)))
+    assert len(shapes) == 1
+    assert len(shapes[0].polygon_px) == 6
+
+
+def test_grey_ground_alone_gives_no_shapes() -> None:
+    assert vectorize(draw([], noise_sigma=10.0)) == ()
+
+
+def test_bad_input_raises_one_line_errors() -> None:
+    with pytest.raises(ImageError, match="uint8"):
+        vectorize(np.zeros((10, 10), np.float32))  # type: ignore[arg-type]
+    with pytest.raises(VisionParamError, match="rdp_epsilon_px"):
+        VectorizeParams(rdp_epsilon_px=-1.0)
+    with pytest.raises(VisionParamError, match="denoise_px"):
+        VectorizeParams(denoise_px=4)

@@ -1,0 +1,98 @@
+"""The vector shape: what vectorization produces and recognition and model building consume."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True, slots=True)
+class Shape:
+    """One coloured region of a frame as polygons in pixel coordinates (OpenCV convention).
+
+    ``polygon_px`` : (n, 2) float — the outer ring, oriented so :func:`signed_area` is
+    positive (clockwise as seen on screen, where y points down), without repeating the
+    first vertex at the end.
+    ``holes_px`` : tuple of (m, 2) float — inner rings (a courtyard seen from above),
+    oriented the other way (negative signed area).
+    ``area_px`` : outer area minus hole areas, in square pixels.
+    ``centroid_px`` : area centroid ``(u, v)`` of the region with holes removed.
+    ``cut_by_border`` : the region touches the image border, so its outline is incomplete.
+    """
+
+    colour_rgb: tuple[int, int, int]
+    polygon_px: FloatArray
+    holes_px: tuple[FloatArray, ...]
+    area_px: float
+    centroid_px: tuple[float, float]
+    cut_by_border: bool
+
+    @classmethod
+    def from_rings(
+        cls,
+        *,
+        colour_rgb: tuple[int, int, int],
+        polygon_px: FloatArray,
+        holes_px: tuple[FloatArray, ...] = (),
+        cut_by_border: bool = False,
+    ) -> Shape:
+        """A shape whose orientation, area and centroid are computed from its rings."""
+        outer = orient(np.asarray(polygon_px, dtype=np.float64), positive=True)
+        holes = tuple(orient(np.asarray(h, dtype=np.float64), positive=False) for h in holes_px)
+        rings = (outer, *holes)
+        area, cu, cv = _area_moments(rings)
+        centroid = (cu / area, cv / area) if area != 0.0 else _vertex_mean(outer)
+        return cls(colour_rgb, outer, holes, area, centroid, cut_by_border)
+
+
+def signed_area(ring: FloatArray) -> float:
+    """Shoelace area of a closed ring ``(n, 2)``; positive when the ring turns counter-clockwise
+    in a y-up frame (clockwise as seen on screen, y down). Summed with ``math.fsum`` so the
+    result does not depend on array layout."""
+    x = ring[:, 0]
+    y = ring[:, 1]
+    terms = x * _next(y) - _next(x) * y
+    return 0.5 * math.fsum(terms.tolist())
+
+
+def orient(ring: FloatArray, *, positive: bool) -> FloatArray:
+    """The ring with its vertex order reversed if needed so ``signed_area`` has the given sign."""
+    if (signed_area(ring) > 0.0) != positive:
+        return ring[::-1].copy()
+    return ring
+
+
+def _area_moments(rings: tuple[FloatArray, ...]) -> tuple[float, float, float]:
+    area_terms: list[float] = []
+    mu_terms: list[float] = []
+    mv_terms: list[float] = []
+    for ring in rings:
+        x0, y0 = ring[:, 0], ring[:, 1]
+        x1, y1 = _next(x0), _next(y0)
+        cross = x0 * y1 - x1 * y0
+        area_terms.extend(cross.tolist())
+        mu_terms.extend(((x0 + x1) * cross).tolist())
+        mv_terms.extend(((y0 + y1) * cross).tolist())
+    area = 0.5 * math.fsum(area_terms)
+    return area, math.fsum(mu_terms) / 6.0, math.fsum(mv_terms) / 6.0
+
+
+def _vertex_mean(ring: FloatArray) -> tuple[float, float]:
+    n = len(ring)
+    return (math.fsum(ring[:, 0].tolist()) / n, math.fsum(ring[:, 1].tolist()) / n)
+
+
+def perimeter(ring: FloatArray) -> float:
+    """Length of a closed ring ``(n, 2)``, summed in a fixed order."""
+    d = _next(ring) - ring
+    return math.fsum(np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]).tolist())
+
+
+def _next(a: FloatArray) -> FloatArray:
+    """``a`` shifted by one along the first axis, cyclically (``np.roll(a, -1)``, faster)."""
+    return np.concatenate([a[1:], a[:1]])
