@@ -279,6 +279,22 @@ def _scan_chunk(
     return Block(offset, length, start_ns if ids else 0, end_ns, True, frozenset(ids), data)
 
 
+def _rescue_chunk(buf: Buf, layout: Layout, pos: int, s: int) -> bool:
+    """Keep the whole messages at the start of a chunk cut by the end of the file."""
+    try:
+        comp, rs, rn, _usize, _crc = chunk_payload(buf, s, len(buf))
+    except struct.error:  # cut inside the chunk's own header fields
+        return False
+    data = _decompress_prefix(comp, buf[rs : rs + rn])
+    if not data:
+        return False
+    block = _scan_chunk(layout, data, pos, len(buf) - pos, data)
+    if not block.channel_ids:
+        return False
+    layout.blocks.append(block)
+    return True
+
+
 def _scan(buf: Buf, layout: Layout) -> None:
     size = len(buf)
     pos, problem, partial = 8, "", False
@@ -297,13 +313,7 @@ def _scan(buf: Buf, layout: Layout) -> None:
                     f"cut at byte {size} inside a {_op_name(op)} record starting at byte {pos}"
                 )
                 if op == Op.CHUNK:
-                    comp, rs, rn, _usize, _crc = chunk_payload(buf, s, size)
-                    data = _decompress_prefix(comp, buf[rs : rs + rn])
-                    if data:
-                        block = _scan_chunk(layout, data, pos, size - pos, data)
-                        if block.channel_ids:
-                            layout.blocks.append(block)
-                            partial = True
+                    partial = _rescue_chunk(buf, layout, pos, s)
                 break
             if op == Op.HEADER:
                 layout.profile, off = _str(buf, s)
