@@ -250,44 +250,89 @@ class Spans:
     col1: int
 
 
-def spans(
-    u_px: tuple[float, ...], v_px: tuple[float, ...], width: int, height: int
-) -> Spans | None:
-    """Pixel-centre coverage of a convex polygon, clipped to the image; None if empty."""
-    n = len(u_px)
-    area2 = 0.0
-    for k in range(n):
-        area2 += u_px[k] * v_px[(k + 1) % n] - u_px[(k + 1) % n] * v_px[k]
-    if not area2 > 0.0:  # make it positive in (u, v): the interior lies left of every edge
-        if area2 == 0.0 or math.isnan(area2):
-            return None
-        u_px, v_px = u_px[::-1], v_px[::-1]
-    row0 = max(math.ceil(min(v_px)), 0)
-    row1 = min(math.ceil(max(v_px)), height)
-    if row1 <= row0:
-        return None
-    rows = np.arange(row0, row1, dtype=np.float64)
-    left = np.full(row1 - row0, -np.inf)
-    right = np.full(row1 - row0, np.inf)
-    for k in range(n):
-        u0, v0, u1, v1 = u_px[k], v_px[k], u_px[(k + 1) % n], v_px[(k + 1) % n]
-        if v1 == v0:
-            continue
-        # evaluate from the lower endpoint so a shared edge gives bit-identical bounds
-        ua, va, ub, vb = (u0, v0, u1, v1) if (v0, u0) < (v1, u1) else (u1, v1, u0, v0)
-        x = ua + (rows - va) * ((ub - ua) / (vb - va))
-        if v1 > v0:
-            np.minimum(right, x, out=right)
-        else:
-            np.maximum(left, x, out=left)
+def spans_batch(faces: list[ScreenFace], width: int, height: int) -> list[Spans | None]:
+    """Pixel-centre coverage of convex faces, clipped to the image; None where empty.
+
+    Each edge is evaluated from its lower endpoint, so two faces sharing an edge get
+    bit-identical bounds; all faces' rows are computed in one vectorised pass.
+    """
+    edges_ua: list[list[float]] = []
+    edges_va: list[list[float]] = []
+    edges_slope: list[list[float]] = []
+    edges_kind: list[list[int]] = []
+    row_ranges: list[tuple[int, int]] = []
+    for sf in faces:
+        u_px, v_px = sf.u_px, sf.v_px
+        n = len(u_px)
+        area2 = 0.0
+        for k in range(n):
+            area2 += u_px[k] * v_px[(k + 1) % n] - u_px[(k + 1) % n] * v_px[k]
+        ua_l: list[float] = []
+        va_l: list[float] = []
+        sl_l: list[float] = []
+        kind_l: list[int] = []
+        row0 = row1 = 0
+        if area2 != 0.0 and not math.isnan(area2):
+            if area2 < 0.0:
+                u_px, v_px = u_px[::-1], v_px[::-1]
+            row0 = max(math.ceil(min(v_px)), 0)
+            row1 = min(math.ceil(max(v_px)), height)
+            for k in range(n):
+                u0, v0, u1, v1 = u_px[k], v_px[k], u_px[(k + 1) % n], v_px[(k + 1) % n]
+                if v1 == v0:
+                    continue
+                ua, va, ub, vb = (u0, v0, u1, v1) if (v0, u0) < (v1, u1) else (u1, v1, u0, v0)
+                ua_l.append(ua)
+                va_l.append(va)
+                sl_l.append((ub - ua) / (vb - va))
+                kind_l.append(1 if v1 > v0 else -1)
+        row_ranges.append((row0, max(row1, row0)))
+        edges_ua.append(ua_l)
+        edges_va.append(va_l)
+        edges_slope.append(sl_l)
+        edges_kind.append(kind_l)
+    n_rows = [r1 - r0 for r0, r1 in row_ranges]
+    total = sum(n_rows)
+    out: list[Spans | None] = [None] * len(faces)
+    if total == 0:
+        return out
+    e_max = max(len(k) for k in edges_kind)
+    n_faces = len(faces)
+    a_ua = np.zeros((n_faces, e_max))
+    a_va = np.zeros((n_faces, e_max))
+    a_slope = np.zeros((n_faces, e_max))
+    a_kind = np.zeros((n_faces, e_max), dtype=np.int8)
+    for f in range(n_faces):
+        m = len(edges_kind[f])
+        a_ua[f, :m] = edges_ua[f]
+        a_va[f, :m] = edges_va[f]
+        a_slope[f, :m] = edges_slope[f]
+        a_kind[f, :m] = edges_kind[f]
+    face_of_row = np.repeat(np.arange(n_faces), n_rows)
+    starts = np.cumsum([0, *n_rows])
+    rows = np.arange(total, dtype=np.int64) - np.repeat(starts[:-1], n_rows)
+    rows += np.repeat(np.array([r0 for r0, _ in row_ranges], dtype=np.int64), n_rows)
+    x = (
+        a_ua[face_of_row]
+        + (rows.astype(np.float64)[:, None] - a_va[face_of_row]) * a_slope[face_of_row]
+    )
+    a_k = a_kind[face_of_row]
+    left = np.where(a_k < 0, x, -np.inf).max(axis=1)
+    right = np.where(a_k > 0, x, np.inf).min(axis=1)
     il = np.clip(np.ceil(left), 0, width).astype(np.int64)
     ir = np.clip(np.ceil(right), 0, width).astype(np.int64)
-    filled = np.flatnonzero(il < ir)
-    if filled.size == 0:
-        return None
-    first, last = int(filled[0]), int(filled[-1]) + 1
-    il, ir = il[first:last], ir[first:last]
-    return Spans(row0 + first, il, ir, int(il.min()), int(ir.max()))
+    filled = il < ir
+    lo = np.where(filled, il, width)
+    hi = np.where(filled, ir, 0)
+    for f in range(n_faces):
+        a, b = int(starts[f]), int(starts[f + 1])
+        if b == a:
+            continue
+        col0, col1 = int(lo[a:b].min()), int(hi[a:b].max())
+        if col1 <= col0:
+            continue
+        out[f] = Spans(row_ranges[f][0], il[a:b], ir[a:b], col0, col1)
+    return out
 
 
 def inverse_depth_plane(

@@ -28,7 +28,7 @@ from uavtool.world.raster import (
     inverse_depth_plane,
     prepare,
     project_faces,
-    spans,
+    spans_batch,
 )
 from uavtool.world.scene import Scene
 
@@ -49,11 +49,18 @@ def render(
     With ``noise_seed`` set, seeded zero-mean sensor noise of about ``noise_std_dn`` is
     added; the same seed gives the same image.
     """
-    packed = render_packed(scene, pose, intrinsics)
-    rgb = np.ascontiguousarray(packed.view(np.uint8).reshape(*packed.shape, 4)[:, :, :3])
+    rgb = rgb_from_packed(render_packed(scene, pose, intrinsics))
     if noise_seed is not None:
         add_noise(rgb, seed=noise_seed, std_dn=noise_std_dn)
     return rgb
+
+
+def rgb_from_packed(packed: npt.NDArray[np.uint32]) -> ImageRGB:
+    """(H, W, 3) uint8 RGB from packed RGBA pixels (a plain byte copy)."""
+    import cv2  # noqa: PLC0415  # keep `import uavtool.world` light
+
+    rgba = packed.view(np.uint8).reshape(*packed.shape, 4)
+    return np.asarray(cv2.cvtColor(rgba, cv2.COLOR_RGBA2RGB), dtype=np.uint8)
 
 
 def _pack(rgb: tuple[int, int, int]) -> np.uint32:
@@ -77,11 +84,10 @@ def render_packed(
     prep = prepare(scene)
     buf = background(scene, pose, intrinsics)
     w, h = intrinsics.width_px, intrinsics.height_px
-    drawn: list[tuple[ScreenFace, Spans]] = []
-    for sf in project_faces(prep, pose, intrinsics, cull=True):
-        sp = spans(sf.u_px, sf.v_px, w, h)
-        if sp is not None:
-            drawn.append((sf, sp))
+    faces = project_faces(prep, pose, intrinsics, cull=True)
+    drawn = [
+        (sf, sp) for sf, sp in zip(faces, spans_batch(faces, w, h), strict=True) if sp is not None
+    ]
     order = None if force_depth_test else _object_order(prep, pose, drawn)
     cols = np.arange(w, dtype=np.int64)
     if order is not None:
