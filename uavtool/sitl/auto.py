@@ -69,6 +69,12 @@ class AutoMission:
     def landing(self) -> bool:
         return self.running and self._landing
 
+    def land_complete(self) -> None:
+        """The vehicle touched down on a NAV_LAND item: report it and finish or go on."""
+        self._landing = False
+        self.reached.append(self.items[self.current].seq)
+        self._advance()
+
     def start(self) -> None:
         if self.current < 1 or self.current >= len(self.items):
             self.current = 1
@@ -179,8 +185,8 @@ class AutoMission:
             if not self._landing and math.hypot(land_n - s.pos_ned_m[0], land_e - s.pos_ned_m[1]) < 0.5:
                 self._landing = True
             if self._landing:
-                ap._descend()
-            return not ap.armed
+                ap.descend()
+            return False  # finished by land_complete() on touchdown
         if cmd == mavlink.MAV_CMD_NAV_RETURN_TO_LAUNCH:
             ap.set_mode(Mode.RTL)
             return False

@@ -290,9 +290,9 @@ class Autopilot:
         elif mode == Mode.RTL:
             self._run_rtl()
         elif mode == Mode.LAND:
-            self._descend()
+            self.descend()
 
-    def _descend(self) -> None:
+    def descend(self) -> None:
         speed = self.params["LAND_SPEED"] / 100.0
         if self.alt_rel_m() > 10.0:
             high = self.params["LAND_SPEED_HIGH"] or self.params["WPNAV_SPEED_DN"]
@@ -325,7 +325,7 @@ class Autopilot:
             self.land_ne = (0.0, 0.0)
             self.say(mavlink.MAV_SEVERITY_INFO, "RTL: landing at home")
         if self._rtl_stage == "land":
-            self._descend()
+            self.descend()
 
     def _update_gimbal(self, dt_s: float) -> None:
         g = self.gimbal
@@ -393,7 +393,9 @@ class Autopilot:
             return
         if self._landed_since_ns is None:
             self._landed_since_ns = self.now_ns
-            if self.mode in (Mode.LAND, Mode.RTL) or self.mission.landing():
+            if self.mission.landing():
+                self.mission.land_complete()
+            if self.mode in (Mode.LAND, Mode.RTL) or self.mode == Mode.AUTO and not self.mission.running:
                 self.disarm(force=True, reason="Land complete: disarming")
             return
         delay = self.params["DISARM_DELAY"]
