@@ -22,6 +22,7 @@ _COMMANDS: tuple[tuple[str, str], ...] = (
     ("uavtool.cli.recording", "info"),
     ("uavtool.cli.recording", "export"),
     ("uavtool.cli.recording", "import_"),
+    ("uavtool.cli.scene", "scene"),
 )
 
 

@@ -144,6 +144,15 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
     }
 
 
+def dump_scene(scene: Scene, *, suffix: str = ".yaml") -> str:
+    """The scene as file text: YAML, or JSON for ``suffix == ".json"``."""
+    data = scene_to_dict(scene)
+    if suffix == ".json":
+        return json.dumps(data, indent=2) + "\n"
+    text: str = yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=100)
+    return text
+
+
 # --------------------------------------------------------------------------- from dict
 
 
