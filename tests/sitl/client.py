@@ -28,7 +28,9 @@ class Client:
 
     @classmethod
     def tcp(cls, port: int, **kw: Any) -> Client:
-        return cls(socket.create_connection(("127.0.0.1", port), timeout=5), **kw)
+        sock = socket.create_connection(("127.0.0.1", port), timeout=5)
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)  # no Nagle delay on commands
+        return cls(sock, **kw)
 
     def close(self) -> None:
         self.sock.close()

@@ -154,7 +154,7 @@ class AutoMission:
                 n, e, _ = ap.state.pos_ned_m
                 ap.vehicle.set_target(Target(pos_ned_m=(n, e, -max(item.z, 1.0))))
         elif cmd == mavlink.MAV_CMD_NAV_WAYPOINT:
-            yaw = None if math.isnan(item.param4) or item.param4 == 0 else item.param4 % 360.0
+            yaw = item.param4 % 360.0 if math.isfinite(item.param4) and item.param4 != 0 else None
             ap.vehicle.set_target(Target(pos_ned_m=self._target_ned(item), yaw_deg=yaw))
         elif cmd == mavlink.MAV_CMD_NAV_LAND:
             n, e, _ = self._target_ned(item)

@@ -159,7 +159,7 @@ class Autopilot:
             return failed("Takeoff: vehicle not armed")
         if not self.on_ground:
             return failed("Takeoff: already flying")
-        if not 0.0 < alt_m:
+        if not 0.0 < alt_m < math.inf:
             return denied(f"Takeoff: altitude must be above 0 m, got {alt_m:g}")
         fence = self.fence_check((self.state.pos_ned_m[0], self.state.pos_ned_m[1], -alt_m))
         if fence is not None:
@@ -192,6 +192,8 @@ class Autopilot:
             self.set_mode(Mode.GUIDED)
         if not self.armed or (self.on_ground and not self.taking_off):
             return failed("Guided: vehicle is not flying")
+        if not all(math.isfinite(v) for v in pos_ned_m):
+            return denied("Guided: target position is not finite")
         fence = self.fence_check(pos_ned_m)
         if fence is not None:
             return fence
@@ -205,6 +207,8 @@ class Autopilot:
             return failed("Guided: not in GUIDED mode")
         if not self.armed:
             return failed("Guided: vehicle not armed")
+        if not all(math.isfinite(v) for v in vel_ned_ms):
+            return denied("Guided: target velocity is not finite")
         self.taking_off = False
         self._velocity_deadline_ns = self.now_ns + 3 * _NS  # ArduCopter: stop after 3 s without an update
         self.vehicle.set_target(
@@ -217,6 +221,9 @@ class Autopilot:
             return failed(f"Yaw: needs GUIDED or AUTO, not {self.mode.name}")
         if not self.armed:
             return failed("Yaw: vehicle not armed")
+        if not math.isfinite(angle_deg):
+            return denied("Yaw: angle is not finite")
+        rate_dps = rate_dps if math.isfinite(rate_dps) else 0.0
         current = self.state.yaw_deg
         if relative:
             step = abs(angle_deg) * (-1.0 if direction < 0 else 1.0)
@@ -230,6 +237,8 @@ class Autopilot:
         return ACCEPTED
 
     def change_speed(self, speed_type: int, speed_ms: float) -> Result:
+        if not math.isfinite(speed_ms):
+            return denied("Change speed: speed is not finite")
         if speed_ms < 0:  # -1 means "no change"
             return ACCEPTED
         if speed_type in (0, 1):
@@ -245,10 +254,10 @@ class Autopilot:
 
     def set_gimbal(self, *, pitch_deg: float | None, yaw_deg: float | None, yaw_locked: bool = False) -> Result:
         g = self.gimbal
-        if pitch_deg is not None and not math.isnan(pitch_deg):
+        if pitch_deg is not None and math.isfinite(pitch_deg):
             low, high = self.params["MNT1_PITCH_MIN"], self.params["MNT1_PITCH_MAX"]
             g.target_pitch_deg = min(max(pitch_deg, low), high)
-        if yaw_deg is not None and not math.isnan(yaw_deg):
+        if yaw_deg is not None and math.isfinite(yaw_deg):
             if yaw_locked:
                 # Earth-frame heading: keep it relative internally, re-evaluated as the vehicle turns.
                 g.yaw_locked = True

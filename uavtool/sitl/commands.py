@@ -98,7 +98,7 @@ def _reposition(session: GcsSession, cmd: CommandArgs) -> Result:
     n, e, _ = ap.ned_of(GeoPoint(lat, lon, ap.home.alt_amsl_m))
     if cmd.p(1) > 0:
         ap.change_speed(1, cmd.p(1))
-    yaw = None if math.isnan(cmd.p(4)) else cmd.p(4) % 360.0
+    yaw = cmd.p(4) % 360.0 if math.isfinite(cmd.p(4)) else None
     change_mode = bool(int(cmd.p(2)) & M.MAV_DO_REPOSITION_FLAGS_CHANGE_MODE)
     return ap.guided_position((n, e, -alt_rel), yaw_deg=yaw, switch_mode=change_mode)
 

@@ -227,7 +227,7 @@ class GcsSession:
     def _apply_target(
         self, mask: int, pos: tuple[float, float, float], vel: tuple[float, float, float], yaw_rad: float
     ) -> None:
-        yaw = None if mask & _TM_YAW else math.degrees(yaw_rad) % 360.0
+        yaw = None if mask & _TM_YAW or not math.isfinite(yaw_rad) else math.degrees(yaw_rad) % 360.0
         if not mask & _TM_POS:
             result = self.ap.guided_position(pos, yaw_deg=yaw)
         elif not mask & _TM_VEL:
@@ -240,7 +240,7 @@ class GcsSession:
     # ------------------------------------------------------------------ gimbal, streams, FTP
     def _on_gimbal_set_attitude(self, msg: Any) -> None:
         w, x, y, z = msg.q
-        if any(math.isnan(v) for v in (w, x, y, z)):
+        if not all(math.isfinite(v) for v in (w, x, y, z)):
             return
         pitch = math.degrees(math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x)))))
         yaw = math.degrees(math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))

@@ -7,10 +7,11 @@ lost requests are tolerated: the vehicle re-requests the item it needs, a few ti
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 from uavtool.mavlink.dialect import mavlink as M
-from uavtool.sitl.auto import SUPPORTED_COMMANDS
+from uavtool.sitl.auto import NAV_COMMANDS, SUPPORTED_COMMANDS
 from uavtool.sitl.state import MissionItem
 
 if TYPE_CHECKING:
@@ -99,6 +100,10 @@ class MissionProtocol:
                      M.MAV_FRAME_GLOBAL_RELATIVE_ALT: M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT}.get(frame, frame)  # fmt: skip
         if msg.seq > 0 and msg.command not in SUPPORTED_COMMANDS:
             self._ack(M.MAV_MISSION_UNSUPPORTED)
+            self._upload = None
+            return
+        if msg.seq > 0 and msg.command in NAV_COMMANDS and not math.isfinite(msg.z):
+            self._ack(M.MAV_MISSION_INVALID_PARAM7)
             self._upload = None
             return
         if msg.seq > 0 and frame not in _FRAMES:

@@ -76,6 +76,7 @@ class Sitl:
         self._thread: threading.Thread | None = None
         self._pacing_reset = True
         self.steps = 0
+        self.rx_bytes = 0  # bytes received on all links, garbage included
         self.error: BaseException | None = None
         try:
             for text in config.endpoints:
@@ -169,6 +170,7 @@ class Sitl:
         for key, _ in self._selector.select(max(timeout_s, 0.0)):
             owner: _Socketed = key.data
             for link, data in owner.on_readable():
+                self.rx_bytes += len(data)
                 for frame in link.receive(data):
                     try:
                         link.session.handle(frame)
