@@ -1,0 +1,139 @@
+"""File-level vision tasks behind ``uavtool vision``: read images, run one stage, write files.
+
+The stages themselves stay pure; this module is the thin I/O shell the CLI calls.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from uavtool.camera import Intrinsics
+from uavtool.vision.errors import ImageError, ModelInputError, ShapeFileError
+from uavtool.vision.io import shapes_to_json, views_from_json
+from uavtool.vision.model3d import Model, View, build_model, central_shape, model_glb, same_colour
+from uavtool.vision.overlay import draw_overlay
+from uavtool.vision.params import ModelParams, RecognizeParams, VectorizeParams
+from uavtool.vision.recognize import Match, best_match
+from uavtool.vision.shapes import Shape
+from uavtool.vision.vectorize import U8Array, vectorize
+
+
+def read_image(path: Path) -> U8Array:
+    """An image file as RGB ``(h, w, 3) uint8``; raises :class:`ImageError`."""
+    if not path.is_file():
+        raise ImageError(f"{path}: no such image file")
+    bgr = cv2.imread(str(path), cv2.IMREAD_COLOR)
+    if bgr is None:
+        raise ImageError(f"{path}: not an image OpenCV can read (PNG, JPEG, ...)")
+    return np.ascontiguousarray(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB))
+
+
+def write_image(path: Path, rgb: U8Array) -> None:
+    """Write an RGB image (format from the file extension)."""
+    if not cv2.imwrite(str(path), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)):
+        raise ImageError(f"{path}: cannot write an image there (check the extension)")
+
+
+def vectorize_file(
+    frame: Path,
+    *,
+    out: Path | None,
+    overlay: Path | None,
+    params: VectorizeParams | None = None,
+) -> tuple[Shape, ...]:
+    """Vectorize an image file; write the shapes JSON and the overlay PNG when asked."""
+    rgb = read_image(frame)
+    shapes = vectorize(rgb, params)
+    if out is not None:
+        out.write_text(shapes_to_json(shapes, width_px=rgb.shape[1], height_px=rgb.shape[0]))
+    if overlay is not None:
+        write_image(overlay, draw_overlay(rgb, shapes))
+    return shapes
+
+
+@dataclass(frozen=True, slots=True)
+class MatchReport:
+    """The target's shape, every shape of the frame with its match, and the best index."""
+
+    target: Shape
+    shapes: tuple[Shape, ...]
+    matches: tuple[Match, ...]
+    best: int
+    threshold: float
+
+
+def match_files(
+    target: Path,
+    frame: Path,
+    *,
+    vectorize_params: VectorizeParams | None = None,
+    params: RecognizeParams | None = None,
+) -> MatchReport:
+    """Vectorize the target bitmap (its largest shape is the target) and a frame, and match
+    every shape of the frame against the target."""
+    p = params if params is not None else RecognizeParams()
+    target_shapes = vectorize(read_image(target), vectorize_params)
+    if not target_shapes:
+        raise ImageError(f"{target}: no coloured shape found in the target image")
+    reference = max(target_shapes, key=lambda s: s.area_px)
+    shapes = vectorize(read_image(frame), vectorize_params)
+    best, matches = best_match(reference, shapes, p)
+    return MatchReport(reference, shapes, matches, best, p.threshold)
+
+
+def model_files(
+    top: Path,
+    front: Path,
+    right: Path,
+    *,
+    poses: Path,
+    out: Path,
+    vectorize_params: VectorizeParams | None = None,
+    params: ModelParams | None = None,
+    hue_tolerance_deg: float = 15.0,
+) -> Model:
+    """Build the model from three photos and their poses file; write it as GLB.
+
+    The object is the shape the top photo is centred on; in the front and right photos,
+    every shape of its colour is the object.
+    """
+    try:
+        text = poses.read_text()
+    except OSError as exc:
+        raise ShapeFileError(f"{poses}: cannot read: {exc.strerror}") from None
+    cams, ground = views_from_json(text, source=str(poses))
+    images = {"top": top, "front": front, "right": right}
+    shapes: dict[str, tuple[Shape, ...]] = {}
+    for name, path in images.items():
+        rgb = read_image(path)
+        _check_size(path, rgb, cams[name][1])
+        shapes[name] = vectorize(rgb, vectorize_params)
+    obj = central_shape(shapes["top"], cams["top"][1])
+    if obj is None:
+        raise ModelInputError(f"{top}: no coloured shape in the top photo")
+    views = {
+        name: View(
+            (obj,)
+            if name == "top"
+            else same_colour(shapes[name], obj.colour_rgb, hue_tolerance_deg=hue_tolerance_deg),
+            cams[name][0],
+            cams[name][1],
+        )
+        for name in images
+    }
+    p = params if params is not None else ModelParams(ground_z_m=ground)
+    model = build_model(views["top"], views["front"], views["right"], p)
+    out.write_bytes(model_glb(model))
+    return model
+
+
+def _check_size(path: Path, rgb: U8Array, k: Intrinsics) -> None:
+    h, w = rgb.shape[:2]
+    if (w, h) != (k.width_px, k.height_px):
+        raise ImageError(
+            f"{path}: image is {w}x{h} but its intrinsics say {k.width_px}x{k.height_px}"
+        )

@@ -1,0 +1,255 @@
+"""3D model from three projections (paper III-C): top, front and right silhouettes.
+
+Each photo's silhouette is turned into a solid using the camera pose and intrinsics at
+capture, and the three solids are intersected (with the ground as a fourth cut):
+
+* front and right: the silhouette's viewing cone — every ray from the camera centre through
+  the silhouette. This is the exact perspective "extrusion along the view direction": a
+  roof edge further away appears lower and narrower, and the cone puts it back at its true
+  size wherever the other views place it. Holes in a silhouette (a tunnel seen end-on)
+  are holes in the cone, so they become tunnels in the model.
+* top: buildings have vertical walls, so the roof outline is the footprint. The top
+  silhouette's rays are cut by the roof plane (its height measured in the side views; the
+  two depend on each other and are iterated to a fixed point) and the outline is extruded
+  straight down to the ground — a courtyard (hole seen from above) stays a hole.
+
+Metric scale comes from the poses: no dimension is assumed. Booleans run in manifold3d,
+whose output is always a closed 2-manifold, so the mesh is watertight by construction.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import trimesh
+
+from uavtool.camera import CameraPose, Intrinsics
+from uavtool.geo import wrap_180
+from uavtool.vision.errors import ModelInputError
+from uavtool.vision.params import ModelParams
+from uavtool.vision.shapes import FloatArray, Shape
+from uavtool.vision.vectorize import hue_distance_deg
+
+# Depth range of the side viewing cones, metres along the optical axis.
+_NEAR_M = 0.25
+_FAR_M = 2000.0
+
+
+@dataclass(frozen=True, slots=True)
+class View:
+    """One photo's silhouette: the shapes of the object in it, with the camera at capture."""
+
+    shapes: tuple[Shape, ...]
+    pose: CameraPose
+    intrinsics: Intrinsics
+
+
+@dataclass(frozen=True, slots=True)
+class Model:
+    """The built model: a watertight mesh in world ENU metres, and what was measured.
+
+    ``footprint_enu_m`` : the outer footprint ring ``(n, 2)``; ``height_m`` : the highest
+    roof above the ground.
+    """
+
+    mesh: trimesh.Trimesh
+    height_m: float
+    footprint_enu_m: FloatArray
+
+
+def build_model(top: View, front: View, right: View, params: ModelParams | None = None) -> Model:
+    """The object's 3D model from its top, front and right views.
+
+    Raises :class:`ModelInputError` when a view has no silhouette, a silhouette touches the
+    image border (unless allowed), the top photo is not close to nadir, the side photos are
+    not close to horizontal, or the two side headings are too close to each other.
+    """
+    import manifold3d  # noqa: PLC0415 — heavy; only model building needs it
+
+    p = params if params is not None else ModelParams()
+    _check_views(top, front, right, p)
+    side = manifold3d.Manifold.batch_boolean(
+        [_cone(front), _cone(right)], manifold3d.OpType.Intersect
+    )
+    side = side.trim_by_plane((0.0, 0.0, 1.0), p.ground_z_m)
+    if side.is_empty():
+        raise ModelInputError(
+            "the front and right silhouettes do not overlap in space: check the poses and "
+            "that both photos show the same building"
+        )
+    rings = _footprint(top, side, p.ground_z_m, p)
+    solid = side ^ _prism(rings, p.ground_z_m, _FAR_M)
+    if solid.is_empty():
+        raise ModelInputError(
+            "the top silhouette does not overlap the front and right ones: check the poses "
+            "and that each photo shows the same building"
+        )
+    mesh = _to_trimesh(solid)
+    return Model(mesh, float(mesh.bounds[1][2]) - p.ground_z_m, rings[0])
+
+
+def model_glb(model: Model) -> bytes:
+    """The model's mesh as binary glTF bytes."""
+    data = model.mesh.export(file_type="glb")
+    if not isinstance(data, bytes):  # trimesh returns bytes for binary formats
+        raise TypeError(f"trimesh returned {type(data).__name__} for GLB")
+    return data
+
+
+def _check_views(top: View, front: View, right: View, p: ModelParams) -> None:
+    for name, view in (("top", top), ("front", front), ("right", right)):
+        if not view.shapes:
+            raise ModelInputError(f"{name}: no silhouette of the object in the photo")
+        if not p.allow_border_cut and any(s.cut_by_border for s in view.shapes):
+            raise ModelInputError(
+                f"{name}: the object touches the image border, so its outline is incomplete; "
+                "take the photo from further away"
+            )
+    if abs(top.pose.pitch_deg + 90.0) > p.max_top_tilt_deg:
+        raise ModelInputError(
+            f"top: gimbal pitch {top.pose.pitch_deg:g}° is not within "
+            f"{p.max_top_tilt_deg:g}° of nadir (−90°)"
+        )
+    for name, view in (("front", front), ("right", right)):
+        if abs(view.pose.pitch_deg) > p.max_side_tilt_deg:
+            raise ModelInputError(
+                f"{name}: gimbal pitch {view.pose.pitch_deg:g}° is not within "
+                f"{p.max_side_tilt_deg:g}° of horizontal"
+            )
+    separation = abs(wrap_180(front.pose.heading_deg - right.pose.heading_deg))
+    if min(separation, 180.0 - separation) < p.min_view_separation_deg:
+        raise ModelInputError(
+            f"front and right headings differ by {separation:g}°; they must be at least "
+            f"{p.min_view_separation_deg:g}° apart (ideally 90°)"
+        )
+
+
+def _normalised_rings(view: View) -> list[FloatArray]:
+    """Every ring of the view's shapes in normalised image coordinates ``(x/z, y/z)``."""
+    k = view.intrinsics
+    rings: list[FloatArray] = []
+    for shape in view.shapes:
+        for ring in (shape.polygon_px, *shape.holes_px):
+            xn = (ring[:, 0] - k.cx_px) / k.fx_px
+            yn = (ring[:, 1] - k.cy_px) / k.fy_px
+            rings.append(np.stack([xn, yn], axis=1))
+    return rings
+
+
+def _cone(view: View) -> Any:
+    """The viewing cone of a silhouette, between the near and far depths, in world ENU."""
+    import manifold3d  # noqa: PLC0415
+
+    rings = [r * _NEAR_M for r in _normalised_rings(view)]
+    section = manifold3d.CrossSection(rings, manifold3d.FillRule.EvenOdd)
+    scale = _FAR_M / _NEAR_M
+    cone = section.extrude(_FAR_M - _NEAR_M, scale_top=(scale, scale)).translate((0, 0, _NEAR_M))
+    return cone.transform(_world_from_camera_3x4(view.pose))
+
+
+def _world_from_camera_3x4(pose: CameraPose) -> list[list[float]]:
+    r = pose.world_from_camera()
+    t = pose.pos_enu_m
+    return [[float(r[i, 0]), float(r[i, 1]), float(r[i, 2]), float(t[i])] for i in range(3)]
+
+
+def _footprint(top: View, side: Any, ground_z_m: float, p: ModelParams) -> list[FloatArray]:
+    """The top silhouette's rings as an ENU footprint ``(n, 2)`` each.
+
+    An outline pixel sees a roof edge at some height ``h``: its ray cut at ``z = h`` gives
+    the footprint corner, and the model's height there (the top of the side views' solid)
+    must be ``h`` again. Each corner iterates that to a fixed point, so a lower wing is put
+    at its own roof height instead of being shrunk onto the highest roof's plane. Where two
+    roofs meet, the outline belongs to the higher one, so the height is the highest within
+    two pixels' ground distance of the corner.
+    """
+    r = top.pose.world_from_camera()
+    ox, oy, oz = top.pose.pos_enu_m
+    h_start = float(side.bounding_box()[5])
+    fx = top.intrinsics.fx_px
+    if h_start >= oz:
+        raise ModelInputError(
+            f"top: the building ({h_start - ground_z_m:.1f} m) reaches the camera ({oz:.1f} m)"
+        )
+    out: list[FloatArray] = []
+    for ring in _normalised_rings(top):
+        pts: list[tuple[float, float]] = []
+        for xn, yn in ring.tolist():
+            dx = r[0, 0] * xn + r[0, 1] * yn + r[0, 2]
+            dy = r[1, 0] * xn + r[1, 1] * yn + r[1, 2]
+            dz = r[2, 0] * xn + r[2, 1] * yn + r[2, 2]
+            if dz >= 0.0:
+                raise ModelInputError("top: part of the silhouette is at or above the horizon")
+            h = h_start
+            x, y = ox, oy
+            for _ in range(p.max_iterations):
+                t = (oz - h) / -dz
+                x, y = ox + t * dx, oy + t * dy
+                new_h = _height_near(
+                    side, x, y, radius_m=2.0 * (oz - h) / fx, z_top=h_start, z_bottom=ground_z_m
+                )
+                if new_h is None:
+                    break
+                done = abs(new_h - h) < p.tolerance_m
+                h = new_h
+                if done:
+                    break
+            t = (oz - h) / -dz
+            pts.append((ox + t * dx, oy + t * dy))
+        out.append(np.array(pts, dtype=np.float64))
+    return out
+
+
+def _height_near(
+    solid: Any, x: float, y: float, *, radius_m: float, z_top: float, z_bottom: float
+) -> float | None:
+    """Highest top surface of ``solid`` over ``(x, y)`` and four points ``radius_m`` away."""
+    best: float | None = None
+    for ex, ey in ((0.0, 0.0), (1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)):
+        px, py = x + ex * radius_m, y + ey * radius_m
+        hits = solid.ray_cast((px, py, z_top + 1.0), (px, py, z_bottom - 1.0))
+        if hits:
+            z = float(hits[0].position[2])
+            best = z if best is None else max(best, z)
+    return best
+
+
+def _prism(rings: Sequence[FloatArray], base_z_m: float, top_z_m: float) -> Any:
+    import manifold3d  # noqa: PLC0415
+
+    section = manifold3d.CrossSection(list(rings), manifold3d.FillRule.EvenOdd)
+    return section.extrude(top_z_m - base_z_m).translate((0.0, 0.0, base_z_m))
+
+
+def _to_trimesh(solid: Any) -> trimesh.Trimesh:
+    mesh = solid.to_mesh()
+    verts = np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3]
+    faces = np.asarray(mesh.tri_verts, dtype=np.int64)
+    return trimesh.Trimesh(vertices=verts, faces=faces, process=True)
+
+
+def central_shape(shapes: tuple[Shape, ...], intrinsics: Intrinsics) -> Shape | None:
+    """The shape a photo is centred on: the one whose centroid is nearest the principal
+    point, among shapes at least a quarter as large as the largest."""
+    if not shapes:
+        return None
+    largest = max(s.area_px for s in shapes)
+    big = [s for s in shapes if s.area_px >= 0.25 * largest]
+    return min(
+        big,
+        key=lambda s: (
+            (s.centroid_px[0] - intrinsics.cx_px) ** 2 + (s.centroid_px[1] - intrinsics.cy_px) ** 2
+        ),
+    )
+
+
+def same_colour(
+    shapes: tuple[Shape, ...], colour_rgb: tuple[int, int, int], *, hue_tolerance_deg: float
+) -> tuple[Shape, ...]:
+    """The shapes whose colour's hue is within ``hue_tolerance_deg`` of ``colour_rgb``'s."""
+    return tuple(
+        s for s in shapes if hue_distance_deg(s.colour_rgb, colour_rgb) <= hue_tolerance_deg
+    )
