@@ -23,6 +23,7 @@ _COMMANDS: tuple[tuple[str, str], ...] = (
     ("uavtool.cli.recording", "export"),
     ("uavtool.cli.recording", "import_"),
     ("uavtool.cli.scene", "scene"),
+    ("uavtool.cli.vision", "vision"),
 )
 
 
