@@ -98,10 +98,10 @@ def match(
     p = params if params is not None else RecognizeParams()
     ref = symbols(reference_px)
     cand = symbols(candidate_px)
-    best = _align(ref, cand, p, mirrored=False)
+    best = _align_any_start(ref, cand, p, mirrored=False)
     if p.allow_mirror:
         flipped = np.asarray(candidate_px, dtype=np.float64) * np.array([-1.0, 1.0])
-        other = _align(ref, symbols(flipped), p, mirrored=True)
+        other = _align_any_start(ref, symbols(flipped), p, mirrored=True)
         if other.score > best.score:
             best = other
     return best
@@ -117,6 +117,42 @@ def best_match(
     scores = [m.score for m in matches]
     best = max(range(len(scores)), key=lambda i: (scores[i], -i))
     return best, matches
+
+
+def _align_any_start(ref: Symbols, cand: Symbols, p: RecognizeParams, *, mirrored: bool) -> Match:
+    """Align with the candidate read from a corner that surely starts a merge group.
+
+    The reference is doubled, so its groups may start anywhere; the candidate is read once
+    from its first corner, so a group of its corners cannot wrap past the end. Starting at
+    its sharpest corner — and also just before it when the corners before it are weak
+    (small turn or short edge, i.e. candidates for merging) — avoids that.
+    """
+    n = len(cand.turn_deg)
+    if n < 3:
+        return NO_MATCH
+    turns = [abs(t) for t in cand.turn_deg.tolist()]
+    lengths = cand.length_rel.tolist()
+    sharpest = max(range(n), key=lambda i: (turns[i], -i))
+    starts = [sharpest]
+    for back in range(1, min(p.max_merge, n)):
+        prev = (sharpest - back) % n
+        weak = turns[prev] < 0.5 * p.angle_scale_deg or lengths[prev] * n < 0.5
+        if not weak:
+            break
+        starts.append(prev)
+    best = NO_MATCH
+    for start in starts:
+        m = _align(ref, _rotated(cand, start), p, mirrored=mirrored)
+        if m.score > best.score or best is NO_MATCH:
+            pairs = tuple((r, tuple((c + start) % n for c in cs)) for r, cs in m.pairs)
+            best = Match(m.score, m.cost, pairs, m.rotation_deg, m.scale, m.mirrored)
+    return best
+
+
+def _rotated(sym: Symbols, start: int) -> Symbols:
+    """The same outline read from corner ``start``."""
+    order = [(start + i) % len(sym.turn_deg) for i in range(len(sym.turn_deg))]
+    return Symbols(sym.turn_deg[order], sym.length_rel[order], sym.ring_px[order], sym.perimeter_px)
 
 
 def _dedupe(ring: FloatArray) -> FloatArray:

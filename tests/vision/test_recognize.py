@@ -1,0 +1,101 @@
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from uavtool.vision import RecognizeParams, Shape, match, match_shapes, vectorize
+
+from .synth import FAMILIES, draw, family_shape, place
+
+THRESHOLD = RecognizeParams().threshold
+RED = (210, 40, 40)
+
+families = st.sampled_from(FAMILIES)
+aspects = st.floats(0.5, 1.0)
+notches = st.floats(0.3, 0.45)
+
+
+def _vectorized(poly: np.ndarray, size: int) -> Shape:
+    shapes = vectorize(draw([(poly, RED)], size=(size, size)))
+    assert len(shapes) == 1
+    return shapes[0]
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    family=families,
+    aspect=aspects,
+    notch=notches,
+    angle=st.floats(0.0, 360.0),
+    scale=st.floats(0.3, 3.0),
+)
+def test_a_rotated_scaled_render_matches_its_original(
+    family: str, aspect: float, notch: float, angle: float, scale: float
+) -> None:
+    base = family_shape(family, aspect, notch)
+    small = 130.0
+    ref_px, cand_px = (small, small * scale) if scale >= 1 else (small / scale, small)
+    ref = _vectorized(place(base, angle_deg=0, size_px=ref_px, centre=(500, 500)), 1000)
+    cand = _vectorized(place(base, angle_deg=angle, size_px=cand_px, centre=(500, 500)), 1000)
+    m = match_shapes(ref, cand)
+    assert m.score >= THRESHOLD
+    assert abs(m.scale - cand_px / ref_px) < 0.05 * cand_px / ref_px
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    fam_a=families,
+    fam_b=families,
+    aspect_a=aspects,
+    aspect_b=aspects,
+    notch=notches,
+    angle=st.floats(0.0, 360.0),
+)
+def test_shapes_of_different_families_do_not_match(
+    fam_a: str, fam_b: str, aspect_a: float, aspect_b: float, notch: float, angle: float
+) -> None:
+    if fam_a == fam_b:
+        return
+    a = _vectorized(place(family_shape(fam_a, aspect_a, notch), angle_deg=0, size_px=200,
+                          centre=(250, 250)), 500)
+    b = _vectorized(place(family_shape(fam_b, aspect_b, notch), angle_deg=angle, size_px=200,
+                          centre=(250, 250)), 500)
+    assert match_shapes(a, b).score < THRESHOLD
+
+
+def test_exact_polygons_match_under_rotation_scale_and_start_corner() -> None:
+    ell = family_shape("L", 0.8, 0.35)
+    moved = np.roll(place(ell, angle_deg=123.0, size_px=3.7, centre=(5, 5)), 2, axis=0)
+    m = match(ell, moved)
+    assert m.score > 0.999
+    assert abs(m.rotation_deg - 123.0) < 1e-6
+    assert abs(m.scale - 3.7) < 1e-9
+    # Every corner is paired once, in order.
+    assert [p[0] for p in m.pairs] == [((i + m.pairs[0][0][0]) % 6,) for i in range(6)]
+
+
+def test_a_split_corner_and_a_vertex_on_an_edge_still_match() -> None:
+    ell = np.array([[0, 0], [100, 0], [100, 40], [40, 40], [40, 100], [0, 100]], float)
+    noisy = np.array(
+        [[0, 0], [50, 0.5], [100, 0], [100, 40], [42, 40], [40, 42], [40, 100], [0, 100]], float
+    )
+    m = match(ell, noisy)
+    assert m.score >= THRESHOLD
+    merged = [p for p in m.pairs if len(p[1]) > 1]
+    assert len(merged) == 2  # both extra vertices were merged away
+
+
+def test_a_mirror_image_does_not_match_unless_allowed() -> None:
+    ell = family_shape("L", 0.6, 0.3)  # unequal legs: no mirror symmetry
+    mirrored = ell * np.array([-1.0, 1.0])
+    assert match(ell, mirrored).score < THRESHOLD
+    allowed = match(ell, mirrored, RecognizeParams(allow_mirror=True))
+    assert allowed.score > 0.999
+    assert allowed.mirrored
+
+
+def test_scores_are_bit_identical_across_runs() -> None:
+    a = family_shape("T", 0.7, 0.35)
+    b = place(family_shape("T", 0.75, 0.4), angle_deg=33.0, size_px=2.0, centre=(1, 2))
+    assert match(a, b).score == match(a.copy(), b.copy()).score
