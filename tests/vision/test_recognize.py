@@ -53,14 +53,20 @@ def test_a_rotated_scaled_render_matches_its_original(
     angle=st.floats(0.0, 360.0),
 )
 def test_shapes_of_different_families_do_not_match(
-    fam_a: str, fam_b: str, aspect_a: float, aspect_b: float, notch: float, angle: float
+    *, fam_a: str, fam_b: str, aspect_a: float, aspect_b: float, notch: float, angle: float
 ) -> None:
     if fam_a == fam_b:
         return
-    a = _vectorized(place(family_shape(fam_a, aspect_a, notch), angle_deg=0, size_px=200,
-                          centre=(250, 250)), 500)
-    b = _vectorized(place(family_shape(fam_b, aspect_b, notch), angle_deg=angle, size_px=200,
-                          centre=(250, 250)), 500)
+    a = _vectorized(
+        place(family_shape(fam_a, aspect_a, notch), angle_deg=0, size_px=200, centre=(250, 250)),
+        500,
+    )
+    b = _vectorized(
+        place(
+            family_shape(fam_b, aspect_b, notch), angle_deg=angle, size_px=200, centre=(250, 250)
+        ),
+        500,
+    )
     assert match_shapes(a, b).score < THRESHOLD
 
 
