@@ -75,6 +75,7 @@ class RecordingWriter:
         self.dialect = dialect
         self.path = Path(path)
         self._file: BinaryIO = create_file(path)
+        # typed Any: mcap's Writer methods are not annotated
         self._mcap: Any = McapWriter(
             self._file, chunk_size=_NEVER, compression=CompressionType.ZSTD
         )
@@ -89,6 +90,7 @@ class RecordingWriter:
         self._schemas: dict[tuple[str, bytes], int] = {}
         self._channels: dict[Any, int] = {}  # key -> channel id
         self._topic_kind: dict[str, Any] = {}  # topic -> value type or JSON schema name
+        self._json_topics: dict[str, int] = {}  # topic -> channel id
         self._sequence: dict[int, int] = {}
         self._mcap.start(profile="", library=LIBRARY)
         tool = {"version": __version__, "dialect": dialect, "mavlink": "2.0"}
@@ -154,7 +156,7 @@ class RecordingWriter:
                     raise ValueError(f"topic {topic!r} already carries {known!r}")
                 return
             schema_id = self._schema(schema_name, JSONSCHEMA_ENCODING, dumps(schema))
-            self._channel(topic, topic, JSON_ENCODING, schema_id)
+            self._json_topics[topic] = self._channel(topic, topic, JSON_ENCODING, schema_id)
             self._topic_kind[topic] = schema_name
 
     # --- writes ------------------------------------------------------------------------------
@@ -174,8 +176,8 @@ class RecordingWriter:
             raise ValueError(f"topic {topic!r}: payload is not JSON: {exc}") from exc
         with self._lock:
             self._check_open()
-            channel_id = self._channels.get(topic)
-            if channel_id is None or not isinstance(self._topic_kind.get(topic), str):
+            channel_id = self._json_topics.get(topic)
+            if channel_id is None:
                 raise ValueError(f"topic {topic!r} is not a JSON topic: call add_json_topic first")
             self._add(channel_id, log_time_ns, publish_time_ns, data)
 
@@ -271,23 +273,17 @@ class RecordingWriter:
     def _add(
         self, channel_id: int, log_time_ns: int, publish_time_ns: int | None, data: bytes
     ) -> None:
-        if not isinstance(log_time_ns, int) or log_time_ns <= 0:
+        if type(log_time_ns) is not int or log_time_ns <= 0:
             raise ValueError(f"log_time_ns must be a positive int, got {log_time_ns!r}")
         publish = log_time_ns if publish_time_ns is None else publish_time_ns
         sequence = self._sequence[channel_id]
         self._sequence[channel_id] = sequence + 1
-        self._mcap.add_message(
-            channel_id=channel_id,
-            log_time=log_time_ns,
-            data=data,
-            publish_time=publish,
-            sequence=sequence,
-        )
+        self._mcap.add_message(channel_id, log_time_ns, data, publish, sequence)
         self._message_count += 1
         self._chunk_size += len(data) + _RECORD_OVERHEAD
         if self._chunk_start_ns is None:
             self._chunk_start_ns = log_time_ns
-        if abs(log_time_ns - self._chunk_start_ns) >= self._interval_ns:
+        if log_time_ns - self._chunk_start_ns >= self._interval_ns:
             self._close_chunk(sync=self._fsync)
         elif self._chunk_size >= self._budget:
             self._close_chunk(sync=False)
