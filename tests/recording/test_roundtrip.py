@@ -183,3 +183,21 @@ def test_unknown_schema_is_a_clear_error(tmp_path: Path) -> None:
             UnknownSchemaError, match=re.escape("ros.mcap: topic '/chatter': cannot decode 'ros1'")
         ):
             reader.decode(message)
+
+
+def test_files_without_a_summary_are_scanned(tmp_path: Path) -> None:
+    from mcap.writer import IndexType, Writer
+
+    path = tmp_path / "bare.mcap"
+    with path.open("wb") as f:
+        w = Writer(f, index_types=IndexType.NONE, repeat_channels=False, repeat_schemas=False)
+        w.start()
+        cid = w.register_channel("/mavlink/raw", "mavlink", 0, {"direction": "in"})
+        for i, (_d, frame) in enumerate(mavlink_frames(10)):
+            w.add_message(cid, log_time=i + 1, data=frame, publish_time=i + 1)
+        w.finish()
+    with RecordingReader(path) as reader:
+        assert reader.health.whole
+        assert not reader.health.indexed
+        frames = [e.value for e in reader.entries(["/mavlink/raw"])]
+    assert frames == [MavlinkFrame(Direction.IN, f) for _, f in mavlink_frames(10)]

@@ -26,6 +26,7 @@ class RecordingInfo:
     path: str
     size_bytes: int
     whole: bool
+    indexed: bool  # read from the summary (whole files written with indexes)
     problem: str  # "" when whole
     readable_bytes: int
     partial_chunk: bool  # messages were rescued from a cut chunk
@@ -78,6 +79,7 @@ def summarize(path: str | Path) -> RecordingInfo:
             path=str(path),
             size_bytes=health.size_bytes,
             whole=health.whole,
+            indexed=health.indexed,
             problem=health.problem,
             readable_bytes=health.readable_bytes,
             partial_chunk=health.partial_chunk,
@@ -96,7 +98,7 @@ def format_info(info: RecordingInfo) -> str:
     """The human-readable report `uavtool info` prints."""
     lines = [f"file:      {info.path} ({info.size_bytes} bytes, written by {info.library or '?'})"]
     if info.whole:
-        lines.append("health:    whole, indexed")
+        lines.append("health:    whole, " + ("indexed" if info.indexed else "no summary or index"))
     else:
         rescued = " (some from a cut chunk)" if info.partial_chunk else ""
         lines.append(f"health:    TRUNCATED — {info.problem}")

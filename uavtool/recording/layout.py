@@ -211,7 +211,7 @@ def _read_summary(buf: Buf, layout: Layout) -> bool:
         != crc
     ):
         return False
-    stats_chunks = -1
+    stats_chunks, stats_channels = -1, -1
     chunk_blocks: list[Block] = []
     meta_offsets: list[tuple[int, int]] = []
     for op, s, _e in iter_records(buf, summary_start, fpos):
@@ -223,6 +223,7 @@ def _read_summary(buf: Buf, layout: Layout) -> bool:
             layout.channels[channel.id] = channel
         elif op == Op.STATISTICS:
             (layout.start_ns, layout.end_ns) = struct.unpack_from("<QQ", buf, s + 26)
+            (stats_channels,) = _U32.unpack_from(buf, s + 10)
             (stats_chunks,) = _U32.unpack_from(buf, s + 22)
             (n_counts,) = _U32.unpack_from(buf, s + 42)
             for k in range(s + 46, s + 46 + n_counts, 10):
@@ -238,6 +239,8 @@ def _read_summary(buf: Buf, layout: Layout) -> bool:
     if stats_chunks != len(chunk_blocks) or (not layout.counts and stats_chunks):
         return False  # no statistics, or messages outside chunks: scan instead
     if sum(layout.counts.values()) and not chunk_blocks:
+        return False
+    if stats_channels != len(layout.channels):  # channels not repeated in the summary
         return False
     layout.blocks = sorted(chunk_blocks, key=lambda b: b.offset)
     for offset, _length in meta_offsets:
