@@ -98,9 +98,10 @@ def _reposition(session: GcsSession, cmd: CommandArgs) -> Result:
     n, e, _ = ap.ned_of(GeoPoint(lat, lon, ap.home.alt_amsl_m))
     if cmd.p(1) > 0:
         ap.change_speed(1, cmd.p(1))
-    yaw = cmd.p(4) % 360.0 if math.isfinite(cmd.p(4)) else None
+    # param4 (yaw) is ignored, as ArduCopter does: clients disagree on its unit (MAVSDK
+    # sends radians, the spec says degrees); yaw is set with CONDITION_YAW or a target.
     change_mode = bool(int(cmd.p(2)) & M.MAV_DO_REPOSITION_FLAGS_CHANGE_MODE)
-    return ap.guided_position((n, e, -alt_rel), yaw_deg=yaw, switch_mode=change_mode)
+    return ap.guided_position((n, e, -alt_rel), switch_mode=change_mode)
 
 
 def _mount_control(session: GcsSession, cmd: CommandArgs) -> Result:
