@@ -131,5 +131,5 @@ def pixel_ray(u_px: float, v_px: float, pose: CameraPose, intrinsics: Intrinsics
     d_cam = np.array(
         [(u_px - intrinsics.cx_px) / intrinsics.fx_px, (v_px - intrinsics.cy_px) / intrinsics.fy_px, 1.0]
     )
-    d = pose.world_from_camera() @ d_cam
+    d: FloatArray = pose.world_from_camera() @ d_cam
     return d / math.sqrt(float(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]))
