@@ -33,33 +33,43 @@ def refine_corners(
     n, m = len(dense_px), len(kept)
     if m < 3:
         return dense_px[kept].copy()
-    lines: list[tuple[float, float, float, float, int]] = []  # cx, cy, dx, dy, edge index
+    spans: list[tuple[int, int]] = []  # (first, last) dense indices of each long edge
     for e in range(m):
         first, last = kept[e], kept[(e + 1) % m]
-        count = (last - first) % n + 1
         chord = dense_px[last] - dense_px[first]
-        if count < 3 or math.hypot(float(chord[0]), float(chord[1])) < min_edge_px:
+        if (last - first) % n >= 2 and math.hypot(float(chord[0]), float(chord[1])) >= min_edge_px:
+            spans.append((first, last))
+    lines = [_fit_span(dense_px, first, last) for first, last in spans]
+    # Merge neighbouring edges that are one straight line (a vertex RDP kept for a rounded
+    # or noisy stretch), refitting the merged span, until none is left.
+    k = 0
+    while len(lines) > 3 and k < len(lines):
+        j = (k + 1) % len(lines)
+        (_, _, dx1, dy1), (_, _, dx2, dy2) = lines[k], lines[j]
+        if abs(dx1 * dy2 - dy1 * dx2) < _MIN_SINE and dx1 * dx2 + dy1 * dy2 > 0.0:
+            spans[k] = (spans[k][0], spans[j][1])
+            lines[k] = _fit_span(dense_px, *spans[k])
+            del spans[j], lines[j]
+            k = max(k - 1, 0) if j > k else k - 1
             continue
-        # Interior points only when there are enough: an RDP vertex next to a corner may
-        # already lie on the following edge.
-        trim = 1 if count >= 6 else 0
-        idx = [(first + t) % n for t in range(trim, count - trim)]
-        lines.append((*_fit_line(dense_px[idx]), e))
+        k += 1
     if len(lines) < 3:
         return dense_px[kept].copy()
     corners: list[tuple[float, float]] = []
     for k in range(len(lines)):
-        cx1, cy1, dx1, dy1, e1 = lines[k - 1]
-        cx2, cy2, dx2, dy2, _ = lines[k]
-        # The RDP vertex that ends edge e1 (start of the following edge).
-        vx, vy = dense_px[kept[(e1 + 1) % m]].tolist()
+        cx1, cy1, dx1, dy1 = lines[k - 1]
+        cx2, cy2, dx2, dy2 = lines[k]
+        end_prev, start_next = spans[k - 1][1], spans[k][0]
         cross = dx1 * dy2 - dy1 * dx2
         if abs(cross) < _MIN_SINE:
-            if e1 == (lines[k][4] - 1) % m:
-                corners.append((vx, vy))  # a straight joint: keep the vertex
+            # Parallel edges joined by a stub (a small step): keep the stub's ends.
+            corners.append(tuple(dense_px[end_prev].tolist()))
+            if start_next != end_prev:
+                corners.append(tuple(dense_px[start_next].tolist()))
             continue
         t = ((cx2 - cx1) * dy2 - (cy2 - cy1) * dx2) / cross
         px, py = cx1 + t * dx1, cy1 + t * dy1
+        vx, vy = dense_px[end_prev].tolist()
         if math.hypot(px - vx, py - vy) > max_shift_px:
             corners.append((vx, vy))
         else:
@@ -67,6 +77,16 @@ def refine_corners(
     if len(corners) < 3:
         return dense_px[kept].copy()
     return np.array(corners, dtype=np.float64)
+
+
+def _fit_span(dense_px: FloatArray, first: int, last: int) -> tuple[float, float, float, float]:
+    """Line through the dense points ``first`` … ``last`` (cyclic), without the end points
+    when there are enough (an RDP vertex next to a corner may lie on the next edge)."""
+    n = len(dense_px)
+    count = (last - first) % n + 1
+    trim = 1 if count >= 6 else 0
+    idx = [(first + t) % n for t in range(trim, count - trim)]
+    return _fit_line(dense_px[idx])
 
 
 def _fit_line(pts: FloatArray) -> tuple[float, float, float, float]:

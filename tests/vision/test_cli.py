@@ -1,0 +1,123 @@
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import cv2
+import numpy as np
+from click.testing import CliRunner
+
+from uavtool.camera import CameraPose, Intrinsics
+from uavtool.cli import cli
+from uavtool.vision.io import views_to_json
+from uavtool.world import load_scene, render
+
+from .synth import draw, family_shape, place
+
+RED = (210, 40, 40)
+BLUE = (40, 90, 220)
+
+
+def _write(path: Path, rgb: np.ndarray) -> Path:
+    cv2.imwrite(str(path), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+    return path
+
+
+def test_every_vision_command_has_an_example() -> None:
+    runner = CliRunner()
+    for args in (["vision"], ["vision", "vectorize"], ["vision", "match"], ["vision", "model"]):
+        result = runner.invoke(cli, [*args, "--help"])
+        assert result.exit_code == 0
+        assert "Example:" in result.output
+
+
+def test_vectorize_writes_shapes_and_overlay(tmp_path: Path) -> None:
+    ell = place(family_shape("L", 0.7, 0.35), angle_deg=20, size_px=200, centre=(320, 240))
+    frame = _write(tmp_path / "frame.png", draw([(ell, RED)]))
+    out, overlay = tmp_path / "shapes.json", tmp_path / "overlay.png"
+    result = CliRunner().invoke(
+        cli, ["vision", "vectorize", str(frame), "-o", str(out), "--overlay", str(overlay)]
+    )
+    assert result.exit_code == 0, result.output
+    assert "6 corners" in result.output
+    assert len(json.loads(out.read_text())["shapes"]) == 1
+    assert cv2.imread(str(overlay)).shape == (960, 1280, 3)
+
+
+def test_match_finds_the_target_and_fails_when_absent(tmp_path: Path) -> None:
+    ell = family_shape("L", 0.6, 0.3)
+    target = _write(
+        tmp_path / "target.png",
+        draw([(place(ell, angle_deg=0, size_px=150, centre=(320, 240)), RED)]),
+    )
+    frame = _write(
+        tmp_path / "frame.png",
+        draw(
+            [
+                (
+                    place(
+                        family_shape("U", 0.8, 0.35), angle_deg=10, size_px=120, centre=(150, 150)
+                    ),
+                    BLUE,
+                ),
+                (place(ell, angle_deg=75, size_px=180, centre=(450, 300)), RED),
+            ]
+        ),
+    )
+    runner = CliRunner()
+    result = runner.invoke(cli, ["vision", "match", str(target), str(frame)])
+    assert result.exit_code == 0, result.output
+    assert "best: shape 1" in result.output
+    other = _write(
+        tmp_path / "other.png",
+        draw(
+            [
+                (
+                    place(
+                        family_shape("U", 0.8, 0.35), angle_deg=0, size_px=150, centre=(320, 240)
+                    ),
+                    BLUE,
+                )
+            ]
+        ),
+    )
+    result = runner.invoke(cli, ["vision", "match", str(target), str(other)])
+    assert result.exit_code == 1
+    assert "uavtool: error: no shape" in result.output
+
+
+def test_model_writes_a_glb(tmp_path: Path) -> None:
+    scene = load_scene("paper")
+    k = Intrinsics.from_hfov()
+    poses = {
+        "top": CameraPose((10.0, -8.0, 20.0), 0.0, -90.0),
+        "front": CameraPose((10.0, -27.0, 3.0), 0.0, 0.0),
+        "right": CameraPose((30.0, -8.0, 3.0), 270.0, 0.0),
+    }
+    paths = [_write(tmp_path / f"{n}.png", render(scene, p, k)) for n, p in poses.items()]
+    (tmp_path / "poses.json").write_text(views_to_json({n: (p, k) for n, p in poses.items()}))
+    out = tmp_path / "model.glb"
+    result = CliRunner().invoke(
+        cli,
+        [
+            "vision",
+            "model",
+            *map(str, paths),
+            "--poses",
+            str(tmp_path / "poses.json"),
+            "-o",
+            str(out),
+        ],
+    )
+    assert result.exit_code == 0, result.output
+    assert "watertight True" in result.output
+    assert out.read_bytes()[:4] == b"glTF"
+
+
+def test_bad_input_is_a_one_line_error(tmp_path: Path) -> None:
+    bogus = tmp_path / "bogus.png"
+    bogus.write_text("not an image")
+    result = CliRunner().invoke(cli, ["vision", "vectorize", str(bogus)])
+    assert result.exit_code == 2
+    assert result.output.strip().count("\n") == 0
+    assert "bogus.png: not an image" in result.output

@@ -1,0 +1,93 @@
+from __future__ import annotations
+
+import functools
+
+import manifold3d
+import numpy as np
+import pytest
+import trimesh
+
+from uavtool.camera import CameraPose, Intrinsics
+from uavtool.vision import vectorize
+from uavtool.vision.errors import ModelInputError
+from uavtool.vision.model3d import Model, View, build_model, model_glb, same_colour
+from uavtool.world import building_mesh, load_scene, render
+
+K = Intrinsics.from_hfov()
+# Around the paper scene's red target (x 5..15 m east, y -12..-4 m north, 5 / 6.5 m high).
+POSES = {
+    "top": CameraPose((10.0, -8.0, 20.0), 0.0, -90.0),
+    "front": CameraPose((10.0, -27.0, 3.0), 0.0, 0.0),  # south of it, looking north
+    "right": CameraPose((30.0, -8.0, 3.0), 270.0, 0.0),  # east of it, looking west
+}
+
+
+def _manifold(mesh: trimesh.Trimesh) -> manifold3d.Manifold:
+    return manifold3d.Manifold(
+        manifold3d.Mesh(
+            vert_properties=np.asarray(mesh.vertices, np.float32),
+            tri_verts=np.asarray(mesh.faces, np.uint32),
+        )
+    )
+
+
+def _occupied(mesh: trimesh.Trimesh, point: tuple[float, float, float]) -> bool:
+    probe = manifold3d.Manifold.cube((0.1, 0.1, 0.1), center=True).translate(point)
+    return (_manifold(mesh) ^ probe).volume() > 1e-6
+
+
+def _views(poses: dict[str, CameraPose]) -> dict[str, View]:
+    scene = load_scene("paper")
+    red = scene.building("red").color_rgb
+    return {
+        name: View(
+            same_colour(vectorize(render(scene, pose, K, noise_seed=7)), red, hue_tolerance_deg=15),
+            pose,
+            K,
+        )
+        for name, pose in poses.items()
+    }
+
+
+@functools.cache
+def _paper_model() -> Model:
+    v = _views(POSES)
+    return build_model(v["top"], v["front"], v["right"])
+
+
+def test_paper_target_model_is_watertight_with_the_right_size() -> None:
+    model = _paper_model()
+    truth = building_mesh(load_scene("paper").building("red"))
+    assert model.mesh.is_watertight
+    assert model.mesh.volume == pytest.approx(truth.volume, rel=0.15)
+    np.testing.assert_allclose(model.mesh.bounds[:, :2], truth.bounds[:, :2], atol=0.1)
+    assert model.mesh.bounds[0, 2] == pytest.approx(0.0, abs=1e-6)
+    assert model.height_m == pytest.approx(6.5, abs=0.8)
+    a, b = _manifold(model.mesh), _manifold(truth)
+    inter = (a ^ b).volume()
+    assert inter / (a.volume() + b.volume() - inter) > 0.82
+
+
+def test_through_holes_survive_as_tunnels() -> None:
+    mesh = _paper_model().mesh
+    assert not _occupied(mesh, (8.75, -10.0, 1.0))  # north-south tunnel, seen from the front
+    assert not _occupied(mesh, (13.0, -6.25, 1.5))  # east-west tunnel, seen from the right
+    assert _occupied(mesh, (8.75, -10.0, 4.0))  # the wing above the tunnel
+    assert _occupied(mesh, (6.0, -10.0, 2.0))
+
+
+def test_glb_round_trips_through_trimesh() -> None:
+    data = model_glb(_paper_model())
+    assert data[:4] == b"glTF"
+    loaded = trimesh.load(trimesh.util.wrap_as_stream(data), file_type="glb", force="mesh")
+    assert loaded.volume == pytest.approx(_paper_model().mesh.volume, rel=1e-4)
+
+
+def test_bad_views_are_refused_with_a_reason() -> None:
+    v = _views(POSES)
+    with pytest.raises(ModelInputError, match="apart"):
+        build_model(v["top"], v["front"], v["front"])
+    with pytest.raises(ModelInputError, match="nadir"):
+        build_model(v["front"], v["front"], v["right"])
+    with pytest.raises(ModelInputError, match="no silhouette"):
+        build_model(View((), POSES["top"], K), v["front"], v["right"])
