@@ -134,18 +134,13 @@ def _cross(rng: random.Random) -> Ring:
 def _radial(rng: random.Random, *, concave: bool) -> Ring:
     n = 5 + _index(rng, 4) if not concave else 6 + 2 * _index(rng, 3)
     r = _size(rng, 4.0, 10.0) / 2.0
-    angles = sorted(rng.random() * 2.0 * math.pi for _ in range(n))
-    if concave:  # alternate outer and inner radii: a star, simple because angles increase
-        step = 2.0 * math.pi / n
-        angles = [k * step + 0.4 * step * rng.random() for k in range(n)]
+    step = 2.0 * math.pi / n
+    angles = [k * step + 0.5 * step * rng.random() for k in range(n)]  # increasing: a simple ring
+    if concave:  # alternate outer and inner radii: a star
         radii = [r if k % 2 == 0 else r * (0.45 + 0.25 * rng.random()) for k in range(n)]
         return [(radii[k] * math.cos(a), radii[k] * math.sin(a)) for k, a in enumerate(angles)]
-    ring = [(r * math.cos(a), r * math.sin(a)) for a in angles]
-    # points on a circle in angular order are convex; drop near-duplicates
-    kept = [p for k, p in enumerate(ring) if k == 0 or math.dist(p, ring[k - 1]) > 0.5]
-    if len(kept) > 3 and math.dist(kept[0], kept[-1]) <= 0.5:
-        kept.pop()
-    return kept if len(kept) >= 3 else _rectangle(rng)
+    # points on a circle in angular order, each gap under 180 degrees: a convex polygon
+    return [(r * math.cos(a), r * math.sin(a)) for a in angles]
 
 
 def _centred(ring: list[tuple[float, float]]) -> Ring:
