@@ -1,0 +1,80 @@
+"""``uavtool sitl`` from the shell, driven by pymavlink's own mavutil as a user would."""
+
+from __future__ import annotations
+
+import os
+import socket
+import subprocess
+import sys
+import time
+
+import pytest
+from click.testing import CliRunner
+
+from uavtool.cli import cli
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def test_help_has_an_example() -> None:
+    result = CliRunner().invoke(cli, ["sitl", "--help"])
+    assert result.exit_code == 0
+    assert "Example" in result.output and "--speedup" in result.output
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--endpoint", "bogus"], "endpoint 'bogus'"),
+        (["--home", "1,2"], "--home '1,2'"),
+        (["--signing-key", "abc"], "--signing-key"),
+        (["--params", "/nonexistent.parm"], "/nonexistent.parm: cannot read"),
+        (["--speedup", "0"], "speedup must be > 0"),
+        (["--wind", "x,y"], "--wind 'x,y'"),
+    ],
+)
+def test_bad_options_exit_2_with_one_line(args: list[str], message: str) -> None:
+    result = CliRunner().invoke(cli, ["sitl", *args])
+    assert result.exit_code == 2
+    assert message in result.output
+    assert "Traceback" not in result.output
+
+
+def test_shell_session_with_mavutil() -> None:
+    port = _free_port()
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "uavtool", "sitl", "--speedup", "5", "--endpoint", f"tcpin:127.0.0.1:{port}"],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env,
+    )  # fmt: skip
+    try:
+        assert proc.stdout is not None
+        banner = proc.stdout.readline() + proc.stdout.readline()
+        assert f"tcpin:127.0.0.1:{port}" in banner
+        script = f"""
+import os
+os.environ["MAVLINK20"] = "1"
+from pymavlink import mavutil
+m = mavutil.mavlink_connection("tcp:127.0.0.1:{port}", source_system=255)
+m.wait_heartbeat(timeout=10)
+m.set_mode("GUIDED")
+m.arducopter_arm()
+m.motors_armed_wait()
+m.mav.command_long_send(1, 1, mavutil.mavlink.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, 0, 5)
+while m.recv_match(type="GLOBAL_POSITION_INT", blocking=True, timeout=10).relative_alt < 4800:
+    pass
+m.set_mode("LAND")
+m.motors_disarmed_wait()
+print("landed", m.recv_match(type="GLOBAL_POSITION_INT", blocking=True).relative_alt)
+"""
+        out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
+        assert out.returncode == 0, out.stderr
+        assert out.stdout.startswith("landed")
+        assert abs(int(out.stdout.split()[1])) < 100
+    finally:
+        proc.terminate()
+        proc.communicate(timeout=10)
