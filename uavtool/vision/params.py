@@ -33,6 +33,12 @@ class VectorizeParams:
     """HSV value (0–255) below which a pixel is too dark to trust its hue."""
     denoise_px: int = 3
     """Median filter aperture applied to the colour-class image (0 or 1 = off; odd)."""
+    roof_only: bool = False
+    """Keep only the brightest shade of each colour: in a photo from above that is the
+    roofs, without the walls perspective shows around them (use for nadir photos)."""
+    roof_value_tolerance: int = 20
+    """With ``roof_only``, HSV values (0–255) this far below the brightest shade still count
+    as roof (sensor noise); walls are darker by much more under the renderer's lighting."""
     point_spacing_px: float = 2.0
     """Distance between the evenly spaced points put along each border: larger is faster
     and coarser."""

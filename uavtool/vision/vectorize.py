@@ -55,6 +55,8 @@ def vectorize(frame_rgb: U8Array, params: VectorizeParams | None = None) -> tupl
     shapes: list[Shape] = []
     for k in range(1, n_classes + 1):
         mask = cv2.inRange(classes, k, k)
+        if p.roof_only:
+            mask = _brightest_shade(hsv, mask, p)
         found = _shapes_in_mask(frame, mask, p)
         shapes.extend(sorted(found, key=lambda s: -s.area_px))
     return tuple(shapes)
@@ -107,6 +109,24 @@ def hue_lut(hsv: CvArray, valid: CvArray, params: VectorizeParams) -> U8Array:
             k += 1
             lut[idx] = k
     return lut
+
+
+def _brightest_shade(hsv: CvArray, mask: CvArray, p: VectorizeParams) -> CvArray:
+    """The part of ``mask`` in the brightest shade of its colour.
+
+    Flat shading gives each face orientation one brightness; a roof faces the sky and is
+    brighter than every wall, so from above this keeps the roofs and drops the walls that
+    perspective shows around them.
+    """
+    hist = cv2.calcHist([hsv], [2], mask, [256], [0, 256]).ravel()
+    total = float(hist.sum())
+    if total == 0.0:
+        return mask
+    # The brightest value holding a real share of the pixels (not a few noisy ones).
+    cum = np.cumsum(hist[::-1])
+    top = 255 - int(np.argmax(cum >= max(p.min_area_px, 0.02 * total)))
+    bright = cv2.inRange(cv2.extractChannel(hsv, 2), max(0, top - p.roof_value_tolerance), 255)
+    return cv2.bitwise_and(mask, bright)
 
 
 def hue_of(colour_rgb: tuple[int, int, int]) -> int:
