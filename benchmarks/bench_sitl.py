@@ -18,7 +18,9 @@ from uavtool.sitl.state import MissionItem
 SIM_SECONDS = 600.0
 
 
-def _drain(port: int, ready: multiprocessing.synchronize.Event, out: multiprocessing.queues.Queue) -> None:  # type: ignore[name-defined]
+def _drain(
+    port: int, ready: multiprocessing.synchronize.Event, out: multiprocessing.queues.Queue
+) -> None:  # type: ignore[name-defined]
     """A ground station in another process: reads and parses everything the vehicle sends."""
     from uavtool.mavlink import FrameParser
 
@@ -38,13 +40,42 @@ def _patrol(sitl: Sitl) -> None:
     """Arm and fly a square patrol in AUTO for the whole benchmark."""
     home = sitl.config.home
     rel = M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
-    items = [MissionItem(0, M.MAV_FRAME_GLOBAL_INT, 16, 0, 1, 0, 0, 0, 0, home.lat_e7, home.lon_e7, home.alt_amsl_m),
-             MissionItem(1, rel, 22, 0, 1, 0, 0, 0, 0, 0, 0, 30)]  # fmt: skip
+    items = [
+        MissionItem(
+            0,
+            M.MAV_FRAME_GLOBAL_INT,
+            16,
+            0,
+            1,
+            0,
+            0,
+            0,
+            0,
+            home.lat_e7,
+            home.lon_e7,
+            home.alt_amsl_m,
+        ),
+        MissionItem(1, rel, 22, 0, 1, 0, 0, 0, 0, 0, 0, 30),
+    ]
     corners = [(9000, 0), (9000, 11000), (0, 11000), (0, 0)]  # a ~100 m square
     for lap in range(40):
         for dlat, dlon in corners:
-            items.append(MissionItem(len(items), rel, 16, 0, 1, 0, 0, 0, 0, home.lat_e7 + dlat,
-                                     home.lon_e7 + dlon, 30 + (lap % 3) * 5))  # fmt: skip
+            items.append(
+                MissionItem(
+                    len(items),
+                    rel,
+                    16,
+                    0,
+                    1,
+                    0,
+                    0,
+                    0,
+                    0,
+                    home.lat_e7 + dlat,
+                    home.lon_e7 + dlon,
+                    30 + (lap % 3) * 5,
+                )
+            )
     sitl.autopilot.mission.replace(items)
     sitl.autopilot.set_mode(Mode.GUIDED)
     sitl.autopilot.arm(force=False)
@@ -70,7 +101,7 @@ def bench_real_time_factor() -> tuple[float, int]:
     proc.join(10)
     assert received == sent, f"client parsed {received} of {sent} frames"
     moved = sitl.autopilot.state.pos_ned_m
-    print(f"  flew to N{moved[0]:.0f} E{moved[1]:.0f} m, {sitl.steps} steps, {sent} frames to the client")
+    print(f"  flew to N{moved[0]:.0f} E{moved[1]:.0f} m, {sitl.steps} steps, {sent} frames sent")
     return wall, sent
 
 
@@ -83,8 +114,13 @@ def bench_message_cost(n: int = 20_000) -> tuple[float, float]:
     sitl = Sitl(SitlConfig(endpoints=(f"udpout:{addr[0]}:{addr[1]}",), speedup=1e9))
     session = sitl.sessions[0]
     telemetry = sitl.telemetry
-    ids = [M.MAVLINK_MSG_ID_GLOBAL_POSITION_INT, M.MAVLINK_MSG_ID_ATTITUDE, M.MAVLINK_MSG_ID_VFR_HUD,
-           M.MAVLINK_MSG_ID_SYS_STATUS, M.MAVLINK_MSG_ID_LOCAL_POSITION_NED]  # fmt: skip
+    ids = [
+        M.MAVLINK_MSG_ID_GLOBAL_POSITION_INT,
+        M.MAVLINK_MSG_ID_ATTITUDE,
+        M.MAVLINK_MSG_ID_VFR_HUD,
+        M.MAVLINK_MSG_ID_SYS_STATUS,
+        M.MAVLINK_MSG_ID_LOCAL_POSITION_NED,
+    ]
 
     def drain() -> None:
         try:
@@ -109,7 +145,9 @@ def bench_message_cost(n: int = 20_000) -> tuple[float, float]:
 
     mav = M.MAVLink(_File(), srcSystem=1, srcComponent=1)
     senders = [
-        lambda: mav.global_position_int_send(1000, -353632610, 1491652300, 594000, 10000, 0, 0, 0, 35300),
+        lambda: mav.global_position_int_send(
+            1000, -353632610, 1491652300, 594000, 10000, 0, 0, 0, 35300
+        ),
         lambda: mav.attitude_send(1000, 0.01, -0.02, 1.2, 0.0, 0.0, 0.0),
         lambda: mav.vfr_hud_send(3.0, 3.0, 353, 45, 594.0, 0.0),
         lambda: mav.sys_status_send(1, 1, 1, 150, 16800, 1200, 99, 0, 0, 0, 0, 0, 0),
@@ -129,12 +167,17 @@ def bench_message_cost(n: int = 20_000) -> tuple[float, float]:
 def main() -> None:
     print(f"uavtool SITL benchmark ({multiprocessing.cpu_count()} cores)")
     wall, sent = bench_real_time_factor()
-    print(f"  {SIM_SECONDS / 60:.0f}-minute flight at max speed-up: {wall:.2f} s wall, real-time factor "
-          f"{SIM_SECONDS / wall:.0f}x (goal: < 10 s, i.e. >= 60x) -> {'PASS' if wall < 10 else 'FAIL'}")  # fmt: skip
+    print(
+        f"  {SIM_SECONDS / 60:.0f}-minute flight at max speed-up: {wall:.2f} s wall, "
+        f"real-time factor {SIM_SECONDS / wall:.0f}x (goal: < 10 s, i.e. >= 60x) -> "
+        f"{'PASS' if wall < 10 else 'FAIL'}"
+    )
     print(f"  telemetry to one TCP client: {sent / wall:,.0f} frames/s wall")
     ours, base = bench_message_cost()
-    print(f"  cost per telemetry message: uavtool build+pack+send {ours:.2f} us, "
-          f"pymavlink encode+send {base:.2f} us, ratio {ours / base:.2f}x")  # fmt: skip
+    print(
+        f"  cost per telemetry message: uavtool build+pack+send {ours:.2f} us, "
+        f"pymavlink encode+send {base:.2f} us, ratio {ours / base:.2f}x"
+    )
 
 
 if __name__ == "__main__":

@@ -39,7 +39,9 @@ class Intrinsics:
     cy_px: float
 
     @classmethod
-    def from_hfov(cls, *, width_px: int = 640, height_px: int = 480, hfov_deg: float = 60.0) -> Intrinsics:
+    def from_hfov(
+        cls, *, width_px: int = 640, height_px: int = 480, hfov_deg: float = 60.0
+    ) -> Intrinsics:
         """Intrinsics of a ``width_px``×``height_px`` camera with horizontal FOV ``hfov_deg``."""
         if width_px <= 0 or height_px <= 0:
             raise InputError(f"camera size must be positive, got {width_px}x{height_px}")
@@ -102,7 +104,11 @@ class CameraPose:
             forward[0] * right[1] - forward[1] * right[0],
         )
         return np.array(
-            [[right[0], down[0], forward[0]], [right[1], down[1], forward[1]], [right[2], down[2], forward[2]]]
+            [
+                [right[0], down[0], forward[0]],
+                [right[1], down[1], forward[1]],
+                [right[2], down[2], forward[2]],
+            ]
         )
 
     def camera_from_world(self) -> FloatArray:
@@ -129,7 +135,11 @@ def project(points_enu_m: FloatArray, pose: CameraPose, intrinsics: Intrinsics) 
 def pixel_ray(u_px: float, v_px: float, pose: CameraPose, intrinsics: Intrinsics) -> FloatArray:
     """Unit direction (ENU) of the ray through pixel ``(u_px, v_px)``."""
     d_cam = np.array(
-        [(u_px - intrinsics.cx_px) / intrinsics.fx_px, (v_px - intrinsics.cy_px) / intrinsics.fy_px, 1.0]
+        [
+            (u_px - intrinsics.cx_px) / intrinsics.fx_px,
+            (v_px - intrinsics.cy_px) / intrinsics.fy_px,
+            1.0,
+        ]
     )
     d: FloatArray = pose.world_from_camera() @ d_cam
     return d / math.sqrt(float(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]))

@@ -8,14 +8,22 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from uavtool.mavlink import FrameParser, mavlink as M, new_encoder
+from uavtool.mavlink import FrameParser, new_encoder
+from uavtool.mavlink import mavlink as M
 
 
 class Client:
     """Talks to the vehicle like a ground station (sysid 255, compid 190)."""
 
-    def __init__(self, sock: socket.socket, *, udp_addr: tuple[str, int] | None = None,
-                 sysid: int = 255, compid: int = 190, signing_key: bytes | None = None) -> None:
+    def __init__(
+        self,
+        sock: socket.socket,
+        *,
+        udp_addr: tuple[str, int] | None = None,
+        sysid: int = 255,
+        compid: int = 190,
+        signing_key: bytes | None = None,
+    ) -> None:
         self.sock = sock
         self.sock.settimeout(0.05)
         self.udp_addr = udp_addr
@@ -54,7 +62,7 @@ class Client:
         while True:
             try:
                 data = self.sock.recv(65536)
-            except (socket.timeout, BlockingIOError):
+            except (TimeoutError, BlockingIOError):
                 data = None
             if data:
                 for frame in self.parser.feed(data):
@@ -65,8 +73,9 @@ class Client:
             if time.monotonic() >= end:
                 return new
 
-    def wait_for(self, msg_type: str, cond: Callable[[Any], bool] | None = None,
-                 timeout: float = 10.0) -> Any:
+    def wait_for(
+        self, msg_type: str, cond: Callable[[Any], bool] | None = None, timeout: float = 10.0
+    ) -> Any:
         """The next matching message after the last one a wait_for returned (expect-style)."""
         end = time.monotonic() + timeout
         while True:
@@ -79,7 +88,9 @@ class Client:
                 raise AssertionError(f"no {msg_type} within {timeout} s")
             self.pump(0.02)
 
-    def wait_until(self, cond: Callable[[Client], bool], timeout: float = 30.0, what: str = "") -> None:
+    def wait_until(
+        self, cond: Callable[[Client], bool], timeout: float = 30.0, what: str = ""
+    ) -> None:
         end = time.monotonic() + timeout
         while time.monotonic() < end:
             self.pump(0.02)
@@ -88,14 +99,23 @@ class Client:
         raise AssertionError(f"timed out waiting for {what or cond}")
 
     # ---------------------------------------------------------------- helpers
-    def command(self, command: int, *params: float, target: tuple[int, int] = (1, 1),
-                timeout: float = 5.0) -> Any:
+    def command(
+        self, command: int, *params: float, target: tuple[int, int] = (1, 1), timeout: float = 5.0
+    ) -> Any:
         p = [*params, *([0.0] * (7 - len(params)))]
         self.send(M.MAVLink_command_long_message(*target, command, 0, *p))
         return self.wait_for("COMMAND_ACK", lambda m: m.command == command, timeout)
 
-    def command_int(self, command: int, frame: int, x: int, y: int, z: float, *params: float,
-                    timeout: float = 5.0) -> Any:
+    def command_int(
+        self,
+        command: int,
+        frame: int,
+        x: int,
+        y: int,
+        z: float,
+        *params: float,
+        timeout: float = 5.0,
+    ) -> Any:
         p = [*params, *([0.0] * (4 - len(params)))]
         self.send(M.MAVLink_command_int_message(1, 1, frame, command, 0, 0, *p, x, y, z))
         return self.wait_for("COMMAND_ACK", lambda m: m.command == command, timeout)
@@ -117,9 +137,14 @@ class Client:
     def takeoff(self, alt_m: float = 10.0) -> None:
         assert self.set_mode("GUIDED").result == M.MAV_RESULT_ACCEPTED
         assert self.command(M.MAV_CMD_COMPONENT_ARM_DISARM, 1).result == M.MAV_RESULT_ACCEPTED
-        assert self.command(M.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, math.nan, 0, 0, alt_m).result == M.MAV_RESULT_ACCEPTED
-        self.wait_until(lambda c: "GLOBAL_POSITION_INT" in c.latest and c.alt_m() > alt_m - 0.3,
-                        what=f"takeoff to {alt_m} m")
+        assert (
+            self.command(M.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, math.nan, 0, 0, alt_m).result
+            == M.MAV_RESULT_ACCEPTED
+        )
+        self.wait_until(
+            lambda c: "GLOBAL_POSITION_INT" in c.latest and c.alt_m() > alt_m - 0.3,
+            what=f"takeoff to {alt_m} m",
+        )
 
     def statustexts(self) -> list[str]:
         return [m.text for m in self.received if m.get_type() == "STATUSTEXT"]

@@ -21,7 +21,13 @@ def _acks(client: Client, command: int) -> int:
 
 @pytest.mark.parametrize(
     "command",
-    [M.MAV_CMD_COMPONENT_ARM_DISARM, M.MAV_CMD_NAV_TAKEOFF, 31999, M.MAV_CMD_DO_SET_MODE, M.MAV_CMD_REQUEST_MESSAGE],
+    [
+        M.MAV_CMD_COMPONENT_ARM_DISARM,
+        M.MAV_CMD_NAV_TAKEOFF,
+        31999,
+        M.MAV_CMD_DO_SET_MODE,
+        M.MAV_CMD_REQUEST_MESSAGE,
+    ],
 )
 def test_exactly_one_ack_per_command(client: Client, command: int) -> None:
     client.send(M.MAVLink_command_long_message(1, 1, command, 0, 0, 0, 0, 0, 0, 0, 0))
@@ -35,8 +41,16 @@ def test_unknown_command_is_unsupported(client: Client) -> None:
 
 
 def test_commands_for_another_system_are_ignored(client: Client) -> None:
-    client.send(M.MAVLink_command_long_message(42, 1, M.MAV_CMD_COMPONENT_ARM_DISARM, 0, 1, 0, 0, 0, 0, 0, 0))
-    client.send(M.MAVLink_command_long_message(1, 99, M.MAV_CMD_COMPONENT_ARM_DISARM, 0, 1, 0, 0, 0, 0, 0, 0))
+    client.send(
+        M.MAVLink_command_long_message(
+            42, 1, M.MAV_CMD_COMPONENT_ARM_DISARM, 0, 1, 0, 0, 0, 0, 0, 0
+        )
+    )
+    client.send(
+        M.MAVLink_command_long_message(
+            1, 99, M.MAV_CMD_COMPONENT_ARM_DISARM, 0, 1, 0, 0, 0, 0, 0, 0
+        )
+    )
     assert _acks(client, M.MAV_CMD_COMPONENT_ARM_DISARM) == 0
 
 
@@ -70,7 +84,10 @@ def test_set_mode_command_and_message(client: Client) -> None:
         client.wait_for("HEARTBEAT", lambda m, n=number: m.custom_mode == n)
     assert client.command(M.MAV_CMD_DO_SET_MODE, 1, 99).result == M.MAV_RESULT_DENIED
     client.send(M.MAVLink_set_mode_message(1, M.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, 4))
-    assert client.wait_for("COMMAND_ACK", lambda m: m.command == M.MAVLINK_MSG_ID_SET_MODE).result == ACCEPTED
+    assert (
+        client.wait_for("COMMAND_ACK", lambda m: m.command == M.MAVLINK_MSG_ID_SET_MODE).result
+        == ACCEPTED
+    )
     # AUTO without a mission is refused with a reason.
     assert client.set_mode("AUTO").result == M.MAV_RESULT_FAILED
 
@@ -79,8 +96,10 @@ def test_land_and_rtl(client: Client) -> None:
     client.takeoff(8)
     assert client.command(M.MAV_CMD_NAV_LAND).result == ACCEPTED
     client.wait_for("HEARTBEAT", lambda m: m.custom_mode == 9)
-    client.wait_until(lambda c: not c.latest["HEARTBEAT"].base_mode & M.MAV_MODE_FLAG_SAFETY_ARMED,
-                      what="disarm after landing")
+    client.wait_until(
+        lambda c: not c.latest["HEARTBEAT"].base_mode & M.MAV_MODE_FLAG_SAFETY_ARMED,
+        what="disarm after landing",
+    )
     assert client.alt_m() < 0.05
     client.takeoff(6)
     assert client.command(M.MAV_CMD_NAV_RETURN_TO_LAUNCH).result == ACCEPTED
@@ -98,8 +117,11 @@ def test_condition_yaw_absolute_and_relative(client: Client) -> None:
 def test_change_speed_limits_ground_speed(client: Client, vehicle: Sitl) -> None:
     client.takeoff(5)
     assert client.command(M.MAV_CMD_DO_CHANGE_SPEED, 1, 3.0, -1).result == ACCEPTED
-    client.send(M.MAVLink_set_position_target_local_ned_message(
-        0, 1, 1, M.MAV_FRAME_LOCAL_NED, 0b110111111000, 80, 0, -5, 0, 0, 0, 0, 0, 0, 0, 0))  # fmt: skip
+    client.send(
+        M.MAVLink_set_position_target_local_ned_message(
+            0, 1, 1, M.MAV_FRAME_LOCAL_NED, 0b110111111000, 80, 0, -5, 0, 0, 0, 0, 0, 0, 0, 0
+        )
+    )
     client.pump(3.0)
     speeds = [m.groundspeed for m in client.received if m.get_type() == "VFR_HUD"]
     assert max(speeds) == pytest.approx(3.0, abs=0.05)
@@ -111,23 +133,28 @@ def test_reposition_honours_altitude_frame(client: Client, vehicle: Sitl, frame:
     home = vehicle.config.home
     target = GeoPoint(home.lat_deg + 0.0002, home.lon_deg + 0.0001, 0)
     alt = 12.0 if frame == M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT else home.alt_amsl_m + 12.0
-    ack = client.command_int(M.MAV_CMD_DO_REPOSITION, frame, target.lat_e7, target.lon_e7, alt, -1, 0, 0, math.nan)
+    ack = client.command_int(
+        M.MAV_CMD_DO_REPOSITION, frame, target.lat_e7, target.lon_e7, alt, -1, 0, 0, math.nan
+    )
     assert ack.result == ACCEPTED
     client.wait_until(lambda c: abs(c.alt_m() - 12.0) < 0.1, what="12 m")
-    pos = client.wait_for("GLOBAL_POSITION_INT")
-    e, n, _ = enu_from_geo(home, GeoPoint(pos.lat / 1e7, pos.lon / 1e7, 0))
     e_t, n_t, _ = enu_from_geo(home, target)
-    client.wait_until(lambda c: math.hypot(
-        *(a - b for a, b in zip(enu_from_geo(home, GeoPoint(c.latest["GLOBAL_POSITION_INT"].lat / 1e7,
-                                                            c.latest["GLOBAL_POSITION_INT"].lon / 1e7, 0))[:2],
-                                (e_t, n_t)))) < 0.3, what="reach target")  # fmt: skip
+
+    def dist_m(c: Client) -> float:
+        pos = c.latest["GLOBAL_POSITION_INT"]
+        e, n, _ = enu_from_geo(home, GeoPoint(pos.lat / 1e7, pos.lon / 1e7, 0))
+        return math.hypot(e - e_t, n - n_t)
+
+    client.wait_until(lambda c: dist_m(c) < 0.3, what="reach target")
 
 
 def test_reposition_outside_geofence_denied(client: Client, vehicle: Sitl) -> None:
     client.takeoff(5)
     home = vehicle.config.home
     far = GeoPoint(home.lat_deg + 0.01, home.lon_deg, 0)  # ~1.1 km
-    ack = client.command_int(M.MAV_CMD_DO_REPOSITION, M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT, far.lat_e7, far.lon_e7, 10)
+    ack = client.command_int(
+        M.MAV_CMD_DO_REPOSITION, M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT, far.lat_e7, far.lon_e7, 10
+    )
     assert ack.result == M.MAV_RESULT_DENIED
     assert "Fence" in client.wait_for("STATUSTEXT").text
     ack = client.command(M.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, 500)
@@ -139,7 +166,10 @@ def test_get_home_position_and_request_message(client: Client, vehicle: Sitl) ->
     home = client.wait_for("HOME_POSITION")
     assert home.latitude == vehicle.config.home.lat_e7
     assert home.altitude == round(vehicle.config.home.alt_amsl_m * 1000)
-    assert client.command(M.MAV_CMD_REQUEST_MESSAGE, M.MAVLINK_MSG_ID_EXTENDED_SYS_STATE).result == ACCEPTED
+    assert (
+        client.command(M.MAV_CMD_REQUEST_MESSAGE, M.MAVLINK_MSG_ID_EXTENDED_SYS_STATE).result
+        == ACCEPTED
+    )
     assert client.command(M.MAV_CMD_REQUEST_MESSAGE, 9999).result == M.MAV_RESULT_FAILED
 
 
@@ -152,18 +182,40 @@ def test_gimbal_v1_and_v2(client: Client) -> None:
         w, x, y, z = c.latest["GIMBAL_DEVICE_ATTITUDE_STATUS"].q
         return math.degrees(math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
 
-    assert client.command(M.MAV_CMD_DO_MOUNT_CONTROL, -90, 0, 0, 0, 0, 0, M.MAV_MOUNT_MODE_MAVLINK_TARGETING).result == ACCEPTED
+    assert (
+        client.command(
+            M.MAV_CMD_DO_MOUNT_CONTROL, -90, 0, 0, 0, 0, 0, M.MAV_MOUNT_MODE_MAVLINK_TARGETING
+        ).result
+        == ACCEPTED
+    )
     client.wait_until(lambda c: abs(pitch_deg(c) + 90) < 0.5, what="nadir")
-    assert client.command(M.MAV_CMD_DO_GIMBAL_MANAGER_PITCHYAW, -30, 20, math.nan, math.nan, 0, 0, 0).result == ACCEPTED
-    client.wait_until(lambda c: abs(pitch_deg(c) + 30) < 0.5 and abs(yaw_deg(c) - 20) < 0.5, what="-30/20")
+    assert (
+        client.command(
+            M.MAV_CMD_DO_GIMBAL_MANAGER_PITCHYAW, -30, 20, math.nan, math.nan, 0, 0, 0
+        ).result
+        == ACCEPTED
+    )
+    client.wait_until(
+        lambda c: abs(pitch_deg(c) + 30) < 0.5 and abs(yaw_deg(c) - 20) < 0.5, what="-30/20"
+    )
     q = [math.cos(math.radians(-10) / 2), 0.0, math.sin(math.radians(-10) / 2), 0.0]
-    client.send(M.MAVLink_gimbal_manager_set_attitude_message(1, 1, 0, 0, q, math.nan, math.nan, math.nan))
+    client.send(
+        M.MAVLink_gimbal_manager_set_attitude_message(1, 1, 0, 0, q, math.nan, math.nan, math.nan)
+    )
     client.wait_until(lambda c: abs(pitch_deg(c) + 10) < 0.5, what="-10 via SET_ATTITUDE")
     client.wait_for("GIMBAL_MANAGER_STATUS")
-    assert client.command(M.MAV_CMD_REQUEST_MESSAGE, M.MAVLINK_MSG_ID_GIMBAL_MANAGER_INFORMATION).result == ACCEPTED
+    assert (
+        client.command(
+            M.MAV_CMD_REQUEST_MESSAGE, M.MAVLINK_MSG_ID_GIMBAL_MANAGER_INFORMATION
+        ).result
+        == ACCEPTED
+    )
     info = client.wait_for("GIMBAL_MANAGER_INFORMATION")
     assert info.pitch_min == pytest.approx(math.radians(-90))
-    assert client.command(M.MAV_CMD_REQUEST_MESSAGE, M.MAVLINK_MSG_ID_GIMBAL_DEVICE_INFORMATION).result == ACCEPTED
+    assert (
+        client.command(M.MAV_CMD_REQUEST_MESSAGE, M.MAVLINK_MSG_ID_GIMBAL_DEVICE_INFORMATION).result
+        == ACCEPTED
+    )
     assert client.wait_for("GIMBAL_DEVICE_INFORMATION").gimbal_device_id == 1
     # Pitch is clamped to the mount's range.
     client.command(M.MAV_CMD_DO_MOUNT_CONTROL, 45, 0, 0)
@@ -171,7 +223,10 @@ def test_gimbal_v1_and_v2(client: Client) -> None:
 
 
 def test_message_interval_and_legacy_data_stream(client: Client) -> None:
-    assert client.command(M.MAV_CMD_SET_MESSAGE_INTERVAL, M.MAVLINK_MSG_ID_ATTITUDE, 20_000).result == ACCEPTED
+    assert (
+        client.command(M.MAV_CMD_SET_MESSAGE_INTERVAL, M.MAVLINK_MSG_ID_ATTITUDE, 20_000).result
+        == ACCEPTED
+    )
     client.command(M.MAV_CMD_GET_MESSAGE_INTERVAL, M.MAVLINK_MSG_ID_ATTITUDE)
     assert client.wait_for("MESSAGE_INTERVAL").interval_us == 20_000
     client.wait_for("SYSTEM_TIME")
@@ -180,7 +235,10 @@ def test_message_interval_and_legacy_data_stream(client: Client) -> None:
     client.wait_until(lambda c: c.latest["SYSTEM_TIME"].time_boot_ms >= t0 + 5000, what="5 s")
     n = sum(1 for m in client.received if m.get_type() == "ATTITUDE") - n0
     assert 230 <= n <= 270  # 50 Hz for 5 s
-    assert client.command(M.MAV_CMD_SET_MESSAGE_INTERVAL, M.MAVLINK_MSG_ID_ATTITUDE, -1).result == ACCEPTED
+    assert (
+        client.command(M.MAV_CMD_SET_MESSAGE_INTERVAL, M.MAVLINK_MSG_ID_ATTITUDE, -1).result
+        == ACCEPTED
+    )
     client.pump(0.3)
     n1 = sum(1 for m in client.received if m.get_type() == "ATTITUDE")
     client.pump(0.5)

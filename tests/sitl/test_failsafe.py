@@ -26,7 +26,9 @@ def _heartbeat_on_each_vehicle_heartbeat(client: Client, seconds: float) -> None
 
 @pytest.fixture
 def fast_attitude(client: Client) -> Client:
-    client.command(M.MAV_CMD_SET_MESSAGE_INTERVAL, M.MAVLINK_MSG_ID_ATTITUDE, 20_000)  # 50 Hz: 20 ms resolution
+    client.command(
+        M.MAV_CMD_SET_MESSAGE_INTERVAL, M.MAVLINK_MSG_ID_ATTITUDE, 20_000
+    )  # 50 Hz: 20 ms resolution
     return client
 
 
@@ -53,7 +55,9 @@ def test_gcs_failsafe_never_fires_while_disarmed(client: Client) -> None:
     _set(client, "FS_GCS_ENABLE", 1)
     _heartbeat_on_each_vehicle_heartbeat(client, 0.3)
     t0 = client.wait_for("SYSTEM_TIME").time_boot_ms
-    client.wait_until(lambda c: c.latest["SYSTEM_TIME"].time_boot_ms > t0 + 15_000, what="15 s sim without GCS")
+    client.wait_until(
+        lambda c: c.latest["SYSTEM_TIME"].time_boot_ms > t0 + 15_000, what="15 s sim without GCS"
+    )
     assert "GCS Failsafe" not in client.statustexts()
     assert client.latest["HEARTBEAT"].system_status == M.MAV_STATE_STANDBY
 
@@ -67,7 +71,9 @@ def test_gcs_failsafe_disabled_by_default(client: Client) -> None:
 
 
 def test_low_battery_triggers_rtl() -> None:
-    config = SitlConfig(endpoints=("tcpin:127.0.0.1:0",), speedup=40, params=(("BATT_CAPACITY", 120),))
+    config = SitlConfig(
+        endpoints=("tcpin:127.0.0.1:0",), speedup=40, params=(("BATT_CAPACITY", 120),)
+    )
     with Sitl(config) as sitl:
         c = Client.tcp(sitl.ports[0])
         c.takeoff(10)

@@ -7,7 +7,8 @@ import random
 import socket
 
 from tests.sitl.client import Client
-from uavtool.mavlink import mavlink as M, new_encoder
+from uavtool.mavlink import mavlink as M
+from uavtool.mavlink import new_encoder
 from uavtool.sitl import Sitl, SitlConfig
 
 N_FRAMES = 100_000
@@ -23,15 +24,25 @@ def _valid_frames(rng: random.Random, enc: object) -> list[bytes]:
         M.MAVLink_command_long_message(1, 1, M.MAV_CMD_CONDITION_YAW, 0, nan, inf, 0, 0, 0, 0, 0),
         M.MAVLink_command_long_message(1, 1, M.MAV_CMD_DO_CHANGE_SPEED, 0, 1, nan, 0, 0, 0, 0, 0),
         M.MAVLink_command_long_message(1, 1, M.MAV_CMD_REQUEST_MESSAGE, 0, 1e30, 0, 0, 0, 0, 0, 0),
-        M.MAVLink_command_long_message(1, 1, M.MAV_CMD_SET_MESSAGE_INTERVAL, 0, -5, 1e-9, 0, 0, 0, 0, 0),
-        M.MAVLink_command_int_message(1, 1, 200, M.MAV_CMD_DO_REPOSITION, 0, 0, -1, 0, 0, nan, 2**31 - 1, -(2**31), inf),
+        M.MAVLink_command_long_message(
+            1, 1, M.MAV_CMD_SET_MESSAGE_INTERVAL, 0, -5, 1e-9, 0, 0, 0, 0, 0
+        ),
+        M.MAVLink_command_int_message(
+            1, 1, 200, M.MAV_CMD_DO_REPOSITION, 0, 0, -1, 0, 0, nan, 2**31 - 1, -(2**31), inf
+        ),
         M.MAVLink_param_set_message(1, 1, b"WPNAV_SPEED", nan, 9),
         M.MAVLink_param_set_message(1, 1, b"\xff\xfe", 1, 9),
         M.MAVLink_param_request_read_message(1, 1, b"", 30000),
-        M.MAVLink_set_position_target_local_ned_message(0, 1, 1, 1, 0, nan, inf, -inf, 0, 0, 0, 0, 0, 0, nan, 0),
-        M.MAVLink_set_position_target_global_int_message(0, 1, 1, 99, 0, 1, 2, 3, 0, 0, 0, 0, 0, 0, 0, 0),
+        M.MAVLink_set_position_target_local_ned_message(
+            0, 1, 1, 1, 0, nan, inf, -inf, 0, 0, 0, 0, 0, 0, nan, 0
+        ),
+        M.MAVLink_set_position_target_global_int_message(
+            0, 1, 1, 99, 0, 1, 2, 3, 0, 0, 0, 0, 0, 0, 0, 0
+        ),
         M.MAVLink_gimbal_manager_set_attitude_message(1, 1, 0, 0, [inf, nan, 0, 0], 0, 0, 0),
-        M.MAVLink_mission_item_int_message(1, 1, 5, 0, 16, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0),  # no transfer open
+        M.MAVLink_mission_item_int_message(
+            1, 1, 5, 0, 16, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0
+        ),  # no transfer open
         M.MAVLink_mission_request_int_message(1, 1, 65535, 0),
         M.MAVLink_mission_count_message(1, 1, 2, 255),
         M.MAVLink_request_data_stream_message(1, 1, 255, 65535, 1),
@@ -75,7 +86,9 @@ def test_100k_malformed_frames_then_normal_flight() -> None:
             bad_udp.sendto(blob[i : i + 1024], ("127.0.0.1", sitl.ports[1]))
             if i % 65536 == 0:
                 good.pump(0)  # keep our own socket drained while the vehicle works
-        good.wait_until(lambda c: sitl.rx_bytes >= half, timeout=60, what="vehicle to read all the garbage")
+        good.wait_until(
+            lambda c: sitl.rx_bytes >= half, timeout=60, what="vehicle to read all the garbage"
+        )
         # The vehicle kept serving the good client while it chewed through the garbage.
         n_before = sum(1 for m in good.received if m.get_type() == "HEARTBEAT")
         good.pump(1.0)
@@ -86,8 +99,10 @@ def test_100k_malformed_frames_then_normal_flight() -> None:
         # And it flies normally afterwards.
         good.takeoff(10)
         assert good.command(M.MAV_CMD_NAV_LAND).result == M.MAV_RESULT_ACCEPTED
-        good.wait_until(lambda c: not c.latest["HEARTBEAT"].base_mode & M.MAV_MODE_FLAG_SAFETY_ARMED,
-                        what="landed")  # fmt: skip
+        good.wait_until(
+            lambda c: not c.latest["HEARTBEAT"].base_mode & M.MAV_MODE_FLAG_SAFETY_ARMED,
+            what="landed",
+        )
         assert good.alt_m() < 0.05
         good.close()
     assert sitl.error is None

@@ -22,8 +22,26 @@ def _local(c: Client) -> tuple[float, float, float]:
 
 def test_local_ned_position_target_with_yaw(client: Client) -> None:
     client.takeoff(5)
-    client.send(M.MAVLink_set_position_target_local_ned_message(
-        0, 1, 1, M.MAV_FRAME_LOCAL_NED, POS_ONLY, 20, -10, -15, 0, 0, 0, 0, 0, 0, math.radians(270), 0))  # fmt: skip
+    client.send(
+        M.MAVLink_set_position_target_local_ned_message(
+            0,
+            1,
+            1,
+            M.MAV_FRAME_LOCAL_NED,
+            POS_ONLY,
+            20,
+            -10,
+            -15,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            math.radians(270),
+            0,
+        )
+    )
     client.wait_until(lambda c: math.dist(_local(c), (20, -10, -15)) < 0.2, what="reach 20,-10,-15")
     assert client.latest["VFR_HUD"].heading == 270
 
@@ -32,8 +50,11 @@ def test_body_offset_frame_is_relative_to_heading(client: Client) -> None:
     client.takeoff(5)
     client.command(M.MAV_CMD_CONDITION_YAW, 90, 0, 1, 0)
     client.wait_until(lambda c: c.latest["VFR_HUD"].heading == 90, what="face east")
-    client.send(M.MAVLink_set_position_target_local_ned_message(
-        0, 1, 1, M.MAV_FRAME_BODY_OFFSET_NED, POS_NO_YAW, 10, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0))  # fmt: skip
+    client.send(
+        M.MAVLink_set_position_target_local_ned_message(
+            0, 1, 1, M.MAV_FRAME_BODY_OFFSET_NED, POS_NO_YAW, 10, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0
+        )
+    )
     client.wait_until(lambda c: math.dist(_local(c), (0, 10, -5)) < 0.2, what="10 m forward = east")
 
 
@@ -41,24 +62,70 @@ def test_global_int_relative_and_amsl(client: Client, vehicle: Sitl) -> None:
     client.takeoff(5)
     home = vehicle.config.home
     lat, lon = home.lat_e7 + 900, home.lon_e7
-    client.send(M.MAVLink_set_position_target_global_int_message(
-        0, 1, 1, M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT, POS_NO_YAW, lat, lon, 9, 0, 0, 0, 0, 0, 0, 0, 0))  # fmt: skip
-    client.wait_until(lambda c: abs(c.alt_m() - 9) < 0.1 and abs(c.latest["GLOBAL_POSITION_INT"].lat - lat) < 3,
-                      what="relative 9 m")  # fmt: skip
-    client.send(M.MAVLink_set_position_target_global_int_message(
-        0, 1, 1, M.MAV_FRAME_GLOBAL_INT, POS_NO_YAW, lat, lon, home.alt_amsl_m + 14, 0, 0, 0, 0, 0, 0, 0, 0))  # fmt: skip
+    client.send(
+        M.MAVLink_set_position_target_global_int_message(
+            0,
+            1,
+            1,
+            M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
+            POS_NO_YAW,
+            lat,
+            lon,
+            9,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+        )
+    )
+    client.wait_until(
+        lambda c: abs(c.alt_m() - 9) < 0.1 and abs(c.latest["GLOBAL_POSITION_INT"].lat - lat) < 3,
+        what="relative 9 m",
+    )
+    client.send(
+        M.MAVLink_set_position_target_global_int_message(
+            0,
+            1,
+            1,
+            M.MAV_FRAME_GLOBAL_INT,
+            POS_NO_YAW,
+            lat,
+            lon,
+            home.alt_amsl_m + 14,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+        )
+    )
     client.wait_until(lambda c: abs(c.alt_m() - 14) < 0.1, what="AMSL 14 m above home")
 
 
 def test_velocity_target_and_stale_stream_stops(client: Client) -> None:
     client.takeoff(5)
-    client.send(M.MAVLink_set_position_target_local_ned_message(
-        0, 1, 1, M.MAV_FRAME_LOCAL_NED, VEL_ONLY, 0, 0, 0, 2, 0, 0, 0, 0, 0, 0, 0))  # fmt: skip
-    client.wait_until(lambda c: abs(c.latest["LOCAL_POSITION_NED"].vx - 2) < 0.02, what="2 m/s north")
+    client.send(
+        M.MAVLink_set_position_target_local_ned_message(
+            0, 1, 1, M.MAV_FRAME_LOCAL_NED, VEL_ONLY, 0, 0, 0, 2, 0, 0, 0, 0, 0, 0, 0
+        )
+    )
+    client.wait_until(
+        lambda c: abs(c.latest["LOCAL_POSITION_NED"].vx - 2) < 0.02, what="2 m/s north"
+    )
     t0 = client.boot_s()
     # No further updates: after 3 s of sim time the vehicle stops by itself.
-    client.wait_until(lambda c: abs(c.latest["LOCAL_POSITION_NED"].vx) < 0.01 and c.boot_s() > t0 + 3,
-                      timeout=20, what="stop")  # fmt: skip
+    client.wait_until(
+        lambda c: abs(c.latest["LOCAL_POSITION_NED"].vx) < 0.01 and c.boot_s() > t0 + 3,
+        timeout=20,
+        what="stop",
+    )
     stopped_x = client.latest["LOCAL_POSITION_NED"].x
     client.pump(0.5)
     assert client.latest["LOCAL_POSITION_NED"].x == pytest.approx(stopped_x, abs=0.05)
@@ -67,8 +134,11 @@ def test_velocity_target_and_stale_stream_stops(client: Client) -> None:
 def test_targets_ignored_outside_guided(client: Client) -> None:
     client.takeoff(5)
     client.set_mode("LOITER")
-    client.send(M.MAVLink_set_position_target_local_ned_message(
-        0, 1, 1, M.MAV_FRAME_LOCAL_NED, POS_ONLY, 30, 0, -5, 0, 0, 0, 0, 0, 0, 0, 0))  # fmt: skip
+    client.send(
+        M.MAVLink_set_position_target_local_ned_message(
+            0, 1, 1, M.MAV_FRAME_LOCAL_NED, POS_ONLY, 30, 0, -5, 0, 0, 0, 0, 0, 0, 0, 0
+        )
+    )
     client.pump(1.0)
     assert abs(client.latest["LOCAL_POSITION_NED"].x) < 0.1
 
@@ -80,9 +150,14 @@ def test_limits_climb_rate_and_horizontal_accel(client: Client) -> None:
     client.wait_until(lambda c: c.alt_m() > 19.9, what="20 m")
     climb = max(m.climb for m in client.received if m.get_type() == "VFR_HUD")
     assert climb == pytest.approx(2.5, abs=0.05)  # WPNAV_SPEED_UP 250 cm/s
-    client.send(M.MAVLink_set_position_target_local_ned_message(
-        0, 1, 1, M.MAV_FRAME_LOCAL_NED, POS_NO_YAW, 150, 0, -20, 0, 0, 0, 0, 0, 0, 0, 0))  # fmt: skip
-    client.wait_until(lambda c: abs(c.latest["LOCAL_POSITION_NED"].x - 150) < 0.2, timeout=40, what="150 m north")
+    client.send(
+        M.MAVLink_set_position_target_local_ned_message(
+            0, 1, 1, M.MAV_FRAME_LOCAL_NED, POS_NO_YAW, 150, 0, -20, 0, 0, 0, 0, 0, 0, 0, 0
+        )
+    )
+    client.wait_until(
+        lambda c: abs(c.latest["LOCAL_POSITION_NED"].x - 150) < 0.2, timeout=40, what="150 m north"
+    )
     speeds = [m.vx for m in client.received if m.get_type() == "LOCAL_POSITION_NED"]
     assert max(speeds) == pytest.approx(10.0, abs=0.05)  # WPNAV_SPEED 1000 cm/s
     pitches = [math.degrees(m.pitch) for m in client.received if m.get_type() == "ATTITUDE"]

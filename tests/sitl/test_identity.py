@@ -24,7 +24,9 @@ def test_heartbeat_is_1hz_in_sim_time(client: Client) -> None:
     client.wait_for("SYSTEM_TIME")
     start = client.latest["SYSTEM_TIME"].time_boot_ms
     n0 = sum(1 for m in client.received if m.get_type() == "HEARTBEAT")
-    client.wait_until(lambda c: c.latest["SYSTEM_TIME"].time_boot_ms >= start + 10_000, what="10 s of sim time")
+    client.wait_until(
+        lambda c: c.latest["SYSTEM_TIME"].time_boot_ms >= start + 10_000, what="10 s of sim time"
+    )
     n = sum(1 for m in client.received if m.get_type() == "HEARTBEAT") - n0
     assert 9 <= n <= 11
 
@@ -60,7 +62,9 @@ def test_autopilot_version_capabilities_and_stable_uid(client: Client, vehicle: 
 
 
 def test_instance_offsets_sysid_and_ports() -> None:
-    config = SitlConfig(endpoints=("tcpin:127.0.0.1:0", "udpin:127.0.0.1:0"), instance=2, speedup=20)
+    config = SitlConfig(
+        endpoints=("tcpin:127.0.0.1:0", "udpin:127.0.0.1:0"), instance=2, speedup=20
+    )
     with Sitl(config) as sitl:
         c = Client.tcp(sitl.ports[0])
         hb = c.wait_for("HEARTBEAT")

@@ -39,34 +39,44 @@ def test_udpout_sends_to_a_listening_ground_station() -> None:
 
 
 def test_two_vehicles_side_by_side() -> None:
-    with Sitl(SitlConfig(endpoints=("tcpin:127.0.0.1:0",), speedup=20)) as a, Sitl(
-        SitlConfig(endpoints=("tcpin:127.0.0.1:0",), speedup=20, instance=1)
-    ) as b:
+    with (
+        Sitl(SitlConfig(endpoints=("tcpin:127.0.0.1:0",), speedup=20)) as a,
+        Sitl(SitlConfig(endpoints=("tcpin:127.0.0.1:0",), speedup=20, instance=1)) as b,
+    ):
         ca, cb = Client.tcp(a.ports[0]), Client.tcp(b.ports[0])
         assert ca.wait_for("HEARTBEAT").get_srcSystem() == 1
         assert cb.wait_for("HEARTBEAT").get_srcSystem() == 2
-        assert cb.command(M.MAV_CMD_COMPONENT_ARM_DISARM, 1, target=(2, 1)).result == M.MAV_RESULT_ACCEPTED
+        assert (
+            cb.command(M.MAV_CMD_COMPONENT_ARM_DISARM, 1, target=(2, 1)).result
+            == M.MAV_RESULT_ACCEPTED
+        )
         ca.close()
         cb.close()
 
 
-@pytest.mark.parametrize("text", ["tcpin:127.0.0.1", "serial:/dev/ttyUSB0:57600", "udpin:127.0.0.1:99999", "tcp::5"])
+@pytest.mark.parametrize(
+    "text", ["tcpin:127.0.0.1", "serial:/dev/ttyUSB0:57600", "udpin:127.0.0.1:99999", "tcp::5"]
+)
 def test_bad_endpoint_strings(text: str) -> None:
     with pytest.raises(LinkError, match="endpoint"):
         parse_endpoint(text)
 
 
 def test_port_in_use_is_a_clear_error() -> None:
-    with Sitl(SitlConfig(endpoints=("tcpin:127.0.0.1:0",))) as a:
-        with pytest.raises(LinkError, match="cannot listen"):
-            Sitl(SitlConfig(endpoints=(f"tcpin:127.0.0.1:{a.ports[0]}",)))
+    with (
+        Sitl(SitlConfig(endpoints=("tcpin:127.0.0.1:0",))) as a,
+        pytest.raises(LinkError, match="cannot listen"),
+    ):
+        Sitl(SitlConfig(endpoints=(f"tcpin:127.0.0.1:{a.ports[0]}",)))
 
 
 def test_signing_refuses_unsigned_commands() -> None:
     with Sitl(SitlConfig(endpoints=("tcpin:127.0.0.1:0",), speedup=20, signing_key=KEY)) as sitl:
         unsigned = Client.tcp(sitl.ports[0])
         hb = unsigned.wait_for("HEARTBEAT")
-        assert unsigned.frames[-1].raw[2] & M.MAVLINK_IFLAG_SIGNED  # the vehicle signs what it sends
+        assert (
+            unsigned.frames[-1].raw[2] & M.MAVLINK_IFLAG_SIGNED
+        )  # the vehicle signs what it sends
         assert hb is not None
         unsigned.send(M.MAVLink_command_long_message(1, 1, 400, 0, 1, 0, 0, 0, 0, 0, 0))
         unsigned.pump(0.3)
@@ -97,12 +107,19 @@ def _flight(speedup: float) -> list[tuple[float, ...]]:
         1.5: M.MAVLink_command_long_message(1, 1, 400, 0, 1, 0, 0, 0, 0, 0, 0),
         2.0: M.MAVLink_command_long_message(1, 1, 22, 0, 0, 0, 0, 0, 0, 0, 15),
         12.0: M.MAVLink_set_position_target_local_ned_message(
-            0, 1, 1, 1, 0b110111111000, 40, 25, -20, 0, 0, 0, 0, 0, 0, 0, 0),  # fmt: skip
+            0, 1, 1, 1, 0b110111111000, 40, 25, -20, 0, 0, 0, 0, 0, 0, 0, 0
+        ),
         20.0: M.MAVLink_command_long_message(1, 1, 115, 0, 120, 30, 1, 0, 0, 0, 0),
         30.0: M.MAVLink_command_long_message(1, 1, 20, 0, 0, 0, 0, 0, 0, 0, 0),
     }
-    config = SitlConfig(endpoints=("tcpin:127.0.0.1:0",), speedup=speedup, wind_speed_ms=6, wind_dir_deg=200,
-                        seed=7, params=(("SIM_WIND_TURB", 1.5),))  # fmt: skip
+    config = SitlConfig(
+        endpoints=("tcpin:127.0.0.1:0",),
+        speedup=speedup,
+        wind_speed_ms=6,
+        wind_dir_deg=200,
+        seed=7,
+        params=(("SIM_WIND_TURB", 1.5),),
+    )
     sitl = Sitl(config)
     # A loopback peer that the vehicle serves like any other; we drive the clock ourselves.
     peer = socket.create_connection(("127.0.0.1", sitl.ports[0]))

@@ -35,8 +35,13 @@ def _until(check: Callable[[], Any], what: str, timeout: float = 20.0) -> Any:
 @pytest.fixture
 def drone() -> Iterator[tuple[Sitl, Any]]:
     with Sitl(SitlConfig(endpoints=("tcpin:127.0.0.1:0",), speedup=10)) as sitl:
-        sdk = mavsdk.Mavsdk(mavsdk.Configuration.create_with_component_type(mavsdk.ComponentType.GROUND_STATION))
-        assert sdk.add_any_connection(f"tcpout://127.0.0.1:{sitl.ports[0]}") == mavsdk.ConnectionResult.SUCCESS
+        sdk = mavsdk.Mavsdk(
+            mavsdk.Configuration.create_with_component_type(mavsdk.ComponentType.GROUND_STATION)
+        )
+        assert (
+            sdk.add_any_connection(f"tcpout://127.0.0.1:{sitl.ports[0]}")
+            == mavsdk.ConnectionResult.SUCCESS
+        )
         system = sdk.first_autopilot(10.0)
         assert system is not None, "MAVSDK did not discover an autopilot"
         try:
@@ -49,7 +54,12 @@ def test_discovery_health_params_and_flight(drone: tuple[Sitl, Any]) -> None:
     sitl, system = drone
     telemetry, action, param = Telemetry(system), Action(system), Param(system)
     health = _until(
-        lambda: (h := telemetry.health()).is_global_position_ok and h.is_home_position_ok and h.is_armable and h,
+        lambda: (
+            (h := telemetry.health()).is_global_position_ok
+            and h.is_home_position_ok
+            and h.is_armable
+            and h
+        ),
         "healthy",
     )
     assert health.is_gyrometer_calibration_ok and health.is_local_position_ok
@@ -67,8 +77,13 @@ def test_discovery_health_params_and_flight(drone: tuple[Sitl, Any]) -> None:
     home = sitl.config.home
     target = geo_from_enu(home, 15.0, 20.0, 12.0)
     action.goto_location(target.lat_deg, target.lon_deg, target.alt_amsl_m, math.nan)
-    _until(lambda: abs(telemetry.position().latitude_deg - target.lat_deg) < 2e-6
-           and abs(telemetry.position().longitude_deg - target.lon_deg) < 2e-6, "goto")  # fmt: skip
+    _until(
+        lambda: (
+            abs(telemetry.position().latitude_deg - target.lat_deg) < 2e-6
+            and abs(telemetry.position().longitude_deg - target.lon_deg) < 2e-6
+        ),
+        "goto",
+    )
     assert telemetry.position().relative_altitude_m == pytest.approx(12.0, abs=0.1)
 
     # Yaw the way MAVSDK does it on ArduPilot: an offboard (GUIDED) position target with yaw.
@@ -89,13 +104,54 @@ def test_mission_round_trip_via_mission_raw(drone: tuple[Sitl, Any]) -> None:
     rel = M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
     # With ArduPilot, item 0 is home: a MissionRaw user sends a placeholder there.
     items = [
-        MissionItem(0, M.MAV_FRAME_GLOBAL_INT, M.MAV_CMD_NAV_WAYPOINT, 0, 1, 0, 0, 0, 0, home.lat_e7, home.lon_e7,
-                    home.alt_amsl_m, 0),
+        MissionItem(
+            0,
+            M.MAV_FRAME_GLOBAL_INT,
+            M.MAV_CMD_NAV_WAYPOINT,
+            0,
+            1,
+            0,
+            0,
+            0,
+            0,
+            home.lat_e7,
+            home.lon_e7,
+            home.alt_amsl_m,
+            0,
+        ),
         MissionItem(1, rel, M.MAV_CMD_NAV_TAKEOFF, 1, 1, 0, 0, 0, 0, 0, 0, 10.0, 0),
-        MissionItem(2, rel, M.MAV_CMD_NAV_WAYPOINT, 0, 1, 0, 0, 0, 0, home.lat_e7 + 1000, home.lon_e7, 15.0, 0),
-        MissionItem(3, rel, M.MAV_CMD_NAV_WAYPOINT, 0, 1, 2, 0, 0, 0, home.lat_e7, home.lon_e7 + 1000, 15.0, 0),
+        MissionItem(
+            2,
+            rel,
+            M.MAV_CMD_NAV_WAYPOINT,
+            0,
+            1,
+            0,
+            0,
+            0,
+            0,
+            home.lat_e7 + 1000,
+            home.lon_e7,
+            15.0,
+            0,
+        ),
+        MissionItem(
+            3,
+            rel,
+            M.MAV_CMD_NAV_WAYPOINT,
+            0,
+            1,
+            2,
+            0,
+            0,
+            0,
+            home.lat_e7,
+            home.lon_e7 + 1000,
+            15.0,
+            0,
+        ),
         MissionItem(4, rel, M.MAV_CMD_NAV_LAND, 0, 1, 0, 0, 0, 0, 0, 0, 0.0, 0),
-    ]  # fmt: skip
+    ]
     mission = MissionRaw(system)
     mission.upload_mission(items)
     got = mission.download_mission()

@@ -15,13 +15,43 @@ def _items(vehicle: Sitl) -> list[tuple[int, int, float, float, float, float, in
     home = vehicle.config.home
     lat, lon = home.lat_e7, home.lon_e7
     return [
-        (M.MAV_CMD_NAV_WAYPOINT, M.MAV_FRAME_GLOBAL_INT, 0, 0, 0, 0, lat, lon, home.alt_amsl_m),  # home
+        (
+            M.MAV_CMD_NAV_WAYPOINT,
+            M.MAV_FRAME_GLOBAL_INT,
+            0,
+            0,
+            0,
+            0,
+            lat,
+            lon,
+            home.alt_amsl_m,
+        ),  # home
         (M.MAV_CMD_NAV_TAKEOFF, REL, 0, 0, 0, 0, 0, 0, 10),
         (M.MAV_CMD_DO_CHANGE_SPEED, M.MAV_FRAME_MISSION, 1, 5, -1, 0, 0, 0, 0),
         (M.MAV_CMD_NAV_WAYPOINT, REL, 0, 0, 0, 0, lat + 2000, lon, 12),
         (M.MAV_CMD_CONDITION_YAW, M.MAV_FRAME_MISSION, 90, 60, 1, 0, 0, 0, 0),
-        (M.MAV_CMD_DO_MOUNT_CONTROL, M.MAV_FRAME_MISSION, -90, 0, 0, 0, 0, 0, M.MAV_MOUNT_MODE_MAVLINK_TARGETING),
-        (M.MAV_CMD_DO_GIMBAL_MANAGER_PITCHYAW, M.MAV_FRAME_MISSION, -45, 0, math.nan, math.nan, 0, 0, 0),
+        (
+            M.MAV_CMD_DO_MOUNT_CONTROL,
+            M.MAV_FRAME_MISSION,
+            -90,
+            0,
+            0,
+            0,
+            0,
+            0,
+            M.MAV_MOUNT_MODE_MAVLINK_TARGETING,
+        ),
+        (
+            M.MAV_CMD_DO_GIMBAL_MANAGER_PITCHYAW,
+            M.MAV_FRAME_MISSION,
+            -45,
+            0,
+            math.nan,
+            math.nan,
+            0,
+            0,
+            0,
+        ),
         (M.MAV_CMD_NAV_WAYPOINT, REL, 1, 0, 0, 0, lat + 2000, lon + 2000, 12),
         (M.MAV_CMD_NAV_LAND, REL, 0, 0, 0, 0, 0, 0, 0),
     ]
@@ -32,7 +62,9 @@ def _upload(client: Client, items: list, *, duplicate: bool = False) -> int:
     while True:
         msg = client.wait_for("MISSION_REQUEST_INT", timeout=5) if True else None
         cmd, frame, p1, p2, p3, p4, x, y, z = items[msg.seq]
-        item = M.MAVLink_mission_item_int_message(1, 1, msg.seq, frame, cmd, 0, 1, p1, p2, p3, p4, x, y, z, 0)
+        item = M.MAVLink_mission_item_int_message(
+            1, 1, msg.seq, frame, cmd, 0, 1, p1, p2, p3, p4, x, y, z, 0
+        )
         client.send(item)
         if duplicate:
             client.send(item)
@@ -57,9 +89,17 @@ def test_upload_download_round_trip_with_home_at_zero(client: Client, vehicle: S
     got = _download(client)
     assert len(got) == len(items)
     assert got[0].x == vehicle.config.home.lat_e7
-    for item, msg in zip(items[1:], got[1:]):
+    for item, msg in zip(items[1:], got[1:], strict=True):
         cmd, frame, p1, p2, _p3, _p4, x, y, z = item
-        assert (msg.command, msg.frame, msg.param1, msg.param2, msg.x, msg.y, msg.z) == (cmd, frame, p1, p2, x, y, z)
+        assert (msg.command, msg.frame, msg.param1, msg.param2, msg.x, msg.y, msg.z) == (
+            cmd,
+            frame,
+            p1,
+            p2,
+            x,
+            y,
+            z,
+        )
 
 
 def test_duplicated_items_are_tolerated(client: Client, vehicle: Sitl) -> None:
@@ -93,7 +133,10 @@ def test_fence_and_rally_are_refused(client: Client) -> None:
 
 
 def test_unsupported_item_command_is_refused(client: Client, vehicle: Sitl) -> None:
-    items = _items(vehicle)[:2] + [(M.MAV_CMD_DO_SET_SERVO, M.MAV_FRAME_MISSION, 0, 0, 0, 0, 0, 0, 0)]
+    items = [
+        *_items(vehicle)[:2],
+        (M.MAV_CMD_DO_SET_SERVO, M.MAV_FRAME_MISSION, 0, 0, 0, 0, 0, 0, 0),
+    ]
     assert _upload(client, items) == M.MAV_MISSION_UNSUPPORTED
 
 
@@ -104,7 +147,9 @@ def test_auto_flight_reports_progress_and_lands(client: Client, vehicle: Sitl) -
     assert client.command(M.MAV_CMD_MISSION_START, 0, 0).result == M.MAV_RESULT_ACCEPTED
     client.wait_for("HEARTBEAT", lambda m: m.custom_mode == 3)
     client.wait_until(
-        lambda c: not c.latest["HEARTBEAT"].base_mode & M.MAV_MODE_FLAG_SAFETY_ARMED, timeout=60, what="mission end"
+        lambda c: not c.latest["HEARTBEAT"].base_mode & M.MAV_MODE_FLAG_SAFETY_ARMED,
+        timeout=60,
+        what="mission end",
     )
     reached = [m.seq for m in client.received if m.get_type() == "MISSION_ITEM_REACHED"]
     assert reached == list(range(1, 9))

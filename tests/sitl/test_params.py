@@ -12,14 +12,29 @@ from uavtool.mavlink import mavlink as M
 from uavtool.sitl import Sitl, SitlConfig
 from uavtool.sitl.params import PARAM_SPECS, load_param_file
 
-ARDUCOPTER_NAMES = ("SYSID_THISMAV", "SYSID_MYGCS", "FS_GCS_ENABLE", "FS_GCS_TIMEOUT", "ARMING_CHECK", "RTL_ALT",
-                    "WPNAV_SPEED", "WPNAV_ACCEL", "PILOT_SPEED_UP", "SIM_SPEEDUP", "SIM_WIND_SPD", "SIM_WIND_DIR")  # fmt: skip
+ARDUCOPTER_NAMES = (
+    "SYSID_THISMAV",
+    "SYSID_MYGCS",
+    "FS_GCS_ENABLE",
+    "FS_GCS_TIMEOUT",
+    "ARMING_CHECK",
+    "RTL_ALT",
+    "WPNAV_SPEED",
+    "WPNAV_ACCEL",
+    "PILOT_SPEED_UP",
+    "SIM_SPEEDUP",
+    "SIM_WIND_SPD",
+    "SIM_WIND_DIR",
+)
 
 
 def test_request_list_sends_every_parameter_with_index_and_count(client: Client) -> None:
     client.send(M.MAVLink_param_request_list_message(1, 1))
-    client.wait_until(lambda c: sum(m.get_type() == "PARAM_VALUE" for m in c.received) >= len(PARAM_SPECS),
-                      timeout=10, what="all params")  # fmt: skip
+    client.wait_until(
+        lambda c: sum(m.get_type() == "PARAM_VALUE" for m in c.received) >= len(PARAM_SPECS),
+        timeout=10,
+        what="all params",
+    )
     values = [m for m in client.received if m.get_type() == "PARAM_VALUE"]
     assert {v.param_count for v in values} == {len(PARAM_SPECS)}
     assert sorted(v.param_index for v in values) == list(range(len(PARAM_SPECS)))
@@ -44,7 +59,9 @@ def test_read_by_name_and_index(client: Client) -> None:
         ("FS_GCS_TIMEOUT", 2.5, M.MAV_PARAM_TYPE_REAL32, 2.5),
     ],
 )
-def test_set_echoes_type_and_stored_value(client: Client, name: str, sent: float, mav_type: int, expected: float) -> None:
+def test_set_echoes_type_and_stored_value(
+    client: Client, name: str, sent: float, mav_type: int, expected: float
+) -> None:
     client.send(M.MAVLink_param_set_message(1, 1, name.encode(), sent, mav_type))
     echo = client.wait_for("PARAM_VALUE", lambda m: m.param_id == name)
     assert echo.param_type == mav_type
@@ -63,10 +80,15 @@ def test_wpnav_speed_changes_flight_speed(client: Client) -> None:
     client.send(M.MAVLink_param_set_message(1, 1, b"WPNAV_SPEED", 400, M.MAV_PARAM_TYPE_REAL32))
     client.wait_for("PARAM_VALUE")
     client.takeoff(5)
-    client.send(M.MAVLink_set_position_target_local_ned_message(
-        0, 1, 1, M.MAV_FRAME_LOCAL_NED, 0b110111111000, 60, 0, -5, 0, 0, 0, 0, 0, 0, 0, 0))  # fmt: skip
+    client.send(
+        M.MAVLink_set_position_target_local_ned_message(
+            0, 1, 1, M.MAV_FRAME_LOCAL_NED, 0b110111111000, 60, 0, -5, 0, 0, 0, 0, 0, 0, 0, 0
+        )
+    )
     client.pump(4)
-    assert max(m.groundspeed for m in client.received if m.get_type() == "VFR_HUD") == pytest.approx(4.0, abs=0.05)
+    assert max(
+        m.groundspeed for m in client.received if m.get_type() == "VFR_HUD"
+    ) == pytest.approx(4.0, abs=0.05)
 
 
 def test_ftp_is_nakked_at_once(client: Client) -> None:
@@ -86,7 +108,9 @@ def test_param_file_loaded_at_start(tmp_path: Path) -> None:
     f = tmp_path / "copter.parm"
     f.write_text("# saved by MAVProxy\nRTL_ALT 3000\nWPNAV_SPEED,800\n\nFS_GCS_ENABLE 1  # rtl\n")
     params = load_param_file(f)
-    with Sitl(SitlConfig(endpoints=("tcpin:127.0.0.1:0",), speedup=20, params=tuple(params.items()))) as sitl:
+    with Sitl(
+        SitlConfig(endpoints=("tcpin:127.0.0.1:0",), speedup=20, params=tuple(params.items()))
+    ) as sitl:
         c = Client.tcp(sitl.ports[0])
         c.send(M.MAVLink_param_request_read_message(1, 1, b"RTL_ALT", -1))
         assert c.wait_for("PARAM_VALUE").param_value == 3000
@@ -95,7 +119,10 @@ def test_param_file_loaded_at_start(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize(
     ("text", "message"),
-    [("RTL_ALT\n", "copter.parm:1: expected 'NAME VALUE'"), ("\nBOGUS 1\n", "copter.parm:2: unknown parameter 'BOGUS'")],
+    [
+        ("RTL_ALT\n", "copter.parm:1: expected 'NAME VALUE'"),
+        ("\nBOGUS 1\n", "copter.parm:2: unknown parameter 'BOGUS'"),
+    ],
 )
 def test_bad_param_file_names_file_and_line(tmp_path: Path, text: str, message: str) -> None:
     f = tmp_path / "copter.parm"

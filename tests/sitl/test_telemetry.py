@@ -5,9 +5,21 @@ from __future__ import annotations
 from tests.sitl.client import Client
 from uavtool.mavlink import mavlink as M
 
-STREAMED = ("GLOBAL_POSITION_INT", "LOCAL_POSITION_NED", "ATTITUDE", "VFR_HUD", "SYS_STATUS", "GPS_RAW_INT",
-            "BATTERY_STATUS", "HOME_POSITION", "EXTENDED_SYS_STATE", "SYSTEM_TIME", "GIMBAL_DEVICE_ATTITUDE_STATUS",
-            "GIMBAL_MANAGER_STATUS", "MISSION_CURRENT")  # fmt: skip
+STREAMED = (
+    "GLOBAL_POSITION_INT",
+    "LOCAL_POSITION_NED",
+    "ATTITUDE",
+    "VFR_HUD",
+    "SYS_STATUS",
+    "GPS_RAW_INT",
+    "BATTERY_STATUS",
+    "HOME_POSITION",
+    "EXTENDED_SYS_STATE",
+    "SYSTEM_TIME",
+    "GIMBAL_DEVICE_ATTITUDE_STATUS",
+    "GIMBAL_MANAGER_STATUS",
+    "MISSION_CURRENT",
+)
 
 
 def test_default_streams(client: Client) -> None:
@@ -17,8 +29,14 @@ def test_default_streams(client: Client) -> None:
 
 def test_sys_status_reports_healthy_and_armable(client: Client) -> None:
     s = client.wait_for("SYS_STATUS")
-    for bit in (M.MAV_SYS_STATUS_SENSOR_GPS, M.MAV_SYS_STATUS_PREARM_CHECK, M.MAV_SYS_STATUS_AHRS,
-                M.MAV_SYS_STATUS_SENSOR_3D_GYRO, M.MAV_SYS_STATUS_SENSOR_3D_ACCEL, M.MAV_SYS_STATUS_SENSOR_3D_MAG):  # fmt: skip
+    for bit in (
+        M.MAV_SYS_STATUS_SENSOR_GPS,
+        M.MAV_SYS_STATUS_PREARM_CHECK,
+        M.MAV_SYS_STATUS_AHRS,
+        M.MAV_SYS_STATUS_SENSOR_3D_GYRO,
+        M.MAV_SYS_STATUS_SENSOR_3D_ACCEL,
+        M.MAV_SYS_STATUS_SENSOR_3D_MAG,
+    ):
         assert s.onboard_control_sensors_present & bit
         assert s.onboard_control_sensors_enabled & bit
         assert s.onboard_control_sensors_health & bit
@@ -34,12 +52,20 @@ def test_landed_state_and_battery_drain(client: Client) -> None:
     client.command(M.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, 30)
     assert client.wait_for("EXTENDED_SYS_STATE").landed_state == M.MAV_LANDED_STATE_TAKEOFF
     client.wait_until(lambda c: c.alt_m() > 29.9, what="30 m")
-    client.wait_for("EXTENDED_SYS_STATE", lambda m: m.landed_state == M.MAV_LANDED_STATE_IN_AIR, timeout=3)
+    client.wait_for(
+        "EXTENDED_SYS_STATE", lambda m: m.landed_state == M.MAV_LANDED_STATE_IN_AIR, timeout=3
+    )
     client.command(M.MAV_CMD_NAV_LAND)
-    client.wait_for("EXTENDED_SYS_STATE", lambda m: m.landed_state == M.MAV_LANDED_STATE_LANDING, timeout=3)
+    client.wait_for(
+        "EXTENDED_SYS_STATE", lambda m: m.landed_state == M.MAV_LANDED_STATE_LANDING, timeout=3
+    )
     states = [m.landed_state for m in client.received if m.get_type() == "EXTENDED_SYS_STATE"]
     order = [s for i, s in enumerate(states) if i == 0 or s != states[i - 1]]
-    assert order == [M.MAV_LANDED_STATE_ON_GROUND, M.MAV_LANDED_STATE_TAKEOFF, M.MAV_LANDED_STATE_IN_AIR,
-                     M.MAV_LANDED_STATE_LANDING]  # fmt: skip
+    assert order == [
+        M.MAV_LANDED_STATE_ON_GROUND,
+        M.MAV_LANDED_STATE_TAKEOFF,
+        M.MAV_LANDED_STATE_IN_AIR,
+        M.MAV_LANDED_STATE_LANDING,
+    ]
     used = [m.current_consumed for m in client.received if m.get_type() == "BATTERY_STATUS"]
     assert used[-1] > used[0]

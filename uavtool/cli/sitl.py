@@ -20,22 +20,40 @@ def _pair(text: str, what: str) -> tuple[float, float]:
 
 @click.command()
 @click.option(
-    "--endpoint", "endpoints", multiple=True, metavar="KIND:HOST:PORT",
+    "--endpoint",
+    "endpoints",
+    multiple=True,
+    metavar="KIND:HOST:PORT",
     help="Where to serve MAVLink (repeatable): tcpin:, udpin:, udpout:, tcp:. "
     "Default: tcpin:127.0.0.1:5760 and udpout:127.0.0.1:14550.",
-)  # fmt: skip
+)
 @click.option("--home", default=None, metavar="LAT,LON,ALT,HDG", help="Home position and heading.")
-@click.option("--speedup", default=1.0, show_default=True, type=float, help="Sim time runs N× wall time.")
-@click.option("--sysid", default=1, show_default=True, type=int, help="MAVLink system id.")
-@click.option("--instance", default=0, show_default=True, type=int, help="Vehicle N: ports +10·N, sysid +N.")
-@click.option("--wind", default=None, metavar="SPEED,DIR", help="Wind in m/s, blowing from DIR degrees.")
-@click.option("--seed", default=0, show_default=True, type=int, help="Seed for wind gusts and sensor noise.")
-@click.option("--signing-key", default=None, metavar="HEX", help="MAVLink 2 signing key (64 hex digits).")
 @click.option(
-    "--params", "params_file", default=None, type=click.Path(path_type=Path),
+    "--speedup", default=1.0, show_default=True, type=float, help="Sim time runs N× wall time."
+)
+@click.option("--sysid", default=1, show_default=True, type=int, help="MAVLink system id.")
+@click.option(
+    "--instance", default=0, show_default=True, type=int, help="Vehicle N: ports +10·N, sysid +N."
+)
+@click.option(
+    "--wind", default=None, metavar="SPEED,DIR", help="Wind in m/s, blowing from DIR degrees."
+)
+@click.option(
+    "--seed", default=0, show_default=True, type=int, help="Seed for wind gusts and sensor noise."
+)
+@click.option(
+    "--signing-key", default=None, metavar="HEX", help="MAVLink 2 signing key (64 hex digits)."
+)
+@click.option(
+    "--params",
+    "params_file",
+    default=None,
+    type=click.Path(path_type=Path),
     help="Parameter file (NAME VALUE per line, as MAVProxy saves).",
-)  # fmt: skip
-@click.option("--duration", default=None, type=float, help="Stop after this many simulated seconds.")
+)
+@click.option(
+    "--duration", default=None, type=float, help="Stop after this many simulated seconds."
+)
 def sitl(
     endpoints: tuple[str, ...],
     home: str | None,
@@ -71,9 +89,13 @@ def sitl(
     if params_file is not None:
         kwargs["params"] = tuple(load_param_file(params_file).items())
     config = SitlConfig(
-        endpoints=endpoints or DEFAULT_ENDPOINTS, speedup=speedup, sysid=sysid, instance=instance, seed=seed,
+        endpoints=endpoints or DEFAULT_ENDPOINTS,
+        speedup=speedup,
+        sysid=sysid,
+        instance=instance,
+        seed=seed,
         **kwargs,  # type: ignore[arg-type]
-    )  # fmt: skip
+    )
     vehicle = Sitl(config)
     click.echo(f"uavtool sitl: vehicle sysid {vehicle.sysid}, speedup {vehicle.speedup:g}x")
     for ep in vehicle.describe_endpoints():

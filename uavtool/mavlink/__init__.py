@@ -4,7 +4,7 @@ The dialect is chosen explicitly by importing pymavlink's generated module; noth
 touches environment variables or pymavlink's ``mavutil`` globals.
 """
 
-from uavtool.mavlink.framing import Frame, FrameParser, new_encoder
 from uavtool.mavlink.dialect import DIALECT, mavlink
+from uavtool.mavlink.framing import Frame, FrameParser, new_encoder
 
 __all__ = ["DIALECT", "Frame", "FrameParser", "mavlink", "new_encoder"]

@@ -59,7 +59,7 @@ class FrameParser:
         n = len(buf)
         while pos < n:
             stx = buf[pos]
-            if stx != _STX_V2 and stx != _STX_V1:
+            if stx not in (_STX_V2, _STX_V1):
                 nxt = _next_stx(buf, pos + 1)
                 self.bytes_dropped += nxt - pos
                 pos = nxt
@@ -110,7 +110,9 @@ def _next_stx(buf: bytearray, start: int) -> int:
     return a if b < 0 else min(a, b)
 
 
-def new_encoder(*, sysid: int, compid: int, signing_key: bytes | None = None, link_id: int = 0) -> Any:
+def new_encoder(
+    *, sysid: int, compid: int, signing_key: bytes | None = None, link_id: int = 0
+) -> Any:
     """A pymavlink ``MAVLink`` object that packs messages from ``sysid``/``compid``.
 
     With ``signing_key`` every packed frame is signed; the signing timestamp starts at the

@@ -63,7 +63,7 @@ class AutoMission:
     def starts_with_takeoff(self) -> bool:
         for it in self.items[1:]:
             if it.command in NAV_COMMANDS:
-                return it.command == mavlink.MAV_CMD_NAV_TAKEOFF
+                return bool(it.command == mavlink.MAV_CMD_NAV_TAKEOFF)
         return False
 
     def landing(self) -> bool:
@@ -182,7 +182,10 @@ class AutoMission:
             return ap.now_ns >= self._hold_until_ns
         if cmd == mavlink.MAV_CMD_NAV_LAND:
             land_n, land_e = ap.land_ne
-            if not self._landing and math.hypot(land_n - s.pos_ned_m[0], land_e - s.pos_ned_m[1]) < 0.5:
+            if (
+                not self._landing
+                and math.hypot(land_n - s.pos_ned_m[0], land_e - s.pos_ned_m[1]) < 0.5
+            ):
                 self._landing = True
             if self._landing:
                 ap.descend()

@@ -15,7 +15,7 @@ from uavtool.geo import GeoPoint, enu_from_geo, geo_from_enu
 from uavtool.mavlink.dialect import mavlink
 from uavtool.sitl.auto import AutoMission
 from uavtool.sitl.params import ParamStore
-from uavtool.sitl.physics import Multicopter, Target, wrap_180
+from uavtool.sitl.physics import Multicopter, State, Target, wrap_180
 from uavtool.sitl.state import (
     ACCEPTED,
     ARMABLE_MODES,
@@ -34,7 +34,9 @@ _SEV = mavlink  # severities: MAV_SEVERITY_*
 class Autopilot:
     """An ArduCopter-like autopilot around a :class:`Multicopter`."""
 
-    def __init__(self, *, home: GeoPoint, home_heading_deg: float, params: ParamStore, seed: int) -> None:
+    def __init__(
+        self, *, home: GeoPoint, home_heading_deg: float, params: ParamStore, seed: int
+    ) -> None:
         self.params = params
         self.home = home
         self.rng = random.Random(seed)
@@ -80,7 +82,7 @@ class Autopilot:
 
     # ------------------------------------------------------------------ state read-outs
     @property
-    def state(self):  # noqa: ANN201 - physics.State, re-exported for telemetry
+    def state(self) -> State:
         return self.vehicle.state
 
     @property
@@ -132,7 +134,12 @@ class Autopilot:
     def set_mode(self, mode: Mode) -> Result:
         if mode == Mode.AUTO and not self.mission.has_nav_items():
             return failed("Mode change to AUTO failed: no mission")
-        if mode == Mode.AUTO and self.armed and self.on_ground and not self.mission.starts_with_takeoff():
+        if (
+            mode == Mode.AUTO
+            and self.armed
+            and self.on_ground
+            and not self.mission.starts_with_takeoff()
+        ):
             return failed("Auto: Missing Takeoff Cmd")
         if mode == self.mode:
             return ACCEPTED
@@ -148,7 +155,14 @@ class Autopilot:
             self._rtl_stage = "climb"
         if mode == Mode.LAND:
             self.land_ne = (self.state.pos_ned_m[0], self.state.pos_ned_m[1])
-        if mode in (Mode.LOITER, Mode.BRAKE, Mode.GUIDED, Mode.STABILIZE, Mode.ALT_HOLD, Mode.POSHOLD):
+        if mode in (
+            Mode.LOITER,
+            Mode.BRAKE,
+            Mode.GUIDED,
+            Mode.STABILIZE,
+            Mode.ALT_HOLD,
+            Mode.POSHOLD,
+        ):
             self.vehicle.set_target(Target(yaw_deg=None))  # brake and hold
         return ACCEPTED
 
@@ -184,7 +198,11 @@ class Autopilot:
         return None
 
     def guided_position(
-        self, pos_ned_m: tuple[float, float, float], *, yaw_deg: float | None = None, switch_mode: bool = False
+        self,
+        pos_ned_m: tuple[float, float, float],
+        *,
+        yaw_deg: float | None = None,
+        switch_mode: bool = False,
     ) -> Result:
         if self.mode != Mode.GUIDED:
             if not switch_mode:
@@ -202,7 +220,9 @@ class Autopilot:
         self.vehicle.set_target(Target(pos_ned_m=pos_ned_m, yaw_deg=yaw))
         return ACCEPTED
 
-    def guided_velocity(self, vel_ned_ms: tuple[float, float, float], *, yaw_deg: float | None = None) -> Result:
+    def guided_velocity(
+        self, vel_ned_ms: tuple[float, float, float], *, yaw_deg: float | None = None
+    ) -> Result:
         if self.mode != Mode.GUIDED:
             return failed("Guided: not in GUIDED mode")
         if not self.armed:
@@ -210,13 +230,20 @@ class Autopilot:
         if not all(math.isfinite(v) for v in vel_ned_ms):
             return denied("Guided: target velocity is not finite")
         self.taking_off = False
-        self._velocity_deadline_ns = self.now_ns + 3 * _NS  # ArduCopter: stop after 3 s without an update
+        self._velocity_deadline_ns = (
+            self.now_ns + 3 * _NS
+        )  # ArduCopter: stop after 3 s without an update
         self.vehicle.set_target(
-            Target(vel_ned_ms=vel_ned_ms, yaw_deg=yaw_deg if yaw_deg is not None else self.vehicle.target.yaw_deg)
+            Target(
+                vel_ned_ms=vel_ned_ms,
+                yaw_deg=yaw_deg if yaw_deg is not None else self.vehicle.target.yaw_deg,
+            )
         )
         return ACCEPTED
 
-    def condition_yaw(self, angle_deg: float, rate_dps: float, direction: int, relative: bool) -> Result:
+    def condition_yaw(
+        self, angle_deg: float, rate_dps: float, direction: int, relative: bool
+    ) -> Result:
         if self.mode not in (Mode.GUIDED, Mode.AUTO):
             return failed(f"Yaw: needs GUIDED or AUTO, not {self.mode.name}")
         if not self.armed:
@@ -232,7 +259,10 @@ class Autopilot:
             target = angle_deg % 360.0
         t = self.vehicle.target
         self.vehicle.target = Target(
-            pos_ned_m=t.pos_ned_m, vel_ned_ms=t.vel_ned_ms, yaw_deg=target, yaw_rate_dps=rate_dps if rate_dps > 0 else None
+            pos_ned_m=t.pos_ned_m,
+            vel_ned_ms=t.vel_ned_ms,
+            yaw_deg=target,
+            yaw_rate_dps=rate_dps if rate_dps > 0 else None,
         )
         return ACCEPTED
 
@@ -252,14 +282,16 @@ class Autopilot:
             return denied(f"Change speed: unknown speed type {speed_type}")
         return ACCEPTED
 
-    def set_gimbal(self, *, pitch_deg: float | None, yaw_deg: float | None, yaw_locked: bool = False) -> Result:
+    def set_gimbal(
+        self, *, pitch_deg: float | None, yaw_deg: float | None, yaw_locked: bool = False
+    ) -> Result:
         g = self.gimbal
         if pitch_deg is not None and math.isfinite(pitch_deg):
             low, high = self.params["MNT1_PITCH_MIN"], self.params["MNT1_PITCH_MAX"]
             g.target_pitch_deg = min(max(pitch_deg, low), high)
         if yaw_deg is not None and math.isfinite(yaw_deg):
             if yaw_locked:
-                # Earth-frame heading: keep it relative internally, re-evaluated as the vehicle turns.
+                # Earth-frame heading, re-evaluated against the vehicle heading as it turns.
                 g.yaw_locked = True
                 g.target_yaw_deg = yaw_deg % 360.0
             else:
@@ -329,7 +361,11 @@ class Autopilot:
         if self._rtl_stage == "climbing" and -d >= self._rtl_alt - 0.2:
             self.vehicle.set_target(Target(pos_ned_m=(0.0, 0.0, -self._rtl_alt)))
             self._rtl_stage = "return"
-        if self._rtl_stage == "return" and math.hypot(n, e) < 0.5 and abs(self.state.vel_ned_ms[0]) < 0.2:
+        if (
+            self._rtl_stage == "return"
+            and math.hypot(n, e) < 0.5
+            and abs(self.state.vel_ned_ms[0]) < 0.2
+        ):
             self._rtl_stage = "land"
             self.land_ne = (0.0, 0.0)
             self.say(mavlink.MAV_SEVERITY_INFO, "RTL: landing at home")
@@ -355,7 +391,11 @@ class Autopilot:
         if not self.armed:
             return 0.3
         s = self.vehicle.state
-        return 12.0 + 3.0 * math.hypot(s.accel_ned_mss[0], s.accel_ned_mss[1]) + 4.0 * max(0.0, -s.vel_ned_ms[2])
+        return (
+            12.0
+            + 3.0 * math.hypot(s.accel_ned_mss[0], s.accel_ned_mss[1])
+            + 4.0 * max(0.0, -s.vel_ned_ms[2])
+        )
 
     def battery_remaining_pct(self) -> int:
         capacity = max(self.params["BATT_CAPACITY"], 1.0)
@@ -376,7 +416,9 @@ class Autopilot:
         ):
             self.failsafe_gcs = True
             self.say(mavlink.MAV_SEVERITY_CRITICAL, "GCS Failsafe")
-            self._failsafe_action(Mode.LAND if action in (4, 5) else Mode.RTL, keep_auto=action == 2)
+            self._failsafe_action(
+                Mode.LAND if action in (4, 5) else Mode.RTL, keep_auto=action == 2
+            )
         if self.armed and not self.failsafe_battery and self.battery_voltage() < p["BATT_LOW_VOLT"]:
             self.failsafe_battery = True
             self.say(mavlink.MAV_SEVERITY_CRITICAL, "Battery 1 is low")
@@ -404,7 +446,9 @@ class Autopilot:
             self._landed_since_ns = self.now_ns
             if self.mission.landing():
                 self.mission.land_complete()
-            if self.mode in (Mode.LAND, Mode.RTL) or self.mode == Mode.AUTO and not self.mission.running:
+            if self.mode in (Mode.LAND, Mode.RTL) or (
+                self.mode == Mode.AUTO and not self.mission.running
+            ):
                 self.disarm(force=True, reason="Land complete: disarming")
             return
         delay = self.params["DISARM_DELAY"]
@@ -417,9 +461,13 @@ class Autopilot:
 
     def landed_state(self) -> int:
         if not self.armed or (self.on_ground and not self.taking_off):
-            return mavlink.MAV_LANDED_STATE_ON_GROUND
+            return int(mavlink.MAV_LANDED_STATE_ON_GROUND)
         if self.taking_off:
-            return mavlink.MAV_LANDED_STATE_TAKEOFF
-        if self.mode == Mode.LAND or (self.mode == Mode.RTL and self._rtl_stage == "land") or self.mission.landing():
-            return mavlink.MAV_LANDED_STATE_LANDING
-        return mavlink.MAV_LANDED_STATE_IN_AIR
+            return int(mavlink.MAV_LANDED_STATE_TAKEOFF)
+        if (
+            self.mode == Mode.LAND
+            or (self.mode == Mode.RTL and self._rtl_stage == "land")
+            or self.mission.landing()
+        ):
+            return int(mavlink.MAV_LANDED_STATE_LANDING)
+        return int(mavlink.MAV_LANDED_STATE_IN_AIR)

@@ -205,5 +205,7 @@ HANDLERS: dict[int, Handler] = {
     M.MAV_CMD_GET_HOME_POSITION: _get_home,
     M.MAV_CMD_MISSION_START: _mission_start,
     M.MAV_CMD_DO_SET_MISSION_CURRENT: _set_mission_current,
-    M.MAV_CMD_REQUEST_PROTOCOL_VERSION: lambda session, cmd: failed("Protocol version: not provided"),
+    M.MAV_CMD_REQUEST_PROTOCOL_VERSION: lambda session, cmd: failed(
+        "Protocol version: not provided"
+    ),
 }

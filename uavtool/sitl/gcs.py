@@ -87,7 +87,11 @@ class GcsSession:
 
     def handle(self, frame: Frame) -> None:
         msg = frame.msg
-        if self.sitl.signing_key is not None and not frame.signed and msg.get_msgId() not in _UNSIGNED_OK:
+        if (
+            self.sitl.signing_key is not None
+            and not frame.signed
+            and msg.get_msgId() not in _UNSIGNED_OK
+        ):
             self.rejected_unsigned += 1
             return
         handler = self._handlers.get(msg.get_type())
@@ -119,12 +123,22 @@ class GcsSession:
 
     # ------------------------------------------------------------------ commands
     def _on_command_long(self, msg: Any) -> None:
-        params = (msg.param1, msg.param2, msg.param3, msg.param4, msg.param5, msg.param6, msg.param7)
+        params = (
+            msg.param1,
+            msg.param2,
+            msg.param3,
+            msg.param4,
+            msg.param5,
+            msg.param6,
+            msg.param7,
+        )
         self._run_command(CommandArgs(msg.command, params, None, 0, 0, self.last_source))
 
     def _on_command_int(self, msg: Any) -> None:
         params = (msg.param1, msg.param2, msg.param3, msg.param4, float(msg.x), float(msg.y), msg.z)
-        self._run_command(CommandArgs(msg.command, params, msg.frame, msg.x, msg.y, self.last_source))
+        self._run_command(
+            CommandArgs(msg.command, params, msg.frame, msg.x, msg.y, self.last_source)
+        )
 
     def _run_command(self, cmd: CommandArgs) -> None:
         handler = HANDLERS.get(cmd.command)
@@ -151,7 +165,11 @@ class GcsSession:
         else:
             result = self.set_mode_number(msg.custom_mode)
         sysid, compid = self.last_source
-        self.send(M.MAVLink_command_ack_message(M.MAVLINK_MSG_ID_SET_MODE, result.code, 0, 0, sysid, compid))
+        self.send(
+            M.MAVLink_command_ack_message(
+                M.MAVLINK_MSG_ID_SET_MODE, result.code, 0, 0, sysid, compid
+            )
+        )
         if result.reason:
             self.statustext(M.MAV_SEVERITY_WARNING, result.reason)
 
@@ -166,7 +184,7 @@ class GcsSession:
             name.encode(), params[name], params.mav_type(name), len(params), params.index(name)
         )
 
-    def _on_param_request_list(self, msg: Any) -> None:
+    def _on_param_request_list(self, msg: Any) -> None:  # noqa: ARG002 - handler signature
         for name in self.ap.params.names():
             self.send(self._param_value(name))
 
@@ -225,9 +243,15 @@ class GcsSession:
         self._apply_target(mask, (n, e, -alt_rel), (msg.vx, msg.vy, msg.vz), msg.yaw)
 
     def _apply_target(
-        self, mask: int, pos: tuple[float, float, float], vel: tuple[float, float, float], yaw_rad: float
+        self,
+        mask: int,
+        pos: tuple[float, float, float],
+        vel: tuple[float, float, float],
+        yaw_rad: float,
     ) -> None:
-        yaw = None if mask & _TM_YAW or not math.isfinite(yaw_rad) else math.degrees(yaw_rad) % 360.0
+        yaw = (
+            None if mask & _TM_YAW or not math.isfinite(yaw_rad) else math.degrees(yaw_rad) % 360.0
+        )
         if not mask & _TM_POS:
             result = self.ap.guided_position(pos, yaw_deg=yaw)
         elif not mask & _TM_VEL:
@@ -250,8 +274,10 @@ class GcsSession:
     def _on_request_data_stream(self, msg: Any) -> None:
         now = self.ap.now_ns
         rate = msg.req_message_rate if msg.start_stop else 0
-        groups = DATA_STREAMS.values() if msg.req_stream_id == M.MAV_DATA_STREAM_ALL else (
-            DATA_STREAMS.get(msg.req_stream_id, ()),
+        groups = (
+            DATA_STREAMS.values()
+            if msg.req_stream_id == M.MAV_DATA_STREAM_ALL
+            else (DATA_STREAMS.get(msg.req_stream_id, ()),)
         )
         for group in groups:
             for msg_id in group:

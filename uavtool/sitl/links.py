@@ -43,7 +43,9 @@ def parse_endpoint(text: str) -> Endpoint:
     """Parse ``KIND:HOST:PORT`` (pymavlink style); raises LinkError with what is wrong."""
     parts = text.strip().split(":")
     if len(parts) != 3 or parts[0] not in _KINDS:
-        raise LinkError(f"endpoint {text!r}: expected KIND:HOST:PORT with KIND one of {', '.join(_KINDS)}")
+        raise LinkError(
+            f"endpoint {text!r}: expected KIND:HOST:PORT with KIND one of {', '.join(_KINDS)}"
+        )
     kind, host, port_text = parts
     try:
         port = int(port_text)
@@ -76,7 +78,9 @@ class Link:
         self.name = name
         self._send_bytes = send_bytes
         self.parser = FrameParser(signing_key=signing_key)
-        self.encoder = new_encoder(sysid=sysid, compid=compid, signing_key=signing_key, link_id=link_id)
+        self.encoder = new_encoder(
+            sysid=sysid, compid=compid, signing_key=signing_key, link_id=link_id
+        )
         self.tap = tap
         self.closed = False
         self.session: Any = None  # the GcsSession serving this link
@@ -229,7 +233,12 @@ class UdpSocket(_Socketed):
             try:
                 self.sock.sendto(data, addr)
             except OSError as exc:  # nobody listening yet, or a full buffer: UDP drops
-                if exc.errno not in (errno.ECONNREFUSED, errno.EAGAIN, errno.ENOBUFS, errno.EWOULDBLOCK):
+                if exc.errno not in (
+                    errno.ECONNREFUSED,
+                    errno.EAGAIN,
+                    errno.ENOBUFS,
+                    errno.EWOULDBLOCK,
+                ):
                     raise
 
         return send

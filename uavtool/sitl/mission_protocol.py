@@ -51,8 +51,20 @@ class MissionProtocol:
 
     def home_item(self) -> MissionItem:
         home = self.session.ap.home
-        return MissionItem(0, M.MAV_FRAME_GLOBAL_INT, M.MAV_CMD_NAV_WAYPOINT, 0, 1, 0, 0, 0, 0,
-                           home.lat_e7, home.lon_e7, home.alt_amsl_m)  # fmt: skip
+        return MissionItem(
+            0,
+            M.MAV_FRAME_GLOBAL_INT,
+            M.MAV_CMD_NAV_WAYPOINT,
+            0,
+            1,
+            0,
+            0,
+            0,
+            0,
+            home.lat_e7,
+            home.lon_e7,
+            home.alt_amsl_m,
+        )
 
     def items(self) -> list[MissionItem]:
         stored = self._mission.items
@@ -62,8 +74,12 @@ class MissionProtocol:
     def on_count(self, msg: Any) -> None:
         if msg.mission_type != M.MAV_MISSION_TYPE_MISSION:
             self.session.send(
-                M.MAVLink_mission_ack_message(msg.get_srcSystem(), msg.get_srcComponent(),
-                                              M.MAV_MISSION_UNSUPPORTED, msg.mission_type)  # fmt: skip
+                M.MAVLink_mission_ack_message(
+                    msg.get_srcSystem(),
+                    msg.get_srcComponent(),
+                    M.MAV_MISSION_UNSUPPORTED,
+                    msg.mission_type,
+                )
             )
             return
         if msg.count == 0:
@@ -79,7 +95,9 @@ class MissionProtocol:
     def _request_next(self) -> None:
         assert self._upload is not None
         sysid, compid = self._upload_src
-        self.session.send(M.MAVLink_mission_request_int_message(sysid, compid, len(self._upload), 0))
+        self.session.send(
+            M.MAVLink_mission_request_int_message(sysid, compid, len(self._upload), 0)
+        )
         self._next_request_ns = self.session.ap.now_ns + _RETRY_NS
 
     def on_item(self, msg: Any, *, is_int: bool) -> None:
@@ -96,8 +114,10 @@ class MissionProtocol:
         x, y = (msg.x, msg.y) if is_int else (round(msg.x * 1e7), round(msg.y * 1e7))
         frame = msg.frame
         if not is_int:  # the float frames map to their _INT twins
-            frame = {M.MAV_FRAME_GLOBAL: M.MAV_FRAME_GLOBAL_INT,
-                     M.MAV_FRAME_GLOBAL_RELATIVE_ALT: M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT}.get(frame, frame)  # fmt: skip
+            frame = {
+                M.MAV_FRAME_GLOBAL: M.MAV_FRAME_GLOBAL_INT,
+                M.MAV_FRAME_GLOBAL_RELATIVE_ALT: M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
+            }.get(frame, frame)
         if msg.seq > 0 and msg.command not in SUPPORTED_COMMANDS:
             self._ack(M.MAV_MISSION_UNSUPPORTED)
             self._upload = None
@@ -110,8 +130,20 @@ class MissionProtocol:
             self._ack(M.MAV_MISSION_UNSUPPORTED_FRAME)
             self._upload = None
             return
-        item = MissionItem(msg.seq, frame, msg.command, msg.current, msg.autocontinue, msg.param1,
-                           msg.param2, msg.param3, msg.param4, x, y, msg.z)  # fmt: skip
+        item = MissionItem(
+            msg.seq,
+            frame,
+            msg.command,
+            msg.current,
+            msg.autocontinue,
+            msg.param1,
+            msg.param2,
+            msg.param3,
+            msg.param4,
+            x,
+            y,
+            msg.z,
+        )
         self._upload.append(item if msg.seq > 0 else self.home_item())
         self._retries = 0
         if len(self._upload) < self._upload_count:
@@ -135,12 +167,18 @@ class MissionProtocol:
     def on_request_list(self, msg: Any) -> None:
         if msg.mission_type != M.MAV_MISSION_TYPE_MISSION:
             self.session.send(
-                M.MAVLink_mission_ack_message(msg.get_srcSystem(), msg.get_srcComponent(),
-                                              M.MAV_MISSION_UNSUPPORTED, msg.mission_type)  # fmt: skip
+                M.MAVLink_mission_ack_message(
+                    msg.get_srcSystem(),
+                    msg.get_srcComponent(),
+                    M.MAV_MISSION_UNSUPPORTED,
+                    msg.mission_type,
+                )
             )
             return
         self.session.send(
-            M.MAVLink_mission_count_message(msg.get_srcSystem(), msg.get_srcComponent(), len(self.items()), 0)
+            M.MAVLink_mission_count_message(
+                msg.get_srcSystem(), msg.get_srcComponent(), len(self.items()), 0
+            )
         )
 
     def on_request(self, msg: Any, *, is_int: bool) -> None:
@@ -149,29 +187,65 @@ class MissionProtocol:
         items = self.items()
         if not 0 <= msg.seq < len(items):
             self.session.send(
-                M.MAVLink_mission_ack_message(msg.get_srcSystem(), msg.get_srcComponent(), M.MAV_MISSION_INVALID_SEQUENCE, 0)
+                M.MAVLink_mission_ack_message(
+                    msg.get_srcSystem(), msg.get_srcComponent(), M.MAV_MISSION_INVALID_SEQUENCE, 0
+                )
             )
             return
         it = items[msg.seq]
         current = 1 if it.seq == self._mission.current else 0
         src = (msg.get_srcSystem(), msg.get_srcComponent())
         if is_int:
-            out = M.MAVLink_mission_item_int_message(*src, it.seq, it.frame, it.command, current, it.autocontinue,
-                                                     it.param1, it.param2, it.param3, it.param4, it.x, it.y, it.z, 0)  # fmt: skip
+            out = M.MAVLink_mission_item_int_message(
+                *src,
+                it.seq,
+                it.frame,
+                it.command,
+                current,
+                it.autocontinue,
+                it.param1,
+                it.param2,
+                it.param3,
+                it.param4,
+                it.x,
+                it.y,
+                it.z,
+                0,
+            )
         else:
-            frame = {M.MAV_FRAME_GLOBAL_INT: M.MAV_FRAME_GLOBAL,
-                     M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT: M.MAV_FRAME_GLOBAL_RELATIVE_ALT}.get(it.frame, it.frame)  # fmt: skip
-            out = M.MAVLink_mission_item_message(*src, it.seq, frame, it.command, current, it.autocontinue,
-                                                 it.param1, it.param2, it.param3, it.param4, it.x / 1e7, it.y / 1e7, it.z, 0)  # fmt: skip
+            frame = {
+                M.MAV_FRAME_GLOBAL_INT: M.MAV_FRAME_GLOBAL,
+                M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT: M.MAV_FRAME_GLOBAL_RELATIVE_ALT,
+            }.get(it.frame, it.frame)
+            out = M.MAVLink_mission_item_message(
+                *src,
+                it.seq,
+                frame,
+                it.command,
+                current,
+                it.autocontinue,
+                it.param1,
+                it.param2,
+                it.param3,
+                it.param4,
+                it.x / 1e7,
+                it.y / 1e7,
+                it.z,
+                0,
+            )
         self.session.send(out)
 
     def on_clear_all(self, msg: Any) -> None:
         src = (msg.get_srcSystem(), msg.get_srcComponent())
         if msg.mission_type not in (M.MAV_MISSION_TYPE_MISSION, M.MAV_MISSION_TYPE_ALL):
-            self.session.send(M.MAVLink_mission_ack_message(*src, M.MAV_MISSION_UNSUPPORTED, msg.mission_type))
+            self.session.send(
+                M.MAVLink_mission_ack_message(*src, M.MAV_MISSION_UNSUPPORTED, msg.mission_type)
+            )
             return
         self._mission.replace([])
-        self.session.send(M.MAVLink_mission_ack_message(*src, M.MAV_MISSION_ACCEPTED, msg.mission_type))
+        self.session.send(
+            M.MAVLink_mission_ack_message(*src, M.MAV_MISSION_ACCEPTED, msg.mission_type)
+        )
 
     def on_set_current(self, msg: Any) -> None:
         if self._mission.set_current(msg.seq):

@@ -7,6 +7,7 @@ what a later PARAM_REQUEST_READ returns.
 
 from __future__ import annotations
 
+import math
 import re
 import struct
 from dataclasses import dataclass
@@ -43,7 +44,9 @@ PARAM_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("RTL_SPEED", 0, _INT16, "RTL horizontal speed, cm/s (0 = WPNAV_SPEED)"),
     ParamSpec("RTL_LOIT_TIME", 0, _INT32, "RTL loiter time above home before landing, ms"),
     ParamSpec("LAND_SPEED", 50, _INT16, "final landing descent rate, cm/s"),
-    ParamSpec("LAND_SPEED_HIGH", 0, _INT16, "landing descent above 10 m, cm/s (0 = WPNAV_SPEED_DN)"),
+    ParamSpec(
+        "LAND_SPEED_HIGH", 0, _INT16, "landing descent above 10 m, cm/s (0 = WPNAV_SPEED_DN)"
+    ),
     ParamSpec("WPNAV_SPEED", 1000, _REAL32, "horizontal waypoint speed, cm/s"),
     ParamSpec("WPNAV_SPEED_UP", 250, _REAL32, "climb rate, cm/s"),
     ParamSpec("WPNAV_SPEED_DN", 150, _REAL32, "descent rate, cm/s"),
@@ -90,7 +93,9 @@ class ParamStore:
     """The live parameter table (name → value), in the fixed order of ``PARAM_SPECS``."""
 
     def __init__(self) -> None:
-        self._values: dict[str, float] = {s.name: coerce(s.mav_type, s.default) for s in PARAM_SPECS}
+        self._values: dict[str, float] = {
+            s.name: coerce(s.mav_type, s.default) for s in PARAM_SPECS
+        }
         self._names: list[str] = [s.name for s in PARAM_SPECS]
 
     def __len__(self) -> int:
@@ -119,7 +124,7 @@ class ParamStore:
         spec = _SPECS_BY_NAME.get(name)
         if spec is None:
             raise ParamError(f"unknown parameter {name!r}")
-        if value != value or value in (float("inf"), float("-inf")):
+        if not math.isfinite(value):
             raise ParamError(f"parameter {name}: value must be finite, got {value}")
         stored = coerce(spec.mav_type, value)
         self._values[name] = stored

@@ -117,8 +117,7 @@ class Multicopter:
         self._update_yaw(dt_s)
         if s.pos_ned_m[2] >= 0.0:
             s.pos_ned_m[2] = 0.0
-            if s.vel_ned_ms[2] > 0.0:
-                s.vel_ned_ms[2] = 0.0
+            s.vel_ned_ms[2] = min(s.vel_ned_ms[2], 0.0)
             s.on_ground = vel_des[2] >= 0.0
             if s.on_ground:
                 s.vel_ned_ms[0] = s.vel_ned_ms[1] = 0.0

@@ -30,6 +30,7 @@ from uavtool.sitl.links import (
     parse_endpoint,
 )
 from uavtool.sitl.params import ParamStore
+from uavtool.sitl.telemetry import Telemetry
 
 log = logging.getLogger(__name__)
 _NS = 1_000_000_000
@@ -61,12 +62,16 @@ class Sitl:
         self.speedup = params["SIM_SPEEDUP"]
         self.dt_ns = _NS // max(int(params["SIM_RATE_HZ"]), 1)
         self.autopilot = Autopilot(
-            home=config.home, home_heading_deg=config.home_heading_deg, params=params, seed=config.seed
+            home=config.home,
+            home_heading_deg=config.home_heading_deg,
+            params=params,
+            seed=config.seed,
         )
-        from uavtool.sitl.telemetry import Telemetry  # after autopilot: telemetry reads it
-
         self.telemetry = Telemetry(
-            self.autopilot, sysid=self.sysid, instance=config.instance, start_unix_us=int(time.time() * 1e6)
+            self.autopilot,
+            sysid=self.sysid,
+            instance=config.instance,
+            start_unix_us=int(time.time() * 1e6),
         )
         self.sessions: list[GcsSession] = []
         self._selector = selectors.DefaultSelector()
@@ -89,9 +94,14 @@ class Sitl:
     def _make_link(self, name: str, send: Callable[[bytes], None]) -> Link:
         self._link_counter += 1
         link = Link(
-            name, send, sysid=self.sysid, compid=self.compid, signing_key=self.signing_key,
-            link_id=self._link_counter & 0xFF, tap=self.frame_tap,
-        )  # fmt: skip
+            name,
+            send,
+            sysid=self.sysid,
+            compid=self.compid,
+            signing_key=self.signing_key,
+            link_id=self._link_counter & 0xFF,
+            tap=self.frame_tap,
+        )
         session = GcsSession(self, link)
         link.session = session
         self.sessions.append(session)
@@ -114,7 +124,11 @@ class Sitl:
     @property
     def ports(self) -> list[int]:
         """The local port of each endpoint, in order (resolves ``:0`` ephemeral ports)."""
-        return [int(s.sock.getsockname()[1]) for s in self._sockets if isinstance(s, (TcpListener, UdpSocket))]
+        return [
+            int(s.sock.getsockname()[1])
+            for s in self._sockets
+            if isinstance(s, (TcpListener, UdpSocket))
+        ]
 
     def describe_endpoints(self) -> list[str]:
         out = []
@@ -208,7 +222,9 @@ class Sitl:
 
     def start(self) -> Sitl:
         """Run in a daemon thread; returns self."""
-        self._thread = threading.Thread(target=self._run_guarded, name=f"sitl-{self.sysid}", daemon=True)
+        self._thread = threading.Thread(
+            target=self._run_guarded, name=f"sitl-{self.sysid}", daemon=True
+        )
         self._thread.start()
         return self
 

@@ -22,7 +22,9 @@ class Mode(IntEnum):
     BRAKE = 17
 
 
-ARMABLE_MODES = frozenset({Mode.STABILIZE, Mode.ALT_HOLD, Mode.GUIDED, Mode.LOITER, Mode.POSHOLD, Mode.BRAKE})
+ARMABLE_MODES = frozenset(
+    {Mode.STABILIZE, Mode.ALT_HOLD, Mode.GUIDED, Mode.LOITER, Mode.POSHOLD, Mode.BRAKE}
+)
 
 
 @dataclass(frozen=True, slots=True)
@@ -34,7 +36,7 @@ class Result:
 
     @property
     def ok(self) -> bool:
-        return self.code == mavlink.MAV_RESULT_ACCEPTED
+        return bool(self.code == mavlink.MAV_RESULT_ACCEPTED)
 
 
 ACCEPTED = Result(mavlink.MAV_RESULT_ACCEPTED)

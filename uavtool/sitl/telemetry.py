@@ -43,7 +43,10 @@ DATA_STREAMS: dict[int, tuple[int, ...]] = {
         M.MAVLINK_MSG_ID_GPS_RAW_INT,
         M.MAVLINK_MSG_ID_MISSION_CURRENT,
     ),
-    M.MAV_DATA_STREAM_POSITION: (M.MAVLINK_MSG_ID_GLOBAL_POSITION_INT, M.MAVLINK_MSG_ID_LOCAL_POSITION_NED),
+    M.MAV_DATA_STREAM_POSITION: (
+        M.MAVLINK_MSG_ID_GLOBAL_POSITION_INT,
+        M.MAVLINK_MSG_ID_LOCAL_POSITION_NED,
+    ),
     M.MAV_DATA_STREAM_EXTRA1: (M.MAVLINK_MSG_ID_ATTITUDE,),
     M.MAV_DATA_STREAM_EXTRA2: (M.MAVLINK_MSG_ID_VFR_HUD,),
     M.MAV_DATA_STREAM_EXTRA3: (
@@ -80,7 +83,9 @@ CAPABILITIES = (
     | M.MAV_PROTOCOL_CAPABILITY_MAVLINK2
 )
 FIRMWARE_VERSION = (4 << 24) | (5 << 16) | (7 << 8) | 255  # reported as Copter 4.5.7 official
-_GUIDED_FLAG_MODES = frozenset({Mode.GUIDED, Mode.AUTO, Mode.RTL, Mode.LAND, Mode.LOITER, Mode.BRAKE, Mode.POSHOLD})
+_GUIDED_FLAG_MODES = frozenset(
+    {Mode.GUIDED, Mode.AUTO, Mode.RTL, Mode.LAND, Mode.LOITER, Mode.BRAKE, Mode.POSHOLD}
+)
 
 
 class Telemetry:
@@ -136,18 +141,33 @@ class Telemetry:
             status = M.MAV_STATE_ACTIVE
         else:
             status = M.MAV_STATE_STANDBY
-        return M.MAVLink_heartbeat_message(M.MAV_TYPE_QUADROTOR, M.MAV_AUTOPILOT_ARDUPILOTMEGA, base, int(ap.mode), status, 3)
+        return M.MAVLink_heartbeat_message(
+            M.MAV_TYPE_QUADROTOR, M.MAV_AUTOPILOT_ARDUPILOTMEGA, base, int(ap.mode), status, 3
+        )
 
     def sys_status(self) -> Any:
         ap = self.ap
         enabled = _SENSORS if ap.armed else _SENSORS & ~M.MAV_SYS_STATUS_SENSOR_MOTOR_OUTPUTS
         return M.MAVLink_sys_status_message(
-            _SENSORS, enabled, _SENSORS, 150, round(ap.battery_voltage() * 1000),
-            round(ap.battery_current_a() * 100), ap.battery_remaining_pct(), 0, 0, 0, 0, 0, 0,
-        )  # fmt: skip
+            _SENSORS,
+            enabled,
+            _SENSORS,
+            150,
+            round(ap.battery_voltage() * 1000),
+            round(ap.battery_current_a() * 100),
+            ap.battery_remaining_pct(),
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+        )
 
     def system_time(self) -> Any:
-        return M.MAVLink_system_time_message(self.start_unix_us + self.ap.now_ns // 1000, self.boot_ms)
+        return M.MAVLink_system_time_message(
+            self.start_unix_us + self.ap.now_ns // 1000, self.boot_ms
+        )
 
     def _position(self) -> tuple[int, int, int, int]:
         ap = self.ap
@@ -169,22 +189,37 @@ class Telemetry:
         vel = math.hypot(s.vel_ned_ms[0], s.vel_ned_ms[1])
         cog = math.degrees(math.atan2(s.vel_ned_ms[1], s.vel_ned_ms[0])) % 360.0
         return M.MAVLink_gps_raw_int_message(
-            self.ap.now_ns // 1000, M.GPS_FIX_TYPE_3D_FIX, lat, lon, alt, 80, 120, round(vel * 100),
-            round(cog * 100) % 36000, 16,
-        )  # fmt: skip
+            self.ap.now_ns // 1000,
+            M.GPS_FIX_TYPE_3D_FIX,
+            lat,
+            lon,
+            alt,
+            80,
+            120,
+            round(vel * 100),
+            round(cog * 100) % 36000,
+            16,
+        )
 
     def attitude(self) -> Any:
         s = self.ap.state
         return M.MAVLink_attitude_message(
-            self.boot_ms, math.radians(s.roll_deg), math.radians(s.pitch_deg),
-            math.radians(_wrap_pi_deg(s.yaw_deg)), 0.0, 0.0, math.radians(s.yaw_rate_dps),
-        )  # fmt: skip
+            self.boot_ms,
+            math.radians(s.roll_deg),
+            math.radians(s.pitch_deg),
+            math.radians(_wrap_pi_deg(s.yaw_deg)),
+            0.0,
+            0.0,
+            math.radians(s.yaw_rate_dps),
+        )
 
     def global_position_int(self) -> Any:
         lat, lon, alt, rel = self._position()
         s = self.ap.state
         vx, vy, vz = (round(v * 100) for v in s.vel_ned_ms)
-        return M.MAVLink_global_position_int_message(self.boot_ms, lat, lon, alt, rel, vx, vy, vz, round(s.yaw_deg * 100) % 36000)
+        return M.MAVLink_global_position_int_message(
+            self.boot_ms, lat, lon, alt, rel, vx, vy, vz, round(s.yaw_deg * 100) % 36000
+        )
 
     def local_position_ned(self) -> Any:
         s = self.ap.state
@@ -196,7 +231,12 @@ class Telemetry:
         speed = math.hypot(s.vel_ned_ms[0], s.vel_ned_ms[1])
         throttle = 0 if not ap.armed else min(100, round(45 - 10 * s.accel_ned_mss[2]))
         return M.MAVLink_vfr_hud_message(
-            speed, speed, round(s.yaw_deg) % 360, throttle, ap.home.alt_amsl_m + ap.alt_rel_m(), -s.vel_ned_ms[2]
+            speed,
+            speed,
+            round(s.yaw_deg) % 360,
+            throttle,
+            ap.home.alt_amsl_m + ap.alt_rel_m(),
+            -s.vel_ned_ms[2],
         )
 
     def battery_status(self) -> Any:
@@ -204,12 +244,21 @@ class Telemetry:
         cell_mv = round(ap.battery_voltage() * 1000 / 4)
         cells = [cell_mv] * 4 + [65535] * 6
         return M.MAVLink_battery_status_message(
-            0, M.MAV_BATTERY_FUNCTION_ALL, M.MAV_BATTERY_TYPE_LIPO, 2500, cells, round(ap.battery_current_a() * 100),
-            round(ap.battery_used_mah), -1, ap.battery_remaining_pct(),
-        )  # fmt: skip
+            0,
+            M.MAV_BATTERY_FUNCTION_ALL,
+            M.MAV_BATTERY_TYPE_LIPO,
+            2500,
+            cells,
+            round(ap.battery_current_a() * 100),
+            round(ap.battery_used_mah),
+            -1,
+            ap.battery_remaining_pct(),
+        )
 
     def extended_sys_state(self) -> Any:
-        return M.MAVLink_extended_sys_state_message(M.MAV_VTOL_STATE_UNDEFINED, self.ap.landed_state())
+        return M.MAVLink_extended_sys_state_message(
+            M.MAV_VTOL_STATE_UNDEFINED, self.ap.landed_state()
+        )
 
     def mission_current(self) -> Any:
         mission = self.ap.mission
@@ -227,19 +276,43 @@ class Telemetry:
     def home_position(self) -> Any:
         home = self.ap.home
         return M.MAVLink_home_position_message(
-            home.lat_e7, home.lon_e7, round(home.alt_amsl_m * 1000), 0.0, 0.0, 0.0, [1.0, 0.0, 0.0, 0.0],
-            0.0, 0.0, 0.0, self.ap.now_ns // 1000,
-        )  # fmt: skip
+            home.lat_e7,
+            home.lon_e7,
+            round(home.alt_amsl_m * 1000),
+            0.0,
+            0.0,
+            0.0,
+            [1.0, 0.0, 0.0, 0.0],
+            0.0,
+            0.0,
+            0.0,
+            self.ap.now_ns // 1000,
+        )
 
     def autopilot_version(self) -> Any:
         return M.MAVLink_autopilot_version_message(
-            CAPABILITIES, FIRMWARE_VERSION, 0, 0, 0, [0] * 8, [0] * 8, [0] * 8, 0x1209, 0x5741, self.uid, self.uid2,
-        )  # fmt: skip
+            CAPABILITIES,
+            FIRMWARE_VERSION,
+            0,
+            0,
+            0,
+            [0] * 8,
+            [0] * 8,
+            [0] * 8,
+            0x1209,
+            0x5741,
+            self.uid,
+            self.uid2,
+        )
 
     def gimbal_device_attitude_status(self) -> Any:
         g = self.ap.gimbal
         q = _quat_from_euler(0.0, math.radians(g.pitch_deg), math.radians(g.yaw_deg))
-        flags = M.GIMBAL_DEVICE_FLAGS_ROLL_LOCK | M.GIMBAL_DEVICE_FLAGS_PITCH_LOCK | M.GIMBAL_DEVICE_FLAGS_YAW_IN_VEHICLE_FRAME
+        flags = (
+            M.GIMBAL_DEVICE_FLAGS_ROLL_LOCK
+            | M.GIMBAL_DEVICE_FLAGS_PITCH_LOCK
+            | M.GIMBAL_DEVICE_FLAGS_YAW_IN_VEHICLE_FRAME
+        )
         # q is in the vehicle frame; delta_yaw is the vehicle's heading, relating it to earth.
         vehicle_yaw = math.radians(_wrap_pi_deg(self.ap.state.yaw_deg))
         return M.MAVLink_gimbal_device_attitude_status_message(
@@ -264,9 +337,16 @@ class Telemetry:
         )
         p = self.ap.params
         return M.MAVLink_gimbal_manager_information_message(
-            self.boot_ms, cap, 1, 0.0, 0.0, math.radians(p["MNT1_PITCH_MIN"]), math.radians(p["MNT1_PITCH_MAX"]),
-            math.radians(p["MNT1_YAW_MIN"]), math.radians(p["MNT1_YAW_MAX"]),
-        )  # fmt: skip
+            self.boot_ms,
+            cap,
+            1,
+            0.0,
+            0.0,
+            math.radians(p["MNT1_PITCH_MIN"]),
+            math.radians(p["MNT1_PITCH_MAX"]),
+            math.radians(p["MNT1_YAW_MIN"]),
+            math.radians(p["MNT1_YAW_MAX"]),
+        )
 
     def gimbal_device_information(self) -> Any:
         cap = (
@@ -277,10 +357,23 @@ class Telemetry:
         )
         p = self.ap.params
         return M.MAVLink_gimbal_device_information_message(
-            self.boot_ms, b"uavtool", b"sim gimbal", b"", 0, 0, 0, cap, 0, 0.0, 0.0,
-            math.radians(p["MNT1_PITCH_MIN"]), math.radians(p["MNT1_PITCH_MAX"]),
-            math.radians(p["MNT1_YAW_MIN"]), math.radians(p["MNT1_YAW_MAX"]), 1,
-        )  # fmt: skip
+            self.boot_ms,
+            b"uavtool",
+            b"sim gimbal",
+            b"",
+            0,
+            0,
+            0,
+            cap,
+            0,
+            0.0,
+            0.0,
+            math.radians(p["MNT1_PITCH_MIN"]),
+            math.radians(p["MNT1_PITCH_MAX"]),
+            math.radians(p["MNT1_YAW_MIN"]),
+            math.radians(p["MNT1_YAW_MAX"]),
+            1,
+        )
 
 
 def _wrap_pi_deg(angle_deg: float) -> float:
@@ -306,7 +399,9 @@ class Streams:
     """Per-link stream schedule: message id → (interval ns, next due ns)."""
 
     def __init__(self) -> None:
-        self.interval_ns: dict[int, int] = {mid: round(_NS / hz) for mid, hz in DEFAULT_RATES_HZ.items()}
+        self.interval_ns: dict[int, int] = {
+            mid: round(_NS / hz) for mid, hz in DEFAULT_RATES_HZ.items()
+        }
         self._next_ns: dict[int, int] = dict.fromkeys(self.interval_ns, 0)
 
     def set_interval(self, msg_id: int, interval_us: float, now_ns: int) -> None:
@@ -331,11 +426,11 @@ class Streams:
 
     def due(self, now_ns: int) -> list[int]:
         out = []
-        for mid, nxt in self._next_ns.items():
-            if now_ns >= nxt:
+        for mid, due_ns in self._next_ns.items():
+            if now_ns >= due_ns:
                 out.append(mid)
                 interval = self.interval_ns[mid]
                 # Keep the phase; if we fell far behind, restart from now rather than burst.
-                nxt += interval
-                self._next_ns[mid] = nxt if nxt > now_ns else now_ns + interval
+                following = due_ns + interval
+                self._next_ns[mid] = following if following > now_ns else now_ns + interval
         return out
