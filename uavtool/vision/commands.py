@@ -76,11 +76,13 @@ def match_files(
     """Vectorize the target bitmap (its largest shape is the target) and a frame, and match
     every shape of the frame against the target."""
     p = params if params is not None else RecognizeParams()
-    target_shapes = vectorize(read_image(target), vectorize_params)
+    # Both pictures are taken from above: compare roofs, not the walls perspective shows.
+    vp = vectorize_params if vectorize_params is not None else VectorizeParams(roof_only=True)
+    target_shapes = vectorize(read_image(target), vp)
     if not target_shapes:
         raise ImageError(f"{target}: no coloured shape found in the target image")
     reference = max(target_shapes, key=lambda s: s.area_px)
-    shapes = vectorize(read_image(frame), vectorize_params)
+    shapes = vectorize(read_image(frame), vp)
     best, matches = best_match(reference, shapes, p)
     return MatchReport(reference, shapes, matches, best, p.threshold)
 
@@ -98,8 +100,8 @@ def model_files(
 ) -> Model:
     """Build the model from three photos and their poses file; write it as GLB.
 
-    The object is the shape the top photo is centred on; in the front and right photos,
-    every shape of its colour is the object.
+    The object is the shape the top photo is centred on (its roofs only); in the front and
+    right photos, every shape of its colour is the object.
     """
     try:
         text = poses.read_text()
@@ -111,7 +113,8 @@ def model_files(
     for name, path in images.items():
         rgb = read_image(path)
         _check_size(path, rgb, cams[name][1])
-        shapes[name] = vectorize(rgb, vectorize_params)
+        vp = vectorize_params or VectorizeParams(roof_only=name == "top")
+        shapes[name] = vectorize(rgb, vp)
     obj = central_shape(shapes["top"], cams["top"][1])
     if obj is None:
         raise ModelInputError(f"{top}: no coloured shape in the top photo")
