@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+import signal
 from pathlib import Path
 
 import click
 
 from uavtool.errors import InputError
+
+
+def _interrupt(_signum: int, _frame: object) -> None:
+    raise KeyboardInterrupt
 
 
 def _pair(text: str, what: str) -> tuple[float, float]:
@@ -101,6 +106,7 @@ def sitl(
     for ep in vehicle.describe_endpoints():
         click.echo(f"  serving MAVLink on {ep}")
     click.echo("  Ctrl-C to stop")
+    signal.signal(signal.SIGTERM, _interrupt)  # `kill` stops it as cleanly as Ctrl-C
     try:
         vehicle.run(duration_s=duration)
     except KeyboardInterrupt:

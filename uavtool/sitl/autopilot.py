@@ -39,8 +39,10 @@ class Autopilot:
     ) -> None:
         self.params = params
         self.home = home
-        self.rng = random.Random(seed)
-        self.vehicle = Multicopter(yaw_deg=home_heading_deg % 360.0, rng=self.rng)
+        # Separate streams: how many sensor readings are sent (clients, rates) must not
+        # change the gusts, so the trajectory depends only on the seed and the commands.
+        self.noise_rng = random.Random(seed * 2 + 1)
+        self.vehicle = Multicopter(yaw_deg=home_heading_deg % 360.0, rng=random.Random(seed * 2))
         self.mode = Mode.STABILIZE
         self.armed = False
         self.now_ns = 0

@@ -182,10 +182,6 @@ def _set_mission_current(session: GcsSession, cmd: CommandArgs) -> Result:
     return ACCEPTED
 
 
-def _accept(session: GcsSession, cmd: CommandArgs) -> Result:
-    return ACCEPTED
-
-
 HANDLERS: dict[int, Handler] = {
     M.MAV_CMD_COMPONENT_ARM_DISARM: _arm_disarm,
     M.MAV_CMD_NAV_TAKEOFF: _takeoff,

@@ -175,12 +175,12 @@ class Telemetry:
         noise = ap.params["SIM_GPS_NOISE"]
         lat_e7, lon_e7 = geo.lat_e7, geo.lon_e7
         if noise > 0:
-            lat_e7 += round(ap.rng.gauss(0.0, noise) / 0.011131884502145034)
-            lon_e7 += round(ap.rng.gauss(0.0, noise) / 0.011131884502145034)
+            lat_e7 += round(ap.noise_rng.gauss(0.0, noise) / 0.011131884502145034)
+            lon_e7 += round(ap.noise_rng.gauss(0.0, noise) / 0.011131884502145034)
         alt_rel = ap.alt_rel_m()
         baro = ap.params["SIM_BARO_RND"]
         if baro > 0:
-            alt_rel += ap.rng.gauss(0.0, baro)
+            alt_rel += ap.noise_rng.gauss(0.0, baro)
         return lat_e7, lon_e7, round((ap.home.alt_amsl_m + alt_rel) * 1000), round(alt_rel * 1000)
 
     def gps_raw_int(self) -> Any:
