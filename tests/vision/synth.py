@@ -37,7 +37,8 @@ def family_shape(family: str, aspect: float, notch: float) -> FloatArray:
     elif family == "house":
         pts = [(0, 0), (w, 0), (w, h), (w / 2, h + 0.5 * h), (0, h)]
     elif family == "trapezoid":
-        pts = [(0, 0), (w, 0), ((1 - t) * w, h), (t * w, h)]
+        inset = 0.5 * t  # the top edge stays over half the base: not a near-triangle
+        pts = [(0, 0), (w, 0), ((1 - inset) * w, h), (inset * w, h)]
     else:
         raise ValueError(family)
     arr = np.array(pts, dtype=np.float64)
@@ -61,6 +62,7 @@ def draw(
     noise_sigma: float = 0.0,
     seed: int = 0,
     holes: list[FloatArray] | None = None,
+    shade: bool = True,
 ) -> npt.NDArray[np.uint8]:
     """An RGB image with grey ground and each polygon filled in its colour, the lower half
     of each polygon slightly darker (shading), holes filled with ground, optional noise."""
@@ -69,6 +71,8 @@ def draw(
     for poly, colour in polys:
         pts = np.round(poly * 16).astype(np.int32)
         cv2.fillPoly(img, [pts], colour, lineType=cv2.LINE_8, shift=4)
+        if not shade:
+            continue
         shade = tuple(int(c * 0.85) for c in colour)
         mask = np.zeros((h, w), np.uint8)
         cv2.fillPoly(mask, [pts], 255, shift=4)

@@ -45,10 +45,11 @@ def test_vectorize_writes_shapes_and_overlay(tmp_path: Path) -> None:
 
 
 def test_match_finds_the_target_and_fails_when_absent(tmp_path: Path) -> None:
+    # Flat roofs (one shade each): `match` compares the brightest shade of each colour.
     ell = family_shape("L", 0.6, 0.3)
     target = _write(
         tmp_path / "target.png",
-        draw([(place(ell, angle_deg=0, size_px=150, centre=(320, 240)), RED)]),
+        draw([(place(ell, angle_deg=0, size_px=150, centre=(320, 240)), RED)], shade=False),
     )
     frame = _write(
         tmp_path / "frame.png",
@@ -61,7 +62,8 @@ def test_match_finds_the_target_and_fails_when_absent(tmp_path: Path) -> None:
                     BLUE,
                 ),
                 (place(ell, angle_deg=75, size_px=180, centre=(450, 300)), RED),
-            ]
+            ],
+            shade=False,
         ),
     )
     runner = CliRunner()

@@ -1,7 +1,5 @@
 """``uavtool vision``: vectorize a frame, match a target, build a 3D model from three photos."""
 
-# ruff: noqa: PLC0415  (heavy imports are lazy so `uavtool --help` stays fast)
-
 from __future__ import annotations
 
 from pathlib import Path

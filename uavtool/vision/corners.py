@@ -86,7 +86,13 @@ def _fit_span(dense_px: FloatArray, first: int, last: int) -> tuple[float, float
     count = (last - first) % n + 1
     trim = 1 if count >= 6 else 0
     idx = [(first + t) % n for t in range(trim, count - trim)]
-    return _fit_line(dense_px[idx])
+    cx, cy, dx, dy = _fit_line(dense_px[idx])
+    # Point the (unoriented) fitted axis the way the outline runs, so that antiparallel
+    # edges (the two sides of a narrow slot) are never taken for one straight line.
+    chord = dense_px[last] - dense_px[first]
+    if dx * float(chord[0]) + dy * float(chord[1]) < 0.0:
+        dx, dy = -dx, -dy
+    return cx, cy, dx, dy
 
 
 def _fit_line(pts: FloatArray) -> tuple[float, float, float, float]:
