@@ -22,7 +22,7 @@ NADIR_45 = CameraPose((0.0, 0.0, 45.0), 0.0, -90.0)
 FRONT_OF_RED = CameraPose((8.75, -32.0, 1.2), 0.0, 0.0)  # looking north along the wing's tunnel
 
 
-def _box(  # noqa: PLR0917
+def _box(
     name: str, rgb: tuple[int, int, int], x0: float, y0: float, x1: float, y1: float, top: float
 ) -> Building:
     return Building(name, rgb, (Block(((x0, y0), (x1, y0), (x1, y1), (x0, y1)), 0.0, top),))
@@ -187,7 +187,7 @@ def test_matches_reference_zbuffer(scene_name: str) -> None:
     yaw=st.floats(0, 360),
     pitch=st.floats(-90, 10),
 )
-def test_random_scenes_match_reference(  # noqa: PLR0917
+def test_random_scenes_match_reference(
     seed: int, e: float, n: float, u: float, yaw: float, pitch: float
 ) -> None:
     scene = generate_scene(seed=seed, buildings=6)

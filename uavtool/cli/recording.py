@@ -1,7 +1,7 @@
 """``uavtool info``, ``uavtool export`` and ``uavtool import``: inspect, repair and convert
 recordings. Heavy imports happen inside the commands so ``uavtool --help`` stays fast."""
 
-# ruff: noqa: PLC0415  (the lazy imports above are deliberate)
+
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """``uavtool scene``: list, validate, render and generate scenes."""
 
-# ruff: noqa: PLC0415  (heavy imports are lazy so `uavtool --help` stays fast)
+
 
 from __future__ import annotations
 
@@ -100,7 +100,7 @@ def validate(scene_ref: str) -> None:
 @click.option(
     "-o", "--output", required=True, type=click.Path(path_type=Path), help="PNG file to write."
 )
-def render(  # noqa: PLR0917  (click passes options positionally)
+def render(
     scene_ref: str,
     pos: str,
     yaw: float,
