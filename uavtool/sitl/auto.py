@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 from uavtool.geo import GeoPoint
 from uavtool.mavlink.dialect import mavlink
 from uavtool.sitl.physics import Target
-from uavtool.sitl.state import MissionItem, Mode
+from uavtool.sitl.state import AMSL_FRAMES, RELATIVE_ALT_FRAMES, MissionItem, Mode
 
 if TYPE_CHECKING:
     from uavtool.sitl.autopilot import Autopilot
@@ -31,10 +31,7 @@ SUPPORTED_COMMANDS = NAV_COMMANDS | {
     mavlink.MAV_CMD_DO_MOUNT_CONTROL,
     mavlink.MAV_CMD_DO_GIMBAL_MANAGER_PITCHYAW,
 }
-_RELATIVE_FRAMES = frozenset(
-    {mavlink.MAV_FRAME_GLOBAL_RELATIVE_ALT, mavlink.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT}
-)
-_GLOBAL_FRAMES = _RELATIVE_FRAMES | {mavlink.MAV_FRAME_GLOBAL, mavlink.MAV_FRAME_GLOBAL_INT}
+_GLOBAL_FRAMES = RELATIVE_ALT_FRAMES | AMSL_FRAMES
 
 
 class AutoMission:
@@ -135,7 +132,7 @@ class AutoMission:
         if item.frame in _GLOBAL_FRAMES and (item.x or item.y):
             point = GeoPoint(item.x / 1e7, item.y / 1e7, ap.home.alt_amsl_m)
             n, e, _ = ap.ned_of(point)
-        if item.frame in _RELATIVE_FRAMES or item.frame not in _GLOBAL_FRAMES:
+        if item.frame in RELATIVE_ALT_FRAMES or item.frame not in _GLOBAL_FRAMES:
             alt_rel = item.z
         else:
             alt_rel = item.z - ap.home.alt_amsl_m

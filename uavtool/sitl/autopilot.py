@@ -11,11 +11,11 @@ import math
 import random
 from collections import deque
 
-from uavtool.geo import GeoPoint, enu_from_geo, geo_from_enu
+from uavtool.geo import GeoPoint, enu_from_geo, geo_from_enu, wrap_180
 from uavtool.mavlink.dialect import mavlink
 from uavtool.sitl.auto import AutoMission
 from uavtool.sitl.params import ParamStore
-from uavtool.sitl.physics import Multicopter, State, Target, wrap_180
+from uavtool.sitl.physics import Multicopter, State, Target
 from uavtool.sitl.state import (
     ACCEPTED,
     ARMABLE_MODES,

@@ -14,7 +14,15 @@ from typing import TYPE_CHECKING
 from uavtool.geo import GeoPoint
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.sitl.autopilot import FORCE_MAGIC
-from uavtool.sitl.state import ACCEPTED, Mode, Result, denied, failed
+from uavtool.sitl.state import (
+    ACCEPTED,
+    AMSL_FRAMES,
+    RELATIVE_ALT_FRAMES,
+    Mode,
+    Result,
+    denied,
+    failed,
+)
 
 if TYPE_CHECKING:
     from uavtool.sitl.gcs import GcsSession
@@ -40,8 +48,6 @@ class CommandArgs:
 
 
 Handler = Callable[["GcsSession", CommandArgs], Result]
-_RELATIVE = (M.MAV_FRAME_GLOBAL_RELATIVE_ALT, M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT)
-_AMSL = (M.MAV_FRAME_GLOBAL, M.MAV_FRAME_GLOBAL_INT)
 
 
 def _arm_disarm(session: GcsSession, cmd: CommandArgs) -> Result:
@@ -87,9 +93,9 @@ def _reposition(session: GcsSession, cmd: CommandArgs) -> Result:
         lat, lon, frame = cmd.p(5), cmd.p(6), M.MAV_FRAME_GLOBAL_RELATIVE_ALT
     else:
         lat, lon, frame = cmd.x / 1e7, cmd.y / 1e7, cmd.frame
-    if frame in _RELATIVE:
+    if frame in RELATIVE_ALT_FRAMES:
         alt_rel = cmd.p(7)
-    elif frame in _AMSL:
+    elif frame in AMSL_FRAMES:
         alt_rel = cmd.p(7) - ap.home.alt_amsl_m
     else:
         return denied(f"Reposition: unsupported frame {frame}")

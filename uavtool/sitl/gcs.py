@@ -18,7 +18,14 @@ from uavtool.geo import GeoPoint
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.sitl.commands import HANDLERS, CommandArgs
 from uavtool.sitl.mission_protocol import MissionProtocol
-from uavtool.sitl.state import ACCEPTED, Mode, Result, denied
+from uavtool.sitl.state import (
+    ACCEPTED,
+    AMSL_FRAMES,
+    RELATIVE_ALT_FRAMES,
+    Mode,
+    Result,
+    denied,
+)
 from uavtool.sitl.telemetry import DATA_STREAMS, Streams
 
 if TYPE_CHECKING:
@@ -228,14 +235,10 @@ class GcsSession:
     def _on_position_target_global(self, msg: Any) -> None:
         ap = self.ap
         mask, frame = msg.type_mask, msg.coordinate_frame
-        if frame in (M.MAV_FRAME_GLOBAL_INT, M.MAV_FRAME_GLOBAL):
+        if frame in AMSL_FRAMES:
             alt_rel = msg.alt - ap.home.alt_amsl_m
-        elif frame in (
-            M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
-            M.MAV_FRAME_GLOBAL_RELATIVE_ALT,
-            M.MAV_FRAME_GLOBAL_TERRAIN_ALT_INT,
-        ):
-            alt_rel = msg.alt
+        elif frame in RELATIVE_ALT_FRAMES or frame == M.MAV_FRAME_GLOBAL_TERRAIN_ALT_INT:
+            alt_rel = msg.alt  # flat terrain: above terrain is above home
         else:
             self.statustext(M.MAV_SEVERITY_WARNING, f"Guided: unsupported frame {frame}")
             return

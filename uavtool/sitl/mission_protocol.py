@@ -19,6 +19,12 @@ if TYPE_CHECKING:
 
 _RETRY_NS = 1_500_000_000
 _MAX_RETRIES = 5
+# MISSION_ITEM (float) frames and their MISSION_ITEM_INT twins; items are stored as _INT.
+_INT_FRAME = {
+    M.MAV_FRAME_GLOBAL: M.MAV_FRAME_GLOBAL_INT,
+    M.MAV_FRAME_GLOBAL_RELATIVE_ALT: M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
+}
+_FLOAT_FRAME = {v: k for k, v in _INT_FRAME.items()}
 _FRAMES = frozenset(
     {
         M.MAV_FRAME_GLOBAL,
@@ -70,17 +76,17 @@ class MissionProtocol:
         stored = self._mission.items
         return stored if stored else [self.home_item()]
 
+    def _refuse_type(self, msg: Any) -> None:
+        """Fence and rally transfers: MAV_MISSION_UNSUPPORTED for that mission type."""
+        src = (msg.get_srcSystem(), msg.get_srcComponent())
+        self.session.send(
+            M.MAVLink_mission_ack_message(*src, M.MAV_MISSION_UNSUPPORTED, msg.mission_type)
+        )
+
     # --------------------------------------------------------------- upload
     def on_count(self, msg: Any) -> None:
         if msg.mission_type != M.MAV_MISSION_TYPE_MISSION:
-            self.session.send(
-                M.MAVLink_mission_ack_message(
-                    msg.get_srcSystem(),
-                    msg.get_srcComponent(),
-                    M.MAV_MISSION_UNSUPPORTED,
-                    msg.mission_type,
-                )
-            )
+            self._refuse_type(msg)
             return
         if msg.count == 0:
             self._mission.replace([])
@@ -114,10 +120,7 @@ class MissionProtocol:
         x, y = (msg.x, msg.y) if is_int else (round(msg.x * 1e7), round(msg.y * 1e7))
         frame = msg.frame
         if not is_int:  # the float frames map to their _INT twins
-            frame = {
-                M.MAV_FRAME_GLOBAL: M.MAV_FRAME_GLOBAL_INT,
-                M.MAV_FRAME_GLOBAL_RELATIVE_ALT: M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
-            }.get(frame, frame)
+            frame = _INT_FRAME.get(frame, frame)
         if msg.seq > 0 and msg.command not in SUPPORTED_COMMANDS:
             self._ack(M.MAV_MISSION_UNSUPPORTED)
             self._upload = None
@@ -166,14 +169,7 @@ class MissionProtocol:
     # --------------------------------------------------------------- download, clear
     def on_request_list(self, msg: Any) -> None:
         if msg.mission_type != M.MAV_MISSION_TYPE_MISSION:
-            self.session.send(
-                M.MAVLink_mission_ack_message(
-                    msg.get_srcSystem(),
-                    msg.get_srcComponent(),
-                    M.MAV_MISSION_UNSUPPORTED,
-                    msg.mission_type,
-                )
-            )
+            self._refuse_type(msg)
             return
         self.session.send(
             M.MAVLink_mission_count_message(
@@ -213,10 +209,7 @@ class MissionProtocol:
                 0,
             )
         else:
-            frame = {
-                M.MAV_FRAME_GLOBAL_INT: M.MAV_FRAME_GLOBAL,
-                M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT: M.MAV_FRAME_GLOBAL_RELATIVE_ALT,
-            }.get(it.frame, it.frame)
+            frame = _FLOAT_FRAME.get(it.frame, it.frame)
             out = M.MAVLink_mission_item_message(
                 *src,
                 it.seq,

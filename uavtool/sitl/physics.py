@@ -11,6 +11,8 @@ import math
 import random
 from dataclasses import dataclass, field
 
+from uavtool.geo import wrap_180
+
 GRAVITY_MSS = 9.80665
 
 
@@ -61,13 +63,6 @@ def sqrt_controller(error: float, p_gain: float, accel_max: float) -> float:
         return p_gain * error
     v = math.sqrt(2.0 * accel_max * (abs(error) - linear_dist / 2.0))
     return v if error > 0 else -v
-
-
-def wrap_180(angle_deg: float) -> float:
-    a = math.fmod(angle_deg + 180.0, 360.0)
-    if a < 0:
-        a += 360.0
-    return a - 180.0
 
 
 class Multicopter:

@@ -7,6 +7,12 @@ from enum import IntEnum
 
 from uavtool.mavlink.dialect import mavlink
 
+# Global frames by altitude reference; the float and _INT variants mean the same here.
+RELATIVE_ALT_FRAMES = frozenset(
+    {mavlink.MAV_FRAME_GLOBAL_RELATIVE_ALT, mavlink.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT}
+)
+AMSL_FRAMES = frozenset({mavlink.MAV_FRAME_GLOBAL, mavlink.MAV_FRAME_GLOBAL_INT})
+
 
 class Mode(IntEnum):
     """The ArduCopter flight modes the built-in vehicle flies (HEARTBEAT custom_mode)."""

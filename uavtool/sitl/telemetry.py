@@ -11,6 +11,7 @@ import math
 from collections.abc import Callable
 from typing import Any
 
+from uavtool.geo import wrap_180
 from uavtool.mavlink.dialect import mavlink
 from uavtool.sitl.autopilot import Autopilot
 from uavtool.sitl.state import Mode
@@ -207,7 +208,7 @@ class Telemetry:
             self.boot_ms,
             math.radians(s.roll_deg),
             math.radians(s.pitch_deg),
-            math.radians(_wrap_pi_deg(s.yaw_deg)),
+            math.radians(wrap_180(s.yaw_deg)),
             0.0,
             0.0,
             math.radians(s.yaw_rate_dps),
@@ -314,7 +315,7 @@ class Telemetry:
             | M.GIMBAL_DEVICE_FLAGS_YAW_IN_VEHICLE_FRAME
         )
         # q is in the vehicle frame; delta_yaw is the vehicle's heading, relating it to earth.
-        vehicle_yaw = math.radians(_wrap_pi_deg(self.ap.state.yaw_deg))
+        vehicle_yaw = math.radians(wrap_180(self.ap.state.yaw_deg))
         return M.MAVLink_gimbal_device_attitude_status_message(
             0, 0, self.boot_ms, flags, q, math.nan, math.nan, math.nan, 0, vehicle_yaw, math.nan, 1
         )
@@ -335,17 +336,8 @@ class Telemetry:
             | M.GIMBAL_MANAGER_CAP_FLAGS_HAS_YAW_FOLLOW
             | M.GIMBAL_MANAGER_CAP_FLAGS_HAS_YAW_LOCK
         )
-        p = self.ap.params
         return M.MAVLink_gimbal_manager_information_message(
-            self.boot_ms,
-            cap,
-            1,
-            0.0,
-            0.0,
-            math.radians(p["MNT1_PITCH_MIN"]),
-            math.radians(p["MNT1_PITCH_MAX"]),
-            math.radians(p["MNT1_YAW_MIN"]),
-            math.radians(p["MNT1_YAW_MAX"]),
+            self.boot_ms, cap, 1, 0.0, 0.0, *self._gimbal_limits_rad()
         )
 
     def gimbal_device_information(self) -> Any:
@@ -355,32 +347,17 @@ class Telemetry:
             | M.GIMBAL_DEVICE_CAP_FLAGS_HAS_YAW_AXIS
             | M.GIMBAL_DEVICE_CAP_FLAGS_HAS_YAW_FOLLOW
         )
-        p = self.ap.params
         return M.MAVLink_gimbal_device_information_message(
-            self.boot_ms,
-            b"uavtool",
-            b"sim gimbal",
-            b"",
-            0,
-            0,
-            0,
-            cap,
-            0,
-            0.0,
-            0.0,
-            math.radians(p["MNT1_PITCH_MIN"]),
-            math.radians(p["MNT1_PITCH_MAX"]),
-            math.radians(p["MNT1_YAW_MIN"]),
-            math.radians(p["MNT1_YAW_MAX"]),
-            1,
-        )
+            self.boot_ms, b"uavtool", b"sim gimbal", b"", 0, 0, 0, cap, 0, 0.0, 0.0,
+            *self._gimbal_limits_rad(), 1,
+        )  # fmt: skip
 
-
-def _wrap_pi_deg(angle_deg: float) -> float:
-    a = math.fmod(angle_deg + 180.0, 360.0)
-    if a < 0:
-        a += 360.0
-    return a - 180.0
+    def _gimbal_limits_rad(self) -> tuple[float, float, float, float]:
+        """(pitch_min, pitch_max, yaw_min, yaw_max) of the mount, radians."""
+        p = self.ap.params
+        names = ("MNT1_PITCH_MIN", "MNT1_PITCH_MAX", "MNT1_YAW_MIN", "MNT1_YAW_MAX")
+        low_pitch, high_pitch, low_yaw, high_yaw = (math.radians(p[n]) for n in names)
+        return low_pitch, high_pitch, low_yaw, high_yaw
 
 
 def _quat_from_euler(roll: float, pitch: float, yaw: float) -> list[float]:
