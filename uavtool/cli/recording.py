@@ -1,8 +1,6 @@
 """``uavtool info``, ``uavtool export`` and ``uavtool import``: inspect, repair and convert
 recordings. Heavy imports happen inside the commands so ``uavtool --help`` stays fast."""
 
-
-
 from __future__ import annotations
 
 from pathlib import Path

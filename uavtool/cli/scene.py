@@ -1,7 +1,5 @@
 """``uavtool scene``: list, validate, render and generate scenes."""
 
-
-
 from __future__ import annotations
 
 from pathlib import Path
