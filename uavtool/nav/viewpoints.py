@@ -1,0 +1,229 @@
+"""Where to take the front, right and top photos of a building (the paper's
+``calcHeadingChangeForImage``).
+
+Sides of a :class:`~uavtool.nav.rect.Rect` with long axis heading θ:
+
+* ``long-a``: the long side whose outward normal points to θ + 90° (for θ in [0, 180)
+  that is the southern half of the compass, so the first-choice front camera looks
+  north-ish); ``long-b`` is the opposite long side.
+* ``short-a``: the short side whose outward normal points to θ; ``short-b`` is opposite.
+
+A camera facing a side stands on that side's outward normal through its midpoint,
+``distance_m`` from it, and looks back along the normal. The right photo looks at the
+building with heading ``front − 90°``: the camera stands to the building's right as seen
+from the front camera. Side photos assume a horizontal camera (gimbal pitch 0).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from uavtool.camera import Intrinsics
+from uavtool.nav.errors import NavParamError
+from uavtool.nav.geometry import Point, as_points, point_polygon_distance, triangle_hits_polygon
+from uavtool.nav.rect import Rect
+
+_OPPOSITE = {"long-a": "long-b", "long-b": "long-a", "short-a": "short-b", "short-b": "short-a"}
+
+
+@dataclass(frozen=True, slots=True)
+class ViewpointParams:
+    """Parameters of :func:`plan_viewpoints`; lengths in metres."""
+
+    margin: float = 0.25
+    """Extra field of view around what must be seen, as a fraction: the camera sees
+    (1 + margin) times the side's half-length and the needed half-height."""
+    camera_alt_m: float = 6.0
+    """Altitude of the front and right photos above the ground (z = 0)."""
+    assumed_height_m: float = 12.0
+    """Tallest building height the vertical field of view must hold, ground to roof."""
+    safety_margin_m: float = 4.0
+    """Least horizontal clearance between a camera position and any other building."""
+    max_distance_m: float = 60.0
+    """Farthest a camera may stand from the side it photographs."""
+    distance_step: float = 1.25
+    """Factor by which the distance grows on each fallback round."""
+
+    def __post_init__(self) -> None:
+        checks = (
+            ("margin", self.margin >= 0.0),
+            ("camera_alt_m", self.camera_alt_m > 0.0),
+            ("assumed_height_m", self.assumed_height_m > 0.0),
+            ("safety_margin_m", self.safety_margin_m >= 0.0),
+            ("max_distance_m", self.max_distance_m > 0.0),
+            ("distance_step", self.distance_step > 1.0),
+        )
+        bounds = {"margin": "≥ 0", "safety_margin_m": "≥ 0", "distance_step": "> 1"}
+        for name, ok in checks:
+            value = getattr(self, name)
+            if not ok or not math.isfinite(value):
+                rule = bounds.get(name, "> 0")
+                raise NavParamError(f"nav.{name} must be finite and {rule}, got {value}")
+
+
+@dataclass(frozen=True, slots=True)
+class Viewpoint:
+    """A camera position (ENU metres) and heading (degrees) for one photo of the building.
+
+    ``side`` is the rectangle side it faces (see the module doc; ``top`` for the top
+    photo), ``distance_m`` its distance from that side (the altitude for ``top``),
+    ``fallback`` is empty for the first choice, else what changed (``opposite side``,
+    ``distance 1.56x``), ``pitch_deg`` the gimbal pitch to use.
+    """
+
+    name: str
+    pos_enu_m: tuple[float, float, float]
+    heading_deg: float
+    side: str
+    distance_m: float
+    fallback: str = ""
+    pitch_deg: float = 0.0
+
+
+@dataclass(frozen=True, slots=True)
+class ViewpointFailure:
+    """No allowed position for photo ``name``; ``reason`` lists each candidate and its blockers."""
+
+    name: str
+    reason: str
+
+
+def _heading(east: float, north: float) -> float:
+    h = math.degrees(math.atan2(east, north)) % 360.0
+    return 0.0 if h >= 360.0 else h + 0.0
+
+
+def _side_geometry(rect: Rect, side: str) -> tuple[Point, Point, Point]:
+    """(end 1, end 2, outward unit normal) of a rectangle side."""
+    (ax, ay), (nx, ny) = rect.axes()
+    cx, cy = rect.center_en
+    hl, hw = rect.length_m / 2.0, rect.width_m / 2.0
+    if side.startswith("long"):
+        s = 1.0 if side == "long-a" else -1.0
+        mid = (cx + s * hw * nx, cy + s * hw * ny)
+        normal, along, half = (s * nx, s * ny), (ax, ay), hl
+    else:
+        s = 1.0 if side == "short-a" else -1.0
+        mid = (cx + s * hl * ax, cy + s * hl * ay)
+        normal, along, half = (s * ax, s * ay), (nx, ny), hw
+    end1 = (mid[0] - half * along[0], mid[1] - half * along[1])
+    end2 = (mid[0] + half * along[0], mid[1] + half * along[1])
+    return end1, end2, normal
+
+
+def base_distance_m(side_length_m: float, intrinsics: Intrinsics, params: ViewpointParams) -> float:
+    """Distance at which a side of this length fills the view with the margin, horizontally
+    (half the side) and vertically (ground and ``assumed_height_m`` from ``camera_alt_m``)."""
+    tan_h = (intrinsics.width_px / 2.0) / intrinsics.fx_px
+    tan_v = (intrinsics.height_px / 2.0) / intrinsics.fy_px
+    k = 1.0 + params.margin
+    d_h = k * (side_length_m / 2.0) / tan_h
+    half_v = max(params.assumed_height_m - params.camera_alt_m, params.camera_alt_m)
+    d_v = k * half_v / tan_v
+    return max(d_h, d_v, params.safety_margin_m)
+
+
+def _ids(indices: list[int]) -> str:
+    return ("obstacle " if len(indices) == 1 else "obstacles ") + ", ".join(map(str, indices))
+
+
+def _plan_one(
+    name: str,
+    rect: Rect,
+    first_side: str,
+    obstacles: list[list[Point]],
+    intrinsics: Intrinsics,
+    params: ViewpointParams,
+) -> Viewpoint | ViewpointFailure:
+    """Try the first side, then the opposite one, at growing distances; first clear wins."""
+    side_len = rect.length_m if first_side.startswith("long") else rect.width_m
+    d0 = base_distance_m(side_len, intrinsics, params)
+    tried: list[str] = []
+    factor, rounds = 1.0, 0
+    while d0 * factor <= params.max_distance_m * (1.0 + 1e-12):
+        distance = d0 * factor
+        for side in (first_side, _OPPOSITE[first_side]):
+            end1, end2, normal = _side_geometry(rect, side)
+            mid = ((end1[0] + end2[0]) / 2.0, (end1[1] + end2[1]) / 2.0)
+            cam = (mid[0] + distance * normal[0], mid[1] + distance * normal[1])
+            near = [
+                (i, c)
+                for i, poly in enumerate(obstacles)
+                if (c := point_polygon_distance(cam, poly)) < params.safety_margin_m
+            ]
+            tri = (cam, end1, end2)
+            hidden = [i for i, poly in enumerate(obstacles) if triangle_hits_polygon(tri, poly)]
+            if not near and not hidden:
+                notes = [] if side == first_side else ["opposite side"]
+                if rounds:
+                    notes.append(f"distance {factor:.2f}x")
+                return Viewpoint(
+                    name=name,
+                    pos_enu_m=(cam[0], cam[1], params.camera_alt_m),
+                    heading_deg=_heading(-normal[0], -normal[1]),
+                    side=side,
+                    distance_m=distance,
+                    fallback=", ".join(notes),
+                )
+            why = []
+            if near:
+                clear = ", ".join(f"{i} ({c:.1f} m)" for i, c in near)
+                why.append(f"within {params.safety_margin_m:g} m of obstacle {clear}")
+            if hidden:
+                why.append(f"no line of sight ({_ids(hidden)})")
+            tried.append(f"{side} at {distance:.1f} m: " + " and ".join(why))
+        rounds += 1
+        factor *= params.distance_step
+    if not tried:
+        return ViewpointFailure(
+            name,
+            f"{name}: the base distance {d0:.1f} m exceeds nav.max_distance_m "
+            f"{params.max_distance_m:g} m",
+        )
+    return ViewpointFailure(
+        name, f"{name}: " + "; ".join(tried) + f" (tried up to {params.max_distance_m:g} m)"
+    )
+
+
+def plan_viewpoints(
+    target: Rect,
+    obstacles: Sequence[Sequence[tuple[float, float]]] | Sequence[Any],
+    intrinsics: Intrinsics,
+    params: ViewpointParams | None = None,
+) -> tuple[Viewpoint | ViewpointFailure, Viewpoint | ViewpointFailure]:
+    """The front and right viewpoints of ``target``, clear of ``obstacles``.
+
+    obstacles : other buildings' footprints, each an (n, 2) ENU ring.
+    Front faces ``long-a`` first, right the short side at heading front − 90°; each
+    candidate must keep ``safety_margin_m`` from every obstacle and see its whole side
+    past them (obstacles are treated as infinitely tall). Fallbacks: the opposite side,
+    then both sides at distances grown by ``distance_step`` up to ``max_distance_m``.
+    When the front has no position, the right photo is planned against the first-choice
+    front heading.
+    """
+    params = params or ViewpointParams()
+    polys = [as_points(p, what=f"obstacles[{i}]") for i, p in enumerate(obstacles)]
+    front = _plan_one("front", target, "long-a", polys, intrinsics, params)
+    front_side = front.side if isinstance(front, Viewpoint) else "long-a"
+    # long-a looks along θ − 90, so its right camera looks along θ − 180: it faces short-a
+    # (outward normal θ); symmetrically long-b → short-b.
+    right_side = "short-a" if front_side == "long-a" else "short-b"
+    right = _plan_one("right", target, right_side, polys, intrinsics, params)
+    return front, right
+
+
+def top_viewpoint(target: Rect, front_heading_deg: float, *, alt_m: float) -> Viewpoint:
+    """The nadir photo above the rectangle's centre, camera heading = the front photo's."""
+    cx, cy = target.center_en
+    return Viewpoint(
+        name="top",
+        pos_enu_m=(cx, cy, float(alt_m)),
+        heading_deg=float(front_heading_deg) % 360.0,
+        side="top",
+        distance_m=float(alt_m),
+        fallback="",
+        pitch_deg=-90.0,
+    )
