@@ -1,0 +1,234 @@
+"""Front/right/top viewpoints: hand-checked positions, each fallback, and the built-in scenes."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from uavtool.camera import CameraPose, Intrinsics, project
+from uavtool.errors import InputError
+from uavtool.nav import (
+    NavParamError,
+    Rect,
+    Viewpoint,
+    ViewpointFailure,
+    ViewpointParams,
+    min_area_rect,
+    plan_viewpoints,
+    top_viewpoint,
+)
+from uavtool.world import building_footprint, load_scene
+
+K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
+P = ViewpointParams()
+# 10 m east–west by 8 m, centred on home: long-a is the south side, short-a the east side.
+BOX = Rect((0.0, 0.0), 90.0, 10.0, 8.0)
+# Vertical fit decides: (1 + 0.25) · max(12 − 6, 6) / tan(vfov/2), tan(vfov/2) = 0.75 tan 30°.
+D0 = 10.0 * math.sqrt(3.0)
+
+
+def square(cx: float, cy: float, half: float) -> list[tuple[float, float]]:
+    return [
+        (cx - half, cy - half),
+        (cx + half, cy - half),
+        (cx + half, cy + half),
+        (cx - half, cy + half),
+    ]
+
+
+def plan(obstacles, params: ViewpointParams = P):
+    front, right = plan_viewpoints(BOX, obstacles, K, params)
+    return front, right
+
+
+def assert_view(v, *, pos, heading, side, distance, fallback="") -> None:
+    assert isinstance(v, Viewpoint), v
+    assert v.pos_enu_m == pytest.approx(pos, abs=1e-9)
+    assert v.heading_deg == pytest.approx(heading, abs=1e-9)
+    assert (v.side, v.fallback) == (side, fallback)
+    assert v.distance_m == pytest.approx(distance)
+
+
+def test_free_field() -> None:
+    front, right = plan([])
+    assert_view(front, pos=(0.0, -4.0 - D0, 6.0), heading=0.0, side="long-a", distance=D0)
+    # right = front − 90: the camera east of the building, looking west
+    assert_view(right, pos=(5.0 + D0, 0.0, 6.0), heading=270.0, side="short-a", distance=D0)
+
+
+def test_long_building_is_fitted_horizontally() -> None:
+    long_box = Rect((0.0, 0.0), 0.0, 40.0, 6.0)  # 40 m north–south
+    front, _ = plan_viewpoints(long_box, [], K, P)
+    d = 1.25 * 20.0 / math.tan(math.radians(30.0))
+    # long axis north: long-a faces east, the camera looks west
+    assert_view(front, pos=(3.0 + d, 0.0, 6.0), heading=270.0, side="long-a", distance=d)
+
+
+@pytest.mark.parametrize(("axis_deg", "front_heading"), [(90.0, 0.0), (30.0, 300.0), (150.0, 60.0)])
+def test_views_see_the_whole_side(axis_deg: float, front_heading: float) -> None:
+    rect = Rect((5.0, -3.0), axis_deg, 14.0, 6.0)
+    front, right = plan_viewpoints(rect, [], K, P)
+    assert isinstance(front, Viewpoint)
+    assert isinstance(right, Viewpoint)
+    assert front.heading_deg == pytest.approx(front_heading)
+    assert right.heading_deg == pytest.approx((front_heading - 90.0) % 360.0)
+    # every corner of the rectangle, at the ground and at the assumed height, is in the image
+    corners = [(x, y, z) for x, y in rect.corners() for z in (0.0, P.assumed_height_m)]
+    for v in (front, right):
+        px = project(np.array(corners), CameraPose(v.pos_enu_m, v.heading_deg, 0.0), K)
+        assert np.all(px[:, 2] > 0)
+        assert np.all((px[:, 0] >= -0.5) & (px[:, 0] <= 639.5))
+        assert np.all((px[:, 1] >= -0.5) & (px[:, 1] <= 479.5))
+
+
+def test_obstacle_at_the_front_camera_gives_the_opposite_side() -> None:
+    front, right = plan([square(0.0, -4.0 - D0, 3.0)])
+    assert_view(
+        front,
+        pos=(0.0, 4.0 + D0, 6.0),
+        heading=180.0,
+        side="long-b",
+        distance=D0,
+        fallback="opposite side",
+    )
+    # right is relative to the actual front heading: 180 − 90 = 90, camera west of the building
+    assert_view(right, pos=(-5.0 - D0, 0.0, 6.0), heading=90.0, side="short-b", distance=D0)
+
+
+def test_line_of_sight_blocked_but_camera_clear() -> None:
+    wall = [(-1.0, -12.0), (1.0, -12.0), (1.0, -11.0), (-1.0, -11.0)]  # 9 m from the camera
+    front, _ = plan([wall])
+    assert_view(
+        front,
+        pos=(0.0, 4.0 + D0, 6.0),
+        heading=180.0,
+        side="long-b",
+        distance=D0,
+        fallback="opposite side",
+    )
+    walls = [wall, [(x, -y) for x, y in wall]]
+    front, right = plan(walls, ViewpointParams(max_distance_m=20.0))  # base distance only
+    assert isinstance(front, ViewpointFailure)
+    assert front.reason == (
+        "front: long-a at 17.3 m: no line of sight (obstacle 0); "
+        "long-b at 17.3 m: no line of sight (obstacle 1) (tried up to 20 m)"
+    )
+    assert_view(right, pos=(5.0 + D0, 0.0, 6.0), heading=270.0, side="short-a", distance=D0)
+
+
+def test_obstacles_by_both_long_side_cameras_give_a_larger_distance() -> None:
+    # 3 m east of each base camera position, outside the line of sight; clear at 1.25 × D0
+    posts = [
+        [(3.0, y - 1.0), (5.0, y - 1.0), (5.0, y + 1.0), (3.0, y + 1.0)]
+        for y in (-4.0 - D0, 4.0 + D0)
+    ]
+    front, right = plan(posts)
+    assert_view(
+        front,
+        pos=(0.0, -4.0 - 1.25 * D0, 6.0),
+        heading=0.0,
+        side="long-a",
+        distance=1.25 * D0,
+        fallback="distance 1.25x",
+    )
+    assert_view(right, pos=(5.0 + D0, 0.0, 6.0), heading=270.0, side="short-a", distance=D0)
+
+
+def test_fully_boxed_in() -> None:
+    walls = [
+        [(-20, -10), (20, -10), (20, -9), (-20, -9)],
+        [(-20, 9), (20, 9), (20, 10), (-20, 10)],
+        [(-10, -8), (-9, -8), (-9, 8), (-10, 8)],
+        [(9, -8), (10, -8), (10, 8), (9, 8)],
+    ]
+    front, right = plan(walls)
+    assert isinstance(front, ViewpointFailure)
+    assert isinstance(right, ViewpointFailure)
+    assert front.reason.startswith(
+        "front: long-a at 17.3 m: no line of sight (obstacle 0); long-b at 17.3 m"
+    )
+    assert "long-b at 52.9 m: no line of sight (obstacle 1)" in front.reason  # 17.3 · 1.25⁵
+    assert front.reason.endswith("(tried up to 60 m)")
+    assert "obstacle 3" in right.reason and "obstacle 2" in right.reason
+
+
+def test_camera_inside_an_obstacle_is_named() -> None:
+    front, _ = plan(
+        [[(-30, -40), (30, -40), (30, 40), (-30, 40)]], ViewpointParams(max_distance_m=18.0)
+    )
+    assert isinstance(front, ViewpointFailure)
+    assert (
+        "long-a at 17.3 m: within 4 m of obstacle 0 (0.0 m) and no line of sight (obstacle 0)"
+        in front.reason
+    )
+
+
+def test_base_distance_beyond_the_limit() -> None:
+    front, _ = plan([], ViewpointParams(max_distance_m=10.0))
+    assert front == ViewpointFailure(
+        "front", "front: the base distance 17.3 m exceeds nav.max_distance_m 10 m"
+    )
+
+
+def test_top_viewpoint() -> None:
+    v = top_viewpoint(BOX, 180.0, alt_m=20.0)
+    assert v == Viewpoint("top", (0.0, 0.0, 20.0), 180.0, "top", 20.0, "", -90.0)
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [
+        ("margin", -0.1),
+        ("camera_alt_m", 0.0),
+        ("assumed_height_m", -1.0),
+        ("safety_margin_m", -1.0),
+        ("max_distance_m", math.inf),
+        ("distance_step", 1.0),
+        ("margin", math.nan),
+    ],
+)
+def test_params_are_validated(field: str, value: float) -> None:
+    with pytest.raises(NavParamError, match=f"nav.{field} must"):
+        ViewpointParams(**{field: value})
+    assert issubclass(NavParamError, InputError)
+
+
+def scene_plan(name: str):
+    scene = load_scene(name)
+    fp = building_footprint(scene.building(scene.target))
+    rect = min_area_rect(list(fp.exterior.coords))
+    others = [
+        list(building_footprint(b).exterior.coords)
+        for b in scene.buildings
+        if b.name != scene.target
+    ]
+    return plan_viewpoints(rect, others, K, P)
+
+
+def test_paper_scene_needs_no_fallback() -> None:
+    front, right = scene_plan("paper")
+    assert_view(front, pos=(10.0, -12.0 - D0, 6.0), heading=0.0, side="long-a", distance=D0)
+    assert_view(right, pos=(15.0 + D0, -8.0, 6.0), heading=270.0, side="short-a", distance=D0)
+
+
+def test_blocked_front_scene_falls_back_to_the_north() -> None:
+    front, right = scene_plan("blocked-front")
+    assert_view(
+        front,
+        pos=(10.0, -4.0 + D0, 6.0),
+        heading=180.0,
+        side="long-b",
+        distance=D0,
+        fallback="opposite side",
+    )
+    # right of a north camera is west, where the blue building stands: east side instead
+    assert_view(
+        right,
+        pos=(15.0 + D0, -8.0, 6.0),
+        heading=270.0,
+        side="short-a",
+        distance=D0,
+        fallback="opposite side",
+    )
