@@ -4,8 +4,8 @@ Evenly spaced points rarely fall exactly on a corner, so RDP keeps a point next 
 two, one on each side (a split corner). Here every edge of the simplified ring that spans
 enough of the dense points gets a least-squares line through them; a corner becomes the
 intersection of two consecutive such lines, and edges too short to fit (the stub between
-the two halves of a split corner) disappear. Scalars use ``math`` and ``math.fsum``, so the
-result is the same on every machine.
+the two halves of a split corner) disappear. Sums use ``math.fsum`` and scalars ``math``
+(numpy only for element-wise products), so the result is the same on every machine.
 """
 
 from __future__ import annotations
@@ -19,6 +19,9 @@ from uavtool.vision.shapes import FloatArray
 # Consecutive lines closer to parallel than this (sine of the angle) do not make a corner.
 _MIN_SINE = 0.05
 
+Line = tuple[float, float, float, float]  # centre x, y and unit direction x, y
+Span = tuple[int, int]  # first and last dense index of an edge (cyclic)
+
 
 def refine_corners(
     dense_px: FloatArray, kept: list[int], *, min_edge_px: float, max_shift_px: float
@@ -30,16 +33,48 @@ def refine_corners(
     refined corner further than ``max_shift_px`` from the RDP vertex it replaces (nearly
     parallel edges) falls back to that vertex.
     """
-    n, m = len(dense_px), len(kept)
+    return refine_rings([dense_px], [kept], min_edge_px=min_edge_px, max_shift_px=max_shift_px)[0]
+
+
+def refine_rings(
+    dense_px: list[FloatArray], kept: list[list[int]], *, min_edge_px: float, max_shift_px: float
+) -> list[FloatArray]:
+    """:func:`refine_corners` of several rings at once (the line fits share array calls)."""
+    points = [d.tolist() for d in dense_px]
+    spans = [_long_edges(pts, k, min_edge_px) for pts, k in zip(points, kept, strict=True)]
+    lines = _fit_spans(dense_px, spans)
+    out: list[FloatArray] = []
+    for r, dense in enumerate(dense_px):
+        if len(kept[r]) < 3:
+            out.append(dense[kept[r]].copy())
+            continue
+        corners = _corners(dense, points[r], spans[r], lines[r], max_shift_px)
+        out.append(dense[kept[r]].copy() if corners is None else corners)
+    return out
+
+
+def _long_edges(pts: list[list[float]], kept: list[int], min_edge_px: float) -> list[Span]:
+    """The edges of the RDP ring long enough to fit a line to."""
+    n, m = len(pts), len(kept)
     if m < 3:
-        return dense_px[kept].copy()
-    spans: list[tuple[int, int]] = []  # (first, last) dense indices of each long edge
+        return []
+    spans: list[Span] = []
     for e in range(m):
         first, last = kept[e], kept[(e + 1) % m]
-        chord = dense_px[last] - dense_px[first]
-        if (last - first) % n >= 2 and math.hypot(float(chord[0]), float(chord[1])) >= min_edge_px:
+        (x0, y0), (x1, y1) = pts[first], pts[last]
+        if (last - first) % n >= 2 and math.hypot(x1 - x0, y1 - y0) >= min_edge_px:
             spans.append((first, last))
-    lines = [_fit_span(dense_px, first, last) for first, last in spans]
+    return spans
+
+
+def _corners(
+    dense: FloatArray,
+    pts: list[list[float]],
+    spans: list[Span],
+    lines: list[Line],
+    max_shift_px: float,
+) -> FloatArray | None:
+    """Intersections of consecutive fitted lines (None: too few lines for a polygon)."""
     # Merge neighbouring edges that are one straight line (a vertex RDP kept for a rounded
     # or noisy stretch), refitting the merged span, until none is left.
     k = 0
@@ -48,64 +83,83 @@ def refine_corners(
         (_, _, dx1, dy1), (_, _, dx2, dy2) = lines[k], lines[j]
         if abs(dx1 * dy2 - dy1 * dx2) < _MIN_SINE and dx1 * dx2 + dy1 * dy2 > 0.0:
             spans[k] = (spans[k][0], spans[j][1])
-            lines[k] = _fit_span(dense_px, *spans[k])
+            lines[k] = _fit_spans([dense], [[spans[k]]])[0][0]
             del spans[j], lines[j]
             k = max(k - 1, 0) if j > k else k - 1
             continue
         k += 1
     if len(lines) < 3:
-        return dense_px[kept].copy()
+        return None
     corners: list[tuple[float, float]] = []
     for k in range(len(lines)):
         cx1, cy1, dx1, dy1 = lines[k - 1]
         cx2, cy2, dx2, dy2 = lines[k]
         end_prev, start_next = spans[k - 1][1], spans[k][0]
+        vx, vy = pts[end_prev]
         cross = dx1 * dy2 - dy1 * dx2
         if abs(cross) < _MIN_SINE:
             # Parallel edges joined by a stub (a small step): keep the stub's ends.
-            corners.append(tuple(dense_px[end_prev].tolist()))
+            corners.append((vx, vy))
             if start_next != end_prev:
-                corners.append(tuple(dense_px[start_next].tolist()))
+                wx, wy = pts[start_next]
+                corners.append((wx, wy))
             continue
         t = ((cx2 - cx1) * dy2 - (cy2 - cy1) * dx2) / cross
         px, py = cx1 + t * dx1, cy1 + t * dy1
-        vx, vy = dense_px[end_prev].tolist()
         if math.hypot(px - vx, py - vy) > max_shift_px:
             corners.append((vx, vy))
         else:
             corners.append((px, py))
     if len(corners) < 3:
-        return dense_px[kept].copy()
+        return None
     return np.array(corners, dtype=np.float64)
 
 
-def _fit_span(dense_px: FloatArray, first: int, last: int) -> tuple[float, float, float, float]:
-    """Line through the dense points ``first`` … ``last`` (cyclic), without the end points
-    when there are enough (an RDP vertex next to a corner may lie on the next edge)."""
-    n = len(dense_px)
-    count = (last - first) % n + 1
-    trim = 1 if count >= 6 else 0
-    idx = [(first + t) % n for t in range(trim, count - trim)]
-    cx, cy, dx, dy = _fit_line(dense_px[idx])
-    # Point the (unoriented) fitted axis the way the outline runs, so that antiparallel
-    # edges (the two sides of a narrow slot) are never taken for one straight line.
-    chord = dense_px[last] - dense_px[first]
-    if dx * float(chord[0]) + dy * float(chord[1]) < 0.0:
-        dx, dy = -dx, -dy
-    return cx, cy, dx, dy
-
-
-def _fit_line(pts: FloatArray) -> tuple[float, float, float, float]:
-    """Total-least-squares line through points ``(k, 2)``: centre and unit direction."""
-    xs = pts[:, 0].tolist()
-    ys = pts[:, 1].tolist()
-    k = len(xs)
-    cx = math.fsum(xs) / k
-    cy = math.fsum(ys) / k
-    dxs = [x - cx for x in xs]
-    dys = [y - cy for y in ys]
-    sxx = math.fsum(d * d for d in dxs)
-    syy = math.fsum(d * d for d in dys)
-    sxy = math.fsum(a * b for a, b in zip(dxs, dys, strict=True))
-    angle = 0.5 * math.atan2(2.0 * sxy, sxx - syy)
-    return cx, cy, math.cos(angle), math.sin(angle)
+def _fit_spans(dense_px: list[FloatArray], spans: list[list[Span]]) -> list[list[Line]]:
+    """A total-least-squares line through the dense points of each span, without the end
+    points when there are enough (an RDP vertex next to a corner may lie on the next edge),
+    its direction pointing the way the outline runs — so the two antiparallel sides of a
+    narrow slot are never taken for one straight line."""
+    starts: list[int] = []
+    counts: list[int] = []
+    base = 0
+    for dense, ring_spans in zip(dense_px, spans, strict=True):
+        n = len(dense)
+        for first, last in ring_spans:
+            count = (last - first) % n + 1
+            trim = 1 if count >= 6 else 0
+            starts.append(base + first + trim)
+            counts.append(count - 2 * trim)
+        base += 2 * n
+    if not starts:
+        return [[] for _ in spans]
+    # Each ring doubled so a span running past the last point is a plain slice.
+    xs = np.concatenate([np.concatenate([d[:, 0], d[:, 0]]) for d in dense_px])
+    ys = np.concatenate([np.concatenate([d[:, 1], d[:, 1]]) for d in dense_px])
+    count_arr = np.array(counts)
+    offsets = np.cumsum(count_arr) - count_arr
+    idx = np.arange(int(count_arr.sum())) + np.repeat(np.array(starts) - offsets, count_arr)
+    gx, gy = xs[idx], ys[idx]
+    gxl, gyl = gx.tolist(), gy.tolist()
+    bounds = list(zip(offsets.tolist(), (offsets + count_arr).tolist(), strict=True))
+    cxs = [math.fsum(gxl[a:b]) / (b - a) for a, b in bounds]
+    cys = [math.fsum(gyl[a:b]) / (b - a) for a, b in bounds]
+    dx = gx - np.repeat(np.array(cxs), count_arr)
+    dy = gy - np.repeat(np.array(cys), count_arr)
+    sxx_t, syy_t, sxy_t = (dx * dx).tolist(), (dy * dy).tolist(), (dx * dy).tolist()
+    out: list[list[Line]] = []
+    s = 0
+    for dense, ring_spans in zip(dense_px, spans, strict=True):
+        ring_lines: list[Line] = []
+        for first, last in ring_spans:
+            a, b = bounds[s]
+            sxx, syy, sxy = math.fsum(sxx_t[a:b]), math.fsum(syy_t[a:b]), math.fsum(sxy_t[a:b])
+            angle = 0.5 * math.atan2(2.0 * sxy, sxx - syy)
+            ux, uy = math.cos(angle), math.sin(angle)
+            chord = dense[last] - dense[first]
+            if ux * float(chord[0]) + uy * float(chord[1]) < 0.0:
+                ux, uy = -ux, -uy
+            ring_lines.append((cxs[s], cys[s], ux, uy))
+            s += 1
+        out.append(ring_lines)
+    return out

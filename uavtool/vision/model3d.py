@@ -28,10 +28,10 @@ import trimesh
 
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.geo import wrap_180
+from uavtool.vision.colour import hue_distance_deg
 from uavtool.vision.errors import ModelInputError
 from uavtool.vision.params import ModelParams
 from uavtool.vision.shapes import FloatArray, Shape
-from uavtool.vision.vectorize import hue_distance_deg
 
 # Depth range of the side viewing cones, metres along the optical axis.
 _NEAR_M = 0.25

@@ -3,34 +3,39 @@
 ``vectorize(frame_rgb, params)`` is pure: the same frame and parameters give bit-identical
 shapes on any machine. OpenCV does the integer work (HSV, masks, contour tracing) and is run
 single-threaded; everything after the contour is IEEE float64 arithmetic in a fixed order.
+
+Only the bounding box of the pixels that have a colour at all is classified and traced —
+the rest of the frame cannot hold a shape — and the borders of all colours are simplified
+together (:mod:`uavtool.vision.outline`).
 """
 
 from __future__ import annotations
 
-import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import cv2
 import numpy as np
 import numpy.typing as npt
 
-from uavtool.vision.corners import refine_corners
+from uavtool.vision.colour import brightest_shade, hue_distance_deg, hue_lut, hue_of
 from uavtool.vision.errors import ImageError
+from uavtool.vision.outline import offset_ring, resample_ring, simplify_rings
 from uavtool.vision.params import VectorizeParams
-from uavtool.vision.rdp import rdp_ring_indices
 from uavtool.vision.shapes import FloatArray, Shape, orient
 
 U8Array = npt.NDArray[np.uint8]
 # What OpenCV returns (its stubs type every array loosely).
 CvArray = npt.NDArray[Any]
 
-# OpenCV's full-range HSV: hue 0–255 covers the 360° circle.
-_HUE_BINS = 256
-_DEG_PER_BIN = 360.0 / _HUE_BINS
-# A run of occupied hue bins may have gaps this wide and still be one colour.
-_MAX_GAP_BINS = 2
-# Mitre joins of the edge offset are clamped to this many offsets (spikes at sharp turns).
-_MAX_MITRE = 3.0
+__all__ = [
+    "CvArray",
+    "U8Array",
+    "hue_distance_deg",
+    "hue_of",
+    "offset_ring",
+    "resample_ring",
+    "vectorize",
+]
 
 
 def vectorize(frame_rgb: U8Array, params: VectorizeParams | None = None) -> tuple[Shape, ...]:
@@ -42,103 +47,48 @@ def vectorize(frame_rgb: U8Array, params: VectorizeParams | None = None) -> tupl
     p = params if params is not None else VectorizeParams()
     frame = _check_frame(frame_rgb)
     cv2.setNumThreads(1)
-    hsv = cv2.cvtColor(frame, cv2.COLOR_RGB2HSV_FULL)
-    valid = cv2.inRange(hsv, (0, p.min_saturation, p.min_value), (255, 255, 255))
-    lut = hue_lut(hsv, valid, p)
+    hue, sat, val = cv2.split(cv2.cvtColor(frame, cv2.COLOR_RGB2HSV_FULL))
+    valid = cv2.bitwise_and(
+        cv2.threshold(sat, p.min_saturation - 1, 255, cv2.THRESH_BINARY)[1],
+        cv2.threshold(val, p.min_value - 1, 255, cv2.THRESH_BINARY)[1],
+    )
+    x, y, w, h = cv2.boundingRect(valid)
+    if w == 0:
+        return ()
+    # Work on the box around every pixel with a colour, grown by the median filter's
+    # reach: outside it the class image is 0 before and after filtering.
+    grow = max(p.denoise_px // 2, 1)
+    x0, y0 = max(x - grow, 0), max(y - grow, 0)
+    x1, y1 = min(x + w + grow, frame.shape[1]), min(y + h + grow, frame.shape[0])
+    box = (slice(y0, y1), slice(x0, x1))
+    hue, valid = hue[box], valid[box]
+    lut = hue_lut(hue, valid, p)
     n_classes = int(lut.max())
     if n_classes == 0:
         return ()
-    classes = cv2.bitwise_and(cv2.LUT(cv2.extractChannel(hsv, 0), lut), valid)
+    classes = cv2.bitwise_and(cv2.LUT(hue, lut), valid)
     if p.denoise_px > 1:
         # The median of class ids is always one of the ids present, so no class is invented.
         classes = cv2.medianBlur(classes, p.denoise_px)
-    shapes: list[Shape] = []
+    regions: list[_Region] = []
     for k in range(1, n_classes + 1):
         mask = cv2.inRange(classes, k, k)
         if p.roof_only:
-            mask = _brightest_shade(hsv, mask, p)
-        found = _shapes_in_mask(frame, mask, p)
-        shapes.extend(sorted(found, key=lambda s: -s.area_px))
-    return tuple(shapes)
-
-
-def hue_lut(hsv: CvArray, valid: CvArray, params: VectorizeParams) -> U8Array:
-    """A 256-entry table from full-range hue to colour class (0 = none, 1…k).
-
-    With a palette, class ``i+1`` is the hues within the tolerance of palette colour ``i``
-    (the nearest colour wins where windows overlap). Without one, each circular run of
-    occupied hue-histogram bins holding at least ``min_area_px`` pixels is a class.
-    """
-    lut = np.zeros(_HUE_BINS, dtype=np.uint8)
-    if params.palette_rgb:
-        best = np.full(_HUE_BINS, np.inf)
-        bins = np.arange(_HUE_BINS, dtype=np.float64)
-        for i, colour in enumerate(params.palette_rgb):
-            centre = float(hue_of(colour)) / _DEG_PER_BIN
-            d = np.abs(bins - centre)
-            d = np.minimum(d, _HUE_BINS - d) * _DEG_PER_BIN
-            take = (d <= params.hue_tolerance_deg) & (d < best)
-            lut[take] = i + 1
-            best[take] = d[take]
-        return lut
-    hist = cv2.calcHist([hsv], [0], valid, [_HUE_BINS], [0, _HUE_BINS]).ravel()
-    occupied = hist >= max(2.0, params.min_area_px / 50.0)
-    if not occupied.any():
-        return lut
-    if occupied.all():
-        lut[:] = 1
-        return lut
-    # Start the circular scan at an empty bin so no run wraps around the start.
-    start = int(np.argmin(occupied))
-    runs: list[list[int]] = []
-    gap = _MAX_GAP_BINS + 1
-    for step in range(_HUE_BINS):
-        b = (start + step) % _HUE_BINS
-        if occupied[b]:
-            if gap > _MAX_GAP_BINS:
-                runs.append([])
-            runs[-1].extend(range(b - gap, b) if gap <= _MAX_GAP_BINS else ())
-            runs[-1].append(b)
-            gap = 0
-        else:
-            gap += 1
-    k = 0
-    for run in runs:
-        idx = [b % _HUE_BINS for b in run]
-        if math.fsum(hist[idx].tolist()) >= params.min_area_px:
-            k += 1
-            lut[idx] = k
-    return lut
-
-
-def _brightest_shade(hsv: CvArray, mask: CvArray, p: VectorizeParams) -> CvArray:
-    """The part of ``mask`` in the brightest shade of its colour.
-
-    Flat shading gives each face orientation one brightness; a roof faces the sky and is
-    brighter than every wall, so from above this keeps the roofs and drops the walls that
-    perspective shows around them.
-    """
-    hist = cv2.calcHist([hsv], [2], mask, [256], [0, 256]).ravel()
-    total = float(hist.sum())
-    if total == 0.0:
-        return mask
-    # The brightest value holding a real share of the pixels (not a few noisy ones).
-    cum = np.cumsum(hist[::-1])
-    top = 255 - int(np.argmax(cum >= max(p.min_area_px, 0.02 * total)))
-    bright = cv2.inRange(cv2.extractChannel(hsv, 2), max(0, top - p.roof_value_tolerance), 255)
-    return cv2.bitwise_and(mask, bright)
-
-
-def hue_of(colour_rgb: tuple[int, int, int]) -> int:
-    """Full-range (0–255) OpenCV hue of one RGB colour."""
-    px = np.array([[colour_rgb]], dtype=np.uint8)
-    return int(cv2.cvtColor(px, cv2.COLOR_RGB2HSV_FULL)[0, 0, 0])
-
-
-def hue_distance_deg(a_rgb: tuple[int, int, int], b_rgb: tuple[int, int, int]) -> float:
-    """Circular hue difference of two colours, degrees in [0, 180]."""
-    d = abs(hue_of(a_rgb) - hue_of(b_rgb))
-    return min(d, _HUE_BINS - d) * _DEG_PER_BIN
+            mask = brightest_shade(val[box], mask, p)
+        regions.extend(_regions(mask, (x0, y0), frame.shape[:2], k, p))
+    rings = simplify_rings([c for r in regions for c in (r.outer, *r.holes)], p)
+    shapes: list[tuple[int, float, int, Shape]] = []
+    at = 0
+    for order, r in enumerate(regions):
+        outer, holes = rings[at], rings[at + 1 : at + 1 + len(r.holes)]
+        at += 1 + len(r.holes)
+        if len(outer) < 3:
+            continue
+        shape = _offset_shape(outer, tuple(h for h in holes if len(h) >= 3), r.cut, p)
+        colour = _inside_colour(frame, r, shape)
+        shapes.append((r.colour_class, -shape.area_px, order, _with_colour(shape, colour)))
+    shapes.sort(key=lambda t: t[:3])
+    return tuple(s for *_, s in shapes)
 
 
 def _check_frame(frame_rgb: U8Array) -> U8Array:
@@ -150,138 +100,108 @@ def _check_frame(frame_rgb: U8Array) -> U8Array:
     return np.ascontiguousarray(arr)
 
 
-def _shapes_in_mask(frame: U8Array, mask: CvArray, p: VectorizeParams) -> list[Shape]:
-    contours, hierarchy = cv2.findContours(mask, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_NONE)
+class _Region(NamedTuple):
+    """One traced region: its border and hole borders (frame pixels), before simplifying."""
+
+    colour_class: int
+    contour: CvArray  # (n, 1, 2) int32, as OpenCV traced it
+    outer: CvArray  # (n, 2)
+    holes: tuple[CvArray, ...]
+    cut: bool
+    mask: CvArray  # the colour's mask over the working box
+    origin: tuple[int, int]  # the box's top-left corner in the frame
+
+
+def _regions(
+    mask: CvArray, origin: tuple[int, int], frame_hw: tuple[int, int], k: int, p: VectorizeParams
+) -> list[_Region]:
+    """The regions of a colour mask large enough to keep, with their holes."""
+    contours, hierarchy = cv2.findContours(
+        mask, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_NONE, offset=origin
+    )
     if len(contours) == 0:
         return []
-    h, w = mask.shape
-    tree = hierarchy[0]
-    shapes: list[Shape] = []
+    h, w = frame_hw
+    tree = hierarchy[0].tolist()
+    out: list[_Region] = []
     for i, contour in enumerate(contours):
         if tree[i][3] != -1:
             continue  # a hole; handled with its parent
         if cv2.contourArea(contour) + 0.5 * len(contour) < p.min_area_px:
             continue
-        pts = contour[:, 0, :]
-        cut = bool(
-            (pts[:, 0] == 0).any()
-            or (pts[:, 1] == 0).any()
-            or (pts[:, 0] == w - 1).any()
-            or (pts[:, 1] == h - 1).any()
-        )
-        holes: list[FloatArray] = []
-        child = int(tree[i][2])
+        bx, by, bw, bh = cv2.boundingRect(contour)
+        cut = bx == 0 or by == 0 or bx + bw == w or by + bh == h
+        holes: list[CvArray] = []
+        child = tree[i][2]
         while child != -1:
             hole = contours[child]
             if cv2.contourArea(hole) - 0.5 * len(hole) >= p.min_hole_area_px:
-                ring = _simplify(hole[:, 0, :], p)
-                if len(ring) >= 3:
-                    holes.append(ring)
-            child = int(tree[child][0])
-        outer = _simplify(pts, p)
-        if len(outer) < 3:
-            continue
-        shape = _offset_shape(outer, tuple(holes), cut, p.edge_offset_px)
-        colour = _inside_colour(frame, mask, contour, shape)
-        shapes.append(
-            Shape(colour, shape.polygon_px, shape.holes_px, shape.area_px, shape.centroid_px, cut)
-        )
-    return shapes
-
-
-def _simplify(contour_px: CvArray, p: VectorizeParams) -> FloatArray:
-    """Evenly spaced points along a closed pixel contour, then RDP, then corner refinement."""
-    dense = resample_ring(contour_px.astype(np.float64), p.point_spacing_px)
-    kept = rdp_ring_indices(dense, p.rdp_epsilon_px)
-    if not p.refine_corners:
-        out: FloatArray = dense[kept]
-        return out
-    return refine_corners(
-        dense,
-        kept.tolist(),
-        min_edge_px=p.min_edge_px,
-        max_shift_px=p.min_edge_px + p.point_spacing_px + p.rdp_epsilon_px,
-    )
-
-
-def resample_ring(ring_px: FloatArray, spacing_px: float) -> FloatArray:
-    """Points every ``spacing_px`` (adjusted to divide the length evenly) along a closed ring."""
-    closed = np.concatenate([ring_px, ring_px[:1]])
-    d = np.diff(closed, axis=0)
-    seg = np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1])
-    cum = np.concatenate([[0.0], np.cumsum(seg)])
-    total = float(cum[-1])
-    n = max(3, round(total / spacing_px))
-    if total == 0.0:
-        return ring_px[:1].copy()
-    s = np.arange(n, dtype=np.float64) * (total / n)
-    return np.stack([np.interp(s, cum, closed[:, 0]), np.interp(s, cum, closed[:, 1])], axis=1)
-
-
-def offset_ring(ring_px: FloatArray, offset_px: float) -> FloatArray:
-    """Move every edge of a ring by ``offset_px`` along its normal ``(dy, −dx)``.
-
-    For the orientations :class:`Shape` uses (outer ring positive, holes negative) this
-    moves every edge away from the filled region.
-    """
-    if offset_px == 0.0 or len(ring_px) < 3:
-        return ring_px
-    d_next = np.concatenate([ring_px[1:], ring_px[:1]]) - ring_px
-    length = np.sqrt(d_next[:, 0] * d_next[:, 0] + d_next[:, 1] * d_next[:, 1])
-    length[length == 0.0] = 1.0
-    normal = np.stack([d_next[:, 1] / length, -d_next[:, 0] / length], axis=1)
-    n_prev = np.concatenate([normal[-1:], normal[:-1]])
-    dot = normal[:, 0] * n_prev[:, 0] + normal[:, 1] * n_prev[:, 1]
-    # Intersection of the two moved edge lines: offset · (n1 + n2) / (1 + n1·n2).
-    denom = np.maximum(1.0 + dot, 2.0 / (_MAX_MITRE * _MAX_MITRE))
-    scale = offset_px / denom
-    out: FloatArray = ring_px + (normal + n_prev) * scale[:, None]
+                holes.append(hole[:, 0, :])
+            child = tree[child][0]
+        out.append(_Region(k, contour, contour[:, 0, :], tuple(holes), cut, mask, origin))
     return out
 
 
 def _offset_shape(
-    outer: FloatArray, holes: tuple[FloatArray, ...], cut: bool, offset_px: float
+    outer: FloatArray, holes: tuple[FloatArray, ...], cut: bool, p: VectorizeParams
 ) -> Shape:
     outer = orient(outer, positive=True)
     holes = tuple(orient(h, positive=False) for h in holes)
     return Shape.from_rings(
         colour_rgb=(0, 0, 0),
-        polygon_px=offset_ring(outer, offset_px),
-        holes_px=tuple(offset_ring(h, offset_px) for h in holes),
+        polygon_px=offset_ring(outer, p.edge_offset_px),
+        holes_px=tuple(offset_ring(h, p.edge_offset_px) for h in holes),
         cut_by_border=cut,
     )
 
 
-def _inside_colour(
-    frame: U8Array, mask: CvArray, contour: CvArray, shape: Shape
-) -> tuple[int, int, int]:
+def _with_colour(shape: Shape, colour_rgb: tuple[int, int, int]) -> Shape:
+    return Shape(
+        colour_rgb,
+        shape.polygon_px,
+        shape.holes_px,
+        shape.area_px,
+        shape.centroid_px,
+        shape.cut_by_border,
+    )
+
+
+def _inside_colour(frame: U8Array, region: _Region, shape: Shape) -> tuple[int, int, int]:
     """Median RGB of the region's pixels in the 3×3 window around a pixel inside it."""
-    h, w = mask.shape
+    h, w = frame.shape[:2]
+    mask, (x0, y0) = region.mask, region.origin
+    mh, mw = mask.shape
     u, v = round(shape.centroid_px[0]), round(shape.centroid_px[1])
     inside = (
-        0 <= u < w
-        and 0 <= v < h
-        and mask[v, u] != 0
-        and cv2.pointPolygonTest(contour, (float(u), float(v)), False) > 0
+        0 <= u - x0 < mw
+        and 0 <= v - y0 < mh
+        and mask[v - y0, u - x0] != 0
+        and cv2.pointPolygonTest(region.contour, (float(u), float(v)), False) > 0
     )
     if not inside:
-        u, v = _deepest_pixel(mask, contour)
-    v0, v1, u0, u1 = max(v - 1, 0), min(v + 2, h), max(u - 1, 0), min(u + 2, w)
-    window = frame[v0:v1, u0:u1][mask[v0:v1, u0:u1] != 0]
+        u, v = _deepest_pixel(mask, region.contour, region.origin)
+    # The 3×3 window, clipped to the frame and to the box (the mask is 0 outside it).
+    v0, v1 = max(v - 1, 0, y0), min(v + 2, h, y0 + mh)
+    u0, u1 = max(u - 1, 0, x0), min(u + 2, w, x0 + mw)
+    window = frame[v0:v1, u0:u1][mask[v0 - y0 : v1 - y0, u0 - x0 : u1 - x0] != 0]
     if len(window) == 0:
         window = frame[v : v + 1, u]
     med = np.sort(window, axis=0)[(len(window) - 1) // 2]
     return (int(med[0]), int(med[1]), int(med[2]))
 
 
-def _deepest_pixel(mask: CvArray, contour: CvArray) -> tuple[int, int]:
-    """The pixel of the contour's region farthest from its border."""
+def _deepest_pixel(mask: CvArray, contour: CvArray, origin: tuple[int, int]) -> tuple[int, int]:
+    """The pixel of the contour's region farthest from its border (frame coordinates;
+    ``mask`` covers the box whose top-left corner is ``origin``)."""
     x, y, bw, bh = cv2.boundingRect(contour)
     region = np.zeros((bh + 2, bw + 2), dtype=np.uint8)
     cv2.drawContours(region, [contour], 0, 255, thickness=cv2.FILLED, offset=(1 - x, 1 - y))
+    mx, my = x - origin[0], y - origin[1]
     inside = cv2.bitwise_and(
         region,
-        cv2.copyMakeBorder(mask[y : y + bh, x : x + bw], 1, 1, 1, 1, cv2.BORDER_CONSTANT, value=0),
+        cv2.copyMakeBorder(
+            mask[my : my + bh, mx : mx + bw], 1, 1, 1, 1, cv2.BORDER_CONSTANT, value=0
+        ),
     )
     dist = cv2.distanceTransform(inside, cv2.DIST_L2, 3)
     k = int(np.argmax(dist))

@@ -1,0 +1,77 @@
+"""From traced pixel borders to polygon rings (paper III-A, steps 3 and 4).
+
+Evenly spaced points along each border, Ramer–Douglas–Peucker, then corner refinement; all
+the rings of a frame go through RDP and the line fits together. IEEE float64 arithmetic in
+a fixed order, so the same borders give the same rings on every machine.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from uavtool.vision.corners import refine_rings
+from uavtool.vision.params import VectorizeParams
+from uavtool.vision.rdp import rdp_rings_indices
+from uavtool.vision.shapes import FloatArray
+
+# Mitre joins of the edge offset are clamped to this many offsets (spikes at sharp turns).
+_MAX_MITRE = 3.0
+
+
+def simplify_rings(contours_px: list[npt.NDArray[Any]], p: VectorizeParams) -> list[FloatArray]:
+    """Each closed pixel border ``(n, 2)`` as a simplified ring ``(m, 2)`` (``m`` may be < 3
+    for a border too small to make a polygon)."""
+    dense = [resample_ring(c.astype(np.float64), p.point_spacing_px) for c in contours_px]
+    kept = rdp_rings_indices(dense, p.rdp_epsilon_px)
+    if not p.refine_corners:
+        return [d[k] for d, k in zip(dense, kept, strict=True)]
+    return refine_rings(
+        dense,
+        [k.tolist() for k in kept],
+        min_edge_px=p.min_edge_px,
+        max_shift_px=p.min_edge_px + p.point_spacing_px + p.rdp_epsilon_px,
+    )
+
+
+def resample_ring(ring_px: FloatArray, spacing_px: float) -> FloatArray:
+    """Points every ``spacing_px`` (adjusted to divide the length evenly) along a closed ring."""
+    x = np.append(ring_px[:, 0], ring_px[0, 0])
+    y = np.append(ring_px[:, 1], ring_px[0, 1])
+    dx = x[1:] - x[:-1]
+    dy = y[1:] - y[:-1]
+    cum = np.empty(len(x))
+    cum[0] = 0.0
+    np.cumsum(np.sqrt(dx * dx + dy * dy), out=cum[1:])
+    total = float(cum[-1])
+    n = max(3, round(total / spacing_px))
+    if total == 0.0:
+        return ring_px[:1].copy()
+    s = np.arange(n, dtype=np.float64) * (total / n)
+    out = np.empty((n, 2))
+    out[:, 0] = np.interp(s, cum, x)
+    out[:, 1] = np.interp(s, cum, y)
+    return out
+
+
+def offset_ring(ring_px: FloatArray, offset_px: float) -> FloatArray:
+    """Move every edge of a ring by ``offset_px`` along its normal ``(dy, −dx)``.
+
+    For the orientations :class:`~uavtool.vision.shapes.Shape` uses (outer ring positive,
+    holes negative) this moves every edge away from the filled region.
+    """
+    if offset_px == 0.0 or len(ring_px) < 3:
+        return ring_px
+    d_next = np.concatenate([ring_px[1:], ring_px[:1]]) - ring_px
+    length = np.sqrt(d_next[:, 0] * d_next[:, 0] + d_next[:, 1] * d_next[:, 1])
+    length[length == 0.0] = 1.0
+    normal = np.stack([d_next[:, 1] / length, -d_next[:, 0] / length], axis=1)
+    n_prev = np.concatenate([normal[-1:], normal[:-1]])
+    dot = normal[:, 0] * n_prev[:, 0] + normal[:, 1] * n_prev[:, 1]
+    # Intersection of the two moved edge lines: offset · (n1 + n2) / (1 + n1·n2).
+    denom = np.maximum(1.0 + dot, 2.0 / (_MAX_MITRE * _MAX_MITRE))
+    scale = offset_px / denom
+    out: FloatArray = ring_px + (normal + n_prev) * scale[:, None]
+    return out
