@@ -59,6 +59,13 @@ def _pair(text: str, what: str) -> tuple[float, float]:
 @click.option(
     "--duration", default=None, type=float, help="Stop after this many simulated seconds."
 )
+@click.option(
+    "--link-outage",
+    "outages",
+    multiple=True,
+    metavar="START:DURATION",
+    help="Fault injection: cut every link for DURATION s from sim time START (repeatable).",
+)
 def sitl(
     endpoints: tuple[str, ...],
     home: str | None,
@@ -70,6 +77,7 @@ def sitl(
     signing_key: str | None,
     params_file: Path | None,
     duration: float | None,
+    outages: tuple[str, ...],
 ) -> None:
     """Run the built-in ArduCopter-like vehicle as a MAVLink endpoint.
 
@@ -81,7 +89,7 @@ def sitl(
       mavproxy.py --master tcp:127.0.0.1:5760
     """
     from uavtool.sitl import Sitl, SitlConfig, parse_home, parse_signing_key
-    from uavtool.sitl.config import DEFAULT_ENDPOINTS
+    from uavtool.sitl.config import DEFAULT_ENDPOINTS, parse_outage
     from uavtool.sitl.params import load_param_file
 
     kwargs: dict[str, object] = {}
@@ -99,6 +107,7 @@ def sitl(
         sysid=sysid,
         instance=instance,
         seed=seed,
+        link_outages_s=tuple(parse_outage(text) for text in outages),
         **kwargs,  # type: ignore[arg-type]
     )
     vehicle = Sitl(config)

@@ -116,7 +116,7 @@ def mavlink_schema(dialect: str, msgid: int) -> tuple[str, bytes]:
     """Schema name (``ardupilotmega.HEARTBEAT``) and JSON schema bytes of one message type."""
     cls = dialect_module(dialect).mavlink_map[msgid]
     properties: dict[str, Any] = {"header": _HEADER_SCHEMA}
-    for name, ftype, length in zip(cls.fieldnames, cls.fieldtypes, cls.array_lengths, strict=True):
+    for name, ftype, length in _fields(cls):
         properties[name] = _field_schema(
             ftype,
             length,
@@ -140,12 +140,18 @@ def mavlink_schema(dialect: str, msgid: int) -> tuple[str, bytes]:
 def _float_fields(dialect: str, msgid: int) -> tuple[tuple[str, bool], ...]:
     cls = dialect_module(dialect).mavlink_map[msgid]
     return tuple(
-        (name, length > 0)
-        for name, ftype, length in zip(
-            cls.fieldnames, cls.fieldtypes, cls.array_lengths, strict=True
-        )
-        if ftype in _FLOAT_TYPES
+        (name, length > 0) for name, ftype, length in _fields(cls) if ftype in _FLOAT_TYPES
     )
+
+
+def _fields(cls: Any) -> list[tuple[str, str, int]]:
+    """``(name, type, array length)`` of each field in declaration order. pymavlink keeps
+    ``array_lengths`` in wire order (``ordered_fieldnames``), not in ``fieldnames`` order."""
+    lengths = dict(zip(cls.ordered_fieldnames, cls.array_lengths, strict=True))
+    return [
+        (name, ftype, lengths[name])
+        for name, ftype in zip(cls.fieldnames, cls.fieldtypes, strict=True)
+    ]
 
 
 def _finite_or_none(x: float) -> float | None:

@@ -28,8 +28,16 @@ class SitlConfig:
     seed: int = 0
     signing_key: bytes | None = None
     params: tuple[tuple[str, float], ...] = ()
+    link_outages_s: tuple[tuple[float, float], ...] = ()
+    """Fault injection: ``(start, duration)`` windows of sim time (s since start) during which
+    every link is cut both ways, as if the radio failed."""
 
     def __post_init__(self) -> None:
+        for start_s, duration_s in self.link_outages_s:
+            if start_s < 0 or duration_s <= 0:
+                raise InputError(
+                    f"link outage {start_s:g}:{duration_s:g}: start must be ≥ 0, duration > 0"
+                )
         if not 1 <= self.sysid + self.instance <= 254:
             raise InputError(f"sysid {self.sysid} + instance {self.instance} must be in 1-254")
         if self.instance < 0:
@@ -64,3 +72,12 @@ def parse_signing_key(text: str) -> bytes:
     if len(key) != 32:
         raise InputError(f"--signing-key: need 32 bytes (64 hex digits), got {len(key)}")
     return key
+
+
+def parse_outage(text: str) -> tuple[float, float]:
+    """``START:DURATION`` (seconds of sim time) → a link outage window."""
+    try:
+        start_s, duration_s = (float(v) for v in text.split(":"))
+    except ValueError:
+        raise InputError(f"--link-outage {text!r}: expected START:DURATION in seconds") from None
+    return start_s, duration_s

@@ -81,6 +81,8 @@ class Sitl:
         self._thread: threading.Thread | None = None
         self._pacing_reset = True
         self.steps = 0
+        self._outages_ns = [(int(a * _NS), int((a + d) * _NS)) for a, d in config.link_outages_s]
+        self.link_down = False
         self.rx_bytes = 0  # bytes received on all links, garbage included
         self.error: BaseException | None = None
         try:
@@ -164,6 +166,10 @@ class Sitl:
         now = ap.now_ns + self.dt_ns
         ap.tick(now, self.dt_ns / _NS)
         self.steps += 1
+        self.link_down = any(a <= now < b for a, b in self._outages_ns)
+        if self.link_down:
+            ap.events.clear()  # what the vehicle says during an outage is lost
+            return
         while ap.events:
             severity, text = ap.events.popleft()
             self.broadcast(M.MAVLink_statustext_message(severity, text.encode()))
@@ -185,6 +191,8 @@ class Sitl:
             owner: _Socketed = key.data
             for link, data in owner.on_readable():
                 self.rx_bytes += len(data)
+                if self.link_down:
+                    continue
                 for frame in link.receive(data):
                     try:
                         link.session.handle(frame)

@@ -1,0 +1,157 @@
+"""``uavtool fly``: fly the search-and-analyze mission and record it."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+from uavtool.errors import InputError
+
+
+def _pairs(values: tuple[str, ...], option: str) -> dict[str, str]:
+    out: dict[str, str] = {}
+    for text in values:
+        key, sep, value = text.partition("=")
+        if not sep:
+            raise InputError(f"{option} {text!r}: expected KEY=VALUE")
+        out[key.strip()] = value.strip()
+    return out
+
+
+@click.command()
+@click.option(
+    "--connect",
+    default=None,
+    metavar="URL",
+    help="Vehicle connection: tcp:HOST:PORT, udpin:HOST:PORT, udpout:HOST:PORT or "
+    "serial:DEVICE[:BAUD]. Default: start the built-in SITL in-process.",
+)
+@click.option(
+    "--scene", default="paper", show_default=True, help="Built-in scene name or scene file."
+)
+@click.option(
+    "--target",
+    type=click.Path(path_type=Path),
+    default=None,
+    help="Picture of the target building from above (PNG). Default: the scene's target, rendered.",
+)
+@click.option(
+    "--camera", default="sim", show_default=True, help="sim, opencv:N (device) or a stream URL."
+)
+@click.option(
+    "--speedup", default=20.0, show_default=True, type=float, help="Built-in SITL speed-up."
+)
+@click.option(
+    "--record",
+    type=click.Path(path_type=Path),
+    default=None,
+    help="Recording path. Default: recordings/<UTC time>.mcap.",
+)
+@click.option("--no-record", is_flag=True, help="Do not write a recording.")
+@click.option(
+    "--visit-all", is_flag=True, help="Visit every point of interest, even after a match."
+)
+@click.option(
+    "--param",
+    "vehicle_params",
+    multiple=True,
+    metavar="NAME=VALUE",
+    help="Set a vehicle parameter before the flight (ArduPilot names, e.g. WPNAV_SPEED=800).",
+)
+@click.option(
+    "--set",
+    "settings",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="Set a mission parameter (e.g. mission.detail_alt_m=25, vectorize.rdp_epsilon_px=2).",
+)
+@click.option("--seed", default=0, show_default=True, type=int, help="SITL wind/noise seed.")
+@click.option("--noise", is_flag=True, help="Add seeded sensor noise to simulated photos.")
+@click.option(
+    "--wind", default=None, metavar="SPEED,DIR", help="Built-in SITL wind (m/s, from deg)."
+)
+@click.option(
+    "--link-outage",
+    "outages",
+    multiple=True,
+    metavar="START:DURATION",
+    help="Fault injection (built-in SITL): cut the link for DURATION s at sim time START.",
+)
+@click.option("-q", "--quiet", is_flag=True, help="Print only the summary.")
+def fly(
+    connect: str | None,
+    scene: str,
+    target: Path | None,
+    camera: str,
+    speedup: float,
+    record: Path | None,
+    no_record: bool,
+    visit_all: bool,
+    vehicle_params: tuple[str, ...],
+    settings: tuple[str, ...],
+    seed: int,
+    noise: bool,
+    wind: str | None,
+    outages: tuple[str, ...],
+    quiet: bool,
+) -> None:
+    """Search the scene for the target building, photograph it from three sides and build
+    its 3D model; record everything to one MCAP file.
+
+    \b
+    Examples:
+      uavtool fly                                  # built-in SITL, scene 'paper'
+      uavtool fly --visit-all --scene blocked-front
+      uavtool fly --connect tcp:127.0.0.1:5760     # ArduPilot SITL (sim_vehicle.py)
+    """
+    from uavtool.mission.params import Params, with_overrides
+    from uavtool.runner.fly import FlyConfig
+    from uavtool.runner.fly import fly as fly_mission
+    from uavtool.runner.params import parse_param
+    from uavtool.runner.summary import format_progress, format_summary
+    from uavtool.sitl.config import parse_outage
+
+    if record is not None and no_record:
+        raise click.UsageError("--record and --no-record exclude each other")
+    overrides = _pairs(settings, "--set")
+    if visit_all:
+        overrides["mission.visit_all"] = "true"
+    params = with_overrides(Params(), overrides)
+    wind_pair = (0.0, 0.0)
+    if wind is not None:
+        try:
+            speed, direction = (float(v) for v in wind.split(","))
+        except ValueError:
+            raise InputError(f"--wind {wind!r}: expected SPEED,DIR, e.g. 5,270") from None
+        wind_pair = (speed, direction)
+    config = FlyConfig(
+        connect=connect,
+        scene=scene,
+        target=target,
+        camera=camera,
+        speedup=speedup,
+        record=record,
+        no_record=no_record,
+        params=params,
+        vehicle_params=tuple(parse_param(p) for p in vehicle_params),
+        seed=seed,
+        noise=noise,
+        wind=wind_pair,
+        link_outages_s=tuple(parse_outage(o) for o in outages),
+        command_line=tuple(sys.argv),
+    )
+
+    def echo(text: str) -> None:
+        if not quiet:
+            click.echo(text)
+
+    summary = fly_mission(
+        config,
+        progress=lambda text, t: echo(format_progress(text, t)),
+        status=lambda text: echo(f"uavtool fly: {text}"),
+    )
+    click.echo(format_summary(summary))
+    if summary.outcome.status.value not in ("completed", "no-match"):
+        sys.exit(1)

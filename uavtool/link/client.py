@@ -1,0 +1,175 @@
+"""The ground-station side of a MAVLink link: one adapter around pymavlink for every vehicle
+(the built-in SITL, ArduPilot's SITL, a real ArduCopter). It only uses what ArduPilot does:
+HEARTBEAT custom modes, COMMAND_LONG with COMMAND_ACK, SET_POSITION_TARGET_GLOBAL_INT,
+SET_MESSAGE_INTERVAL, HOME_POSITION and the gimbal/mount status messages."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from uavtool.errors import LinkError
+from uavtool.geo import GeoPoint
+from uavtool.link.transport import Transport
+from uavtool.mavlink.dialect import mavlink as M
+from uavtool.mavlink.framing import FrameParser, new_encoder
+
+GCS_SYSID = 255
+GCS_COMPID = M.MAV_COMP_ID_MISSIONPLANNER
+Tap = Callable[[str, bytes], None]
+"""Called with ``("in" | "out", frame bytes)`` for every whole frame that crosses the link."""
+
+# What the runner needs, and how often (Hz); requested with SET_MESSAGE_INTERVAL.
+STREAMS: dict[int, float] = {
+    M.MAVLINK_MSG_ID_GLOBAL_POSITION_INT: 10.0,
+    M.MAVLINK_MSG_ID_ATTITUDE: 10.0,
+    M.MAVLINK_MSG_ID_SYS_STATUS: 1.0,
+    M.MAVLINK_MSG_ID_EXTENDED_SYS_STATE: 2.0,
+    M.MAVLINK_MSG_ID_GIMBAL_DEVICE_ATTITUDE_STATUS: 10.0,
+    M.MAVLINK_MSG_ID_MOUNT_STATUS: 10.0,
+    M.MAVLINK_MSG_ID_HOME_POSITION: 0.5,
+}
+_NOT_VEHICLES = {M.MAV_TYPE_GCS, M.MAV_TYPE_GIMBAL, M.MAV_TYPE_ONBOARD_CONTROLLER}
+
+
+@dataclass(slots=True)
+class VehicleState:
+    """The latest of each message the vehicle sent (pymavlink message objects)."""
+
+    heartbeat: Any = None
+    position: Any = None  # GLOBAL_POSITION_INT
+    attitude: Any = None
+    extended: Any = None  # EXTENDED_SYS_STATE
+    sys_status: Any = None
+    gimbal_pitch_deg: float | None = None
+    gimbal_yaw_deg: float | None = None
+    home: GeoPoint | None = None
+    statustext: list[tuple[int, str]] = field(default_factory=list)
+
+
+class VehicleLink:
+    """A connection to one vehicle. ``poll`` reads what arrived and returns the messages from
+    the vehicle; ``send`` packs and sends. Not thread-safe (the runner owns it)."""
+
+    def __init__(self, transport: Transport, *, tap: Tap | None = None) -> None:
+        self.transport = transport
+        self.name = transport.name
+        self.tap = tap
+        self._parser = FrameParser()
+        self._mav = new_encoder(sysid=GCS_SYSID, compid=GCS_COMPID)
+        self.target_system = 0
+        self.target_component = 0
+        self.state = VehicleState()
+
+    def close(self) -> None:
+        self.transport.close()
+
+    # --- receiving ----------------------------------------------------------------------------
+
+    def poll(self, timeout_s: float) -> list[Any]:
+        """Messages from the vehicle received within ``timeout_s`` (one read)."""
+        data = self.transport.recv(timeout_s)
+        if not data:
+            return []
+        out = []
+        for frame in self._parser.feed(data):
+            if self.tap is not None:
+                self.tap("in", frame.raw)
+            msg = frame.msg
+            if self._accept(msg):
+                self._update(msg)
+                out.append(msg)
+        return out
+
+    def _accept(self, msg: Any) -> bool:
+        sysid = msg.get_srcSystem()
+        if self.target_system == 0:
+            if msg.get_type() != "HEARTBEAT" or msg.type in _NOT_VEHICLES:
+                return False
+            if msg.autopilot == M.MAV_AUTOPILOT_INVALID:
+                return False
+            self.target_system = sysid
+            self.target_component = msg.get_srcComponent()
+        return bool(sysid == self.target_system)
+
+    def _update(self, msg: Any) -> None:
+        s = self.state
+        kind = msg.get_type()
+        if kind == "HEARTBEAT":
+            if msg.get_srcComponent() == self.target_component:
+                s.heartbeat = msg
+        elif kind == "GLOBAL_POSITION_INT":
+            s.position = msg
+        elif kind == "ATTITUDE":
+            s.attitude = msg
+        elif kind == "EXTENDED_SYS_STATE":
+            s.extended = msg
+        elif kind == "SYS_STATUS":
+            s.sys_status = msg
+        elif kind == "HOME_POSITION":
+            s.home = GeoPoint(msg.latitude / 1e7, msg.longitude / 1e7, msg.altitude / 1000.0)
+        elif kind == "GIMBAL_DEVICE_ATTITUDE_STATUS":
+            s.gimbal_pitch_deg, s.gimbal_yaw_deg = _gimbal_angles(msg)
+        elif kind == "MOUNT_STATUS":
+            s.gimbal_pitch_deg, s.gimbal_yaw_deg = msg.pointing_a / 100.0, msg.pointing_c / 100.0
+        elif kind == "STATUSTEXT":
+            s.statustext.append((msg.severity, msg.text))
+
+    # --- sending ------------------------------------------------------------------------------
+
+    def send(self, msg: Any) -> None:
+        frame = bytes(msg.pack(self._mav))
+        self._mav.seq = (self._mav.seq + 1) % 256
+        if self.tap is not None:
+            self.tap("out", frame)
+        self.transport.send(frame)
+
+    def heartbeat(self) -> None:
+        self.send(M.MAVLink_heartbeat_message(M.MAV_TYPE_GCS, M.MAV_AUTOPILOT_INVALID, 0, 0, 0, 3))
+
+    def command_long(self, command: int, *params: float) -> None:
+        args = [*params, *([0.0] * (7 - len(params)))]
+        self.send(
+            M.MAVLink_command_long_message(
+                self.target_system, self.target_component, command, 0, *args
+            )
+        )
+
+    def request_streams(self) -> None:
+        """Ask for the messages the runner uses (ArduPilot honours SET_MESSAGE_INTERVAL)."""
+        for msgid, hz in STREAMS.items():
+            self.command_long(M.MAV_CMD_SET_MESSAGE_INTERVAL, msgid, 1e6 / hz)
+        self.command_long(M.MAV_CMD_REQUEST_MESSAGE, M.MAVLINK_MSG_ID_HOME_POSITION)
+
+    def wait_vehicle(self, timeout_s: float, *, on_wait: Callable[[], None] | None = None) -> None:
+        """Block until a vehicle's heartbeat and home position are known; LinkError if not."""
+        import time  # noqa: PLC0415 - the runner, not the mission, waits in wall time
+
+        deadline = time.monotonic() + timeout_s
+        last_request = 0.0
+        while self.state.home is None or self.state.position is None or last_request == 0.0:
+            now = time.monotonic()
+            if now > deadline:
+                what = "heartbeat" if self.target_system == 0 else "home position"
+                raise LinkError(f"{self.name}: no {what} from a vehicle in {timeout_s:g} s")
+            if self.target_system and now - last_request > 2.0:
+                self.heartbeat()
+                self.request_streams()
+                last_request = now
+            if on_wait is not None:
+                on_wait()
+            self.poll(0.05)
+
+
+def _gimbal_angles(msg: Any) -> tuple[float, float]:
+    """(pitch, yaw relative to the vehicle) in degrees from a gimbal attitude quaternion."""
+    w, x, y, z = msg.q
+    if any(math.isnan(v) for v in (w, x, y, z)):
+        return math.nan, math.nan
+    pitch = math.degrees(math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x)))))
+    yaw = math.degrees(math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))
+    if not msg.flags & M.GIMBAL_DEVICE_FLAGS_YAW_IN_VEHICLE_FRAME and not math.isnan(msg.delta_yaw):
+        yaw -= math.degrees(msg.delta_yaw)  # earth-frame yaw: make it relative to the nose
+    return pitch, yaw

@@ -1,0 +1,379 @@
+"""The search-and-analyze mission (paper section V) as a pure state machine.
+
+Observations go in (:meth:`Mission.step`), outputs come out: commands for the runner to
+execute and results to record. The mission never reads a clock (its time is the vehicle's
+``time_boot_ms``), a socket or a random generator, and never sees the scene's ground truth,
+so a replay that feeds it the recorded observations reproduces every output exactly.
+
+The scenario is written as one generator, read top to bottom in :meth:`Mission._fly`; each
+``yield`` waits for the next observation. What can go wrong anywhere — a command refused or
+unanswered, a move that never arrives, someone else changing the mode, the link going quiet —
+is handled once, in the waiting helpers, which end the flight by raising :class:`_End`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from collections.abc import Callable, Generator
+from typing import TypeVar
+
+from uavtool.geo import wrap_180
+from uavtool.mission.errors import MissionInputError, MissionStateError
+from uavtool.mission.observations import (
+    CommandResult,
+    LinkLost,
+    LinkRestored,
+    Observation,
+    Photo,
+    Telemetry,
+    U8Array,
+)
+from uavtool.mission.outputs import (
+    Arm,
+    Command,
+    Event,
+    GoTo,
+    Level,
+    ModelBuilt,
+    Outcome,
+    Output,
+    Plan,
+    SetGimbal,
+    SetMode,
+    Shapes,
+    Status,
+    Takeoff,
+    TakePhoto,
+    Vec3,
+)
+from uavtool.mission.params import Params
+from uavtool.vision import Shape, vectorize
+
+T = TypeVar("T")
+Wait = Generator[None, Observation, T]
+"""A step that waits for observations and finally returns a ``T``."""
+
+NADIR_DEG = -90.0
+HORIZONTAL_DEG = 0.0
+
+
+class _End(Exception):  # noqa: N818 - control flow inside the generator, never escapes
+    def __init__(self, status: Status, reason: str) -> None:
+        super().__init__(reason)
+        self.status = status
+        self.reason = reason
+
+
+class Mission:
+    """One flight of the mission. Call :meth:`start` once, then :meth:`step` with each
+    observation until :attr:`outcome` is set.
+
+    ``target_rgb`` : (H, W, 3) uint8 — the target building photographed from above; its
+    largest shape is what the mission looks for.
+    Raises :class:`MissionInputError` if the target image holds no shape.
+    """
+
+    def __init__(self, params: Params, target_rgb: U8Array) -> None:
+        self.params = params
+        target_shapes = vectorize(target_rgb, params.vectorize)
+        if not target_shapes:
+            raise MissionInputError("target image: no coloured shape found in it")
+        self.target_shapes = target_shapes
+        self.target: Shape = max(target_shapes, key=lambda s: s.area_px)
+        self.outcome: Outcome | None = None
+        self.last: Telemetry | None = None
+        self.visited: list[int] = []
+        self.matched_poi = -1
+        self.match_score = 0.0
+        self.model_built = False
+        self.plan: Plan | None = None
+        self.model: ModelBuilt | None = None
+        self._out: list[Output] = []
+        self._next_id = 0
+        self._frames_seen = 0
+        self._expected_modes: frozenset[str] = frozenset()
+        self._link_was_lost = False
+        self._deferred: list[Observation] = []
+        self._gen = self._run()
+        self._started = False
+
+    # --- the outside: observations in, outputs out --------------------------------------------
+
+    def start(self) -> list[Output]:
+        """The outputs before the first observation (the target's shapes)."""
+        if self._started:
+            raise MissionStateError("the mission was already started")
+        self._started = True
+        self._emit(Shapes(-1, "target", self.target_shapes))
+        next(self._gen)
+        return self._take()
+
+    def step(self, observation: Observation) -> list[Output]:
+        """Feed one observation; returns what the mission does about it (may be empty)."""
+        if not self._started:
+            raise MissionStateError("call start() before step()")
+        if self.outcome is not None:
+            raise MissionStateError("the mission has ended")
+        with contextlib.suppress(StopIteration):  # the flight's generator has finished
+            self._gen.send(observation)
+        return self._take()
+
+    @property
+    def done(self) -> bool:
+        return self.outcome is not None
+
+    def _take(self) -> list[Output]:
+        out, self._out = self._out, []
+        return out
+
+    def _emit(self, output: Output) -> None:
+        self._out.append(output)
+
+    def _event(self, level: Level, text: str) -> None:
+        self._emit(Event(level, text))
+
+    def _new_id(self) -> int:
+        self._next_id += 1
+        return self._next_id
+
+    # --- the flight, and how it ends ----------------------------------------------------------
+
+    def _run(self) -> Wait[None]:
+        from uavtool.mission.scenario import fly  # noqa: PLC0415 - the scenario uses this module
+
+        try:
+            yield from fly(self)
+            reason = "model built" if self.model_built else "target found; model not built"
+            end = _End(Status.COMPLETED, reason)
+        except _End as exc:
+            end = exc
+        self._event(
+            Level.INFO if end.status is Status.COMPLETED else Level.WARNING,
+            f"mission ends: {end.status.value}: {end.reason}",
+        )
+        try:
+            yield from self._finish(end.status)
+        except _End as exc:
+            self._event(Level.ERROR, f"while finishing: {exc.reason}")
+        self.outcome = Outcome(
+            end.status,
+            end.reason,
+            tuple(self.visited),
+            self.matched_poi,
+            self.match_score,
+            self.model_built,
+        )
+        self._emit(self.outcome)
+
+    def _finish(self, status: Status) -> Wait[None]:
+        """Bring the vehicle home (or watch someone else do it) until it has landed."""
+        if status is Status.LINK_LOST or self.last is None:
+            return
+        landed = self._landed_and_disarmed
+        if status is Status.TAKEOVER:
+            self._expected_modes = frozenset()
+            self._event(Level.INFO, "no more commands; watching until the vehicle lands")
+        elif not landed(self.last):
+            self._event(Level.INFO, "returning home (RTL)")
+            yield from self.set_mode("RTL", also=("LAND",))
+        ok = yield from self.wait_until(landed, self.params.mission.land_timeout_s)
+        if ok:
+            self._event(Level.INFO, "landed and disarmed")
+        else:
+            self._event(Level.WARNING, "still flying when the mission stopped watching")
+
+    @staticmethod
+    def _landed_and_disarmed(t: Telemetry) -> bool:
+        return t.landed and not t.armed
+
+    # --- waiting: every observation passes through here ---------------------------------------
+
+    def observe(self) -> Wait[Observation]:
+        """The next observation, after the checks that apply everywhere."""
+        while True:
+            if self._deferred:
+                obs = self._deferred.pop(0)
+            else:
+                obs = yield
+            if isinstance(obs, LinkLost):
+                yield from self._wait_for_link(obs)
+                continue
+            if isinstance(obs, LinkRestored):
+                continue
+            if isinstance(obs, Telemetry):
+                self.last = obs
+                self._check_mode(obs)
+            return obs
+
+    def _wait_for_link(self, lost: LinkLost) -> Wait[None]:
+        self._link_was_lost = True
+        self._event(
+            Level.WARNING,
+            f"link lost ({lost.silent_s:.1f} s of silence): waiting; the vehicle's failsafe "
+            "is in charge",
+        )
+        while True:
+            obs = yield
+            if isinstance(obs, LinkRestored):
+                self._event(Level.INFO, f"link restored after {obs.silent_s:.1f} s")
+                return
+            if isinstance(obs, LinkLost):
+                if obs.silent_s > self.params.mission.link_lost_abort_s:
+                    raise _End(Status.LINK_LOST, f"no link for {obs.silent_s:.0f} s")
+                continue
+            self._deferred.append(obs)  # e.g. a command result that arrived before the cut
+
+    def _check_mode(self, t: Telemetry) -> None:
+        if not self._expected_modes or t.mode in self._expected_modes:
+            return
+        who = "the vehicle's failsafe" if self._link_was_lost else "the pilot or a failsafe"
+        status = Status.LINK_LOST if self._link_was_lost else Status.TAKEOVER
+        raise _End(status, f"mode changed to {t.mode} by {who}")
+
+    def now_ms(self) -> int:
+        return self.last.time_boot_ms if self.last is not None else 0
+
+    def wait_until(self, done: Callable[[Telemetry], bool], timeout_s: float) -> Wait[bool]:
+        """Wait for telemetry that satisfies ``done``; False after ``timeout_s`` of vehicle time."""
+        start_ms = self.now_ms()
+        if self.last is not None and done(self.last):
+            return True
+        while True:
+            obs = yield from self.observe()
+            if isinstance(obs, Telemetry):
+                if done(obs):
+                    return True
+                if obs.time_boot_ms - start_ms > timeout_s * 1000.0:
+                    return False
+
+    def pause(self, duration_s: float) -> Wait[None]:
+        yield from self.wait_until(lambda _t: False, duration_s)
+
+    # --- commands -----------------------------------------------------------------------------
+
+    def command(
+        self, make: Callable[[int], Command], what: str, *, retries: int = -1
+    ) -> Wait[None]:
+        """Issue a command until the vehicle accepts it; abort (RTL) after the retries."""
+        attempts = 1 + (self.params.mission.command_retries if retries < 0 else retries)
+        detail = ""
+        for attempt in range(1, attempts + 1):
+            cmd = make(self._new_id())
+            self._emit(cmd)
+            result = yield from self._result(cmd.id)
+            if result.accepted:
+                return
+            detail = result.detail
+            self._event(Level.WARNING, f"{what}: {detail} (attempt {attempt} of {attempts})")
+            if attempt < attempts:
+                yield from self.pause(self.params.mission.retry_wait_s)
+        raise _End(Status.ABORTED, f"{what} failed {attempts} times: {detail}")
+
+    def _result(self, action_id: int) -> Wait[CommandResult]:
+        while True:
+            obs = yield from self.observe()
+            if isinstance(obs, CommandResult) and obs.action_id == action_id:
+                return obs
+
+    def set_mode(self, mode: str, *, also: tuple[str, ...] = ()) -> Wait[None]:
+        """Switch mode and wait until telemetry shows it; from then on any other mode (except
+        ``also``) means someone else took over."""
+        if self._expected_modes:  # the switch itself is not someone else's doing
+            self._expected_modes = self._expected_modes | {mode, *also}
+        yield from self.command(lambda i: SetMode(i, mode), f"mode {mode}")
+        ok = yield from self.wait_until(lambda t: t.mode == mode, self.params.mission.move_slack_s)
+        if not ok:
+            raise _End(Status.ABORTED, f"the vehicle accepted mode {mode} but never showed it")
+        self._expected_modes = frozenset((mode, *also))
+
+    def move(self, pos_enu_m: Vec3, heading_deg: float | None, what: str) -> Wait[None]:
+        """Fly to a position (and heading) and wait until there and still."""
+        p = self.params.mission
+        for attempt in range(1, p.command_retries + 2):
+            yield from self.command(lambda i: GoTo(i, pos_enu_m, heading_deg), what)
+            timeout_s = _distance(self.last, pos_enu_m) / p.cruise_speed_m_s + p.move_slack_s
+            arrived = yield from self.wait_until(
+                lambda t: self._arrived(t, pos_enu_m, heading_deg), timeout_s
+            )
+            if arrived:
+                return
+            self._event(
+                Level.WARNING, f"{what}: not reached in {timeout_s:.0f} s (attempt {attempt})"
+            )
+        raise _End(Status.ABORTED, f"{what}: position never reached")
+
+    def _arrived(self, t: Telemetry, pos_enu_m: Vec3, heading_deg: float | None) -> bool:
+        p = self.params.mission
+        if _distance(t, pos_enu_m) > p.arrive_radius_m or t.speed_m_s > p.arrive_speed_m_s:
+            return False
+        return heading_deg is None or abs(wrap_180(t.heading_deg - heading_deg)) <= (
+            p.heading_tolerance_deg
+        )
+
+    def photo(self, tag: str, pitch_deg: float) -> Wait[Photo]:
+        """Point the gimbal (if needed), then take a photo and return it."""
+        p = self.params.mission
+        last = self.last
+        if last is None or abs(last.gimbal_pitch_deg - pitch_deg) > p.gimbal_tolerance_deg:
+            yield from self.command(lambda i: SetGimbal(i, pitch_deg), f"gimbal to {pitch_deg:g}°")
+            ok = yield from self.wait_until(
+                lambda t: abs(t.gimbal_pitch_deg - pitch_deg) <= p.gimbal_tolerance_deg,
+                p.move_slack_s,
+            )
+            if not ok:
+                self._event(Level.WARNING, f"gimbal did not report {pitch_deg:g}°; photo anyway")
+        cmd = TakePhoto(self._new_id(), tag)
+        self._emit(cmd)
+        while True:
+            obs = yield from self.observe()
+            if isinstance(obs, Photo) and obs.action_id == cmd.id:
+                return obs
+            if isinstance(obs, CommandResult) and obs.action_id == cmd.id and not obs.accepted:
+                raise _End(Status.ABORTED, f"photo {tag!r}: {obs.detail}")
+
+    def event(self, level: Level, text: str) -> None:
+        self._event(level, text)
+
+    def emit(self, output: Output) -> None:
+        self._emit(output)
+
+    def end(self, status: Status, reason: str) -> _End:
+        """The exception that ends the flight (``raise mission.end(...)``)."""
+        return _End(status, reason)
+
+    def arm_and_take_off(self, alt_m: float) -> Wait[None]:
+        """GUIDED, arm (retrying while pre-arm checks fail) and climb to ``alt_m``."""
+        p = self.params.mission
+        yield from self.set_mode("GUIDED")
+        start_ms = self.now_ms()
+        while True:
+            cmd = Arm(self._new_id())
+            self._emit(cmd)
+            result = yield from self._result(cmd.id)
+            if result.accepted:
+                break
+            if self.now_ms() - start_ms > p.arm_wait_s * 1000.0:
+                raise _End(
+                    Status.ABORTED, f"arming refused for {p.arm_wait_s:.0f} s: {result.detail}"
+                )
+            yield from self.pause(p.retry_wait_s)
+        ok = yield from self.wait_until(lambda t: t.armed, p.move_slack_s)
+        if not ok:
+            raise _End(Status.ABORTED, "the vehicle accepted arming but never showed armed")
+        yield from self.command(lambda i: Takeoff(i, alt_m), f"take-off to {alt_m:g} m")
+        climbed = yield from self.wait_until(
+            lambda t: t.pos_enu_m[2] >= alt_m - p.arrive_radius_m,
+            alt_m / p.climb_speed_m_s + p.move_slack_s,
+        )
+        if not climbed:
+            raise _End(Status.ABORTED, f"take-off: {alt_m:g} m never reached")
+
+
+def _distance(t: Telemetry | None, pos_enu_m: Vec3) -> float:
+    if t is None:
+        return 0.0
+    dx = t.pos_enu_m[0] - pos_enu_m[0]
+    dy = t.pos_enu_m[1] - pos_enu_m[1]
+    dz = t.pos_enu_m[2] - pos_enu_m[2]
+    return math.sqrt(dx * dx + dy * dy + dz * dz)

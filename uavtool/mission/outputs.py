@@ -1,0 +1,176 @@
+"""What the mission produces: commands for the vehicle and camera (which the runner executes),
+and results (vision, navigation, events, the outcome) which are recorded and compared on replay.
+Every output is a small immutable value; ``id`` numbers a mission's commands from 1."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+
+from uavtool.nav import Viewpoint, ViewpointFailure
+from uavtool.vision import Shape
+
+Vec3 = tuple[float, float, float]
+
+
+# --- commands ----------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class SetMode:
+    """Switch the autopilot to a mode by ArduCopter name (``GUIDED``, ``RTL``, ``LAND`` …)."""
+
+    id: int
+    mode: str
+
+
+@dataclass(frozen=True, slots=True)
+class Arm:
+    id: int
+
+
+@dataclass(frozen=True, slots=True)
+class Takeoff:
+    """Climb vertically to ``alt_m`` above home (GUIDED, armed)."""
+
+    id: int
+    alt_m: float
+
+
+@dataclass(frozen=True, slots=True)
+class GoTo:
+    """Fly to ``pos_enu_m`` (z above home) and face ``heading_deg`` (None: keep heading)."""
+
+    id: int
+    pos_enu_m: Vec3
+    heading_deg: float | None
+
+
+@dataclass(frozen=True, slots=True)
+class SetGimbal:
+    """Point the camera: ``pitch_deg`` (−90 nadir, 0 horizontal), ``yaw_deg`` from the nose."""
+
+    id: int
+    pitch_deg: float
+    yaw_deg: float = 0.0
+
+
+@dataclass(frozen=True, slots=True)
+class TakePhoto:
+    """Take a photo now; the runner answers with a :class:`Photo` observation."""
+
+    id: int
+    tag: str
+
+
+Command = SetMode | Arm | Takeoff | GoTo | SetGimbal | TakePhoto
+
+
+# --- results -----------------------------------------------------------------------------------
+
+
+class Level(Enum):
+    INFO = "info"
+    WARNING = "warning"
+    ERROR = "error"
+
+
+@dataclass(frozen=True, slots=True)
+class Event:
+    """Something worth telling a person (phase changes, findings, failures)."""
+
+    level: Level
+    text: str
+
+
+@dataclass(frozen=True, slots=True)
+class Shapes:
+    """The shapes vectorized from frame ``frame_index``."""
+
+    frame_index: int
+    tag: str
+    shapes: tuple[Shape, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class PointOfInterest:
+    """A building seen in the overview: where it is (ENU, on the roof plane) and its colour.
+    ``shape_index`` is its index in the overview's shapes."""
+
+    index: int
+    shape_index: int
+    pos_en_m: tuple[float, float]
+    colour_rgb: tuple[int, int, int]
+    area_px: float
+
+
+@dataclass(frozen=True, slots=True)
+class Plan:
+    """The points of interest and the order they will be visited in."""
+
+    frame_index: int
+    pois: tuple[PointOfInterest, ...]
+    order: tuple[int, ...]
+    route_m: float
+
+
+@dataclass(frozen=True, slots=True)
+class Recognition:
+    """Frame ``frame_index`` at point of interest ``poi`` compared with the target.
+
+    ``scores`` : one per shape of the frame; ``candidate`` the shape judged (the one the photo
+    is centred on; −1 if none), ``score`` its score, ``matched`` whether it reaches the
+    threshold."""
+
+    frame_index: int
+    poi: int
+    scores: tuple[float, ...]
+    candidate: int
+    score: float
+    matched: bool
+
+
+@dataclass(frozen=True, slots=True)
+class Viewpoints:
+    """The photo positions planned for the model. ``footprint_en_m`` is the target's
+    estimated footprint they were planned around."""
+
+    footprint_en_m: tuple[tuple[float, float], ...]
+    top: Viewpoint
+    front: Viewpoint | ViewpointFailure
+    right: Viewpoint | ViewpointFailure
+
+
+@dataclass(frozen=True, slots=True)
+class ModelBuilt:
+    """The 3D model (world ENU metres): mesh arrays as nested tuples, and GLB bytes."""
+
+    vertices_m: tuple[tuple[float, float, float], ...]
+    faces: tuple[tuple[int, int, int], ...]
+    glb: bytes
+    height_m: float
+    volume_m3: float
+
+
+class Status(Enum):
+    COMPLETED = "completed"
+    NO_MATCH = "no-match"
+    ABORTED = "aborted"
+    TAKEOVER = "pilot-takeover"
+    LINK_LOST = "link-lost"
+
+
+@dataclass(frozen=True, slots=True)
+class Outcome:
+    """How the mission ended; the last output. ``visited`` lists points of interest in the
+    order photographed; ``matched_poi`` is −1 when none matched."""
+
+    status: Status
+    reason: str
+    visited: tuple[int, ...]
+    matched_poi: int
+    match_score: float
+    model_built: bool
+
+
+Output = Command | Event | Shapes | Plan | Recognition | Viewpoints | ModelBuilt | Outcome

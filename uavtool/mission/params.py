@@ -1,0 +1,171 @@
+"""The mission's parameters: one typed, documented structure, recorded with every mission.
+
+``Params`` groups the mission's own settings with those of each vision and navigation stage it
+calls. Keys are dotted paths (``mission.detail_alt_m``, ``vectorize.rdp_epsilon_px``,
+``viewpoints.safety_margin_m``) for ``--set key=value`` on ``fly`` and ``replay``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import typing
+from dataclasses import dataclass, field
+from typing import Any
+
+from uavtool.errors import InputError
+from uavtool.nav import ViewpointParams
+from uavtool.vision import ModelParams, RecognizeParams, VectorizeParams
+
+
+@dataclass(frozen=True, slots=True)
+class MissionParams:
+    """What the mission does and how patient it is. Distances in metres, times in seconds
+    of vehicle time (the telemetry's ``time_boot_ms``), angles in degrees."""
+
+    overview_alt_m: float = 45.0
+    """Altitude above home of the overview photo (the whole scene in view)."""
+    detail_alt_m: float = 20.0
+    """Altitude of the nadir photo at each point of interest, and of transit between views."""
+    roof_plane_z_m: float = 5.0
+    """Typical roof height: overview shapes are projected onto this plane to place points of
+    interest and obstacles (a roof seen from above sits higher than the ground)."""
+    roof_gap_px: float = 6.0
+    """Same-coloured roofs closer than this (pixels) in a nadir photo are one building: blocks
+    of different heights show as separate roofs split by a strip of wall."""
+    match_hue_tolerance_deg: float = 20.0
+    """A candidate whose colour's hue is further than this from the target's is not a match,
+    whatever its shape (0 = judge by shape alone)."""
+    min_poi_area_px: float = 150.0
+    """Overview shapes smaller than this (square pixels) are not visited."""
+    visit_all: bool = False
+    """Visit every point of interest even after a match (then keep the best-scoring match)."""
+    arrive_radius_m: float = 0.6
+    """A position counts as reached within this distance …"""
+    arrive_speed_m_s: float = 0.3
+    """… and below this ground speed (so the photo is not blurred by motion)."""
+    heading_tolerance_deg: float = 3.0
+    """A commanded heading counts as reached within this."""
+    gimbal_tolerance_deg: float = 2.0
+    """A commanded gimbal pitch counts as reached within this."""
+    cruise_speed_m_s: float = 5.0
+    """Slowest speed a move is expected to make: its timeout is distance / this + slack."""
+    climb_speed_m_s: float = 1.0
+    """Slowest climb rate expected during take-off (its timeout)."""
+    move_slack_s: float = 20.0
+    """Extra time allowed for any move, climb or turn before it counts as failed."""
+    retry_wait_s: float = 2.0
+    """Pause before a refused command is tried again."""
+    arm_wait_s: float = 60.0
+    """Arming is retried this long (pre-arm checks may need time after boot)."""
+    command_retries: int = 3
+    """A refused or unanswered command (or a move that times out) is retried this many times,
+    then the mission aborts with RTL."""
+    link_lost_abort_s: float = 30.0
+    """Silence from the vehicle for longer than this ends the mission (the vehicle's own
+    failsafe flies it); shorter losses are waited out and the mission resumes."""
+    land_timeout_s: float = 300.0
+    """Time allowed for the return and landing before the mission stops watching."""
+
+    def __post_init__(self) -> None:
+        for name in ("overview_alt_m", "detail_alt_m", "arrive_radius_m", "cruise_speed_m_s"):
+            if not getattr(self, name) > 0:
+                raise InputError(f"mission.{name} must be positive, got {getattr(self, name)}")
+        if self.detail_alt_m > self.overview_alt_m:
+            raise InputError("mission.detail_alt_m must not be above mission.overview_alt_m")
+        if self.command_retries < 0:
+            raise InputError(f"mission.command_retries must be ≥ 0, got {self.command_retries}")
+
+
+@dataclass(frozen=True, slots=True)
+class Params:
+    """Everything that shapes the mission's decisions (recorded as metadata ``mission``)."""
+
+    mission: MissionParams = field(default_factory=MissionParams)
+    vectorize: VectorizeParams = field(default_factory=lambda: VectorizeParams(roof_only=True))
+    """Vectorization of nadir photos (overview, points of interest, top)."""
+    side_vectorize: VectorizeParams = field(default_factory=VectorizeParams)
+    """Vectorization of the front and right photos (walls, not only roofs)."""
+    recognize: RecognizeParams = field(default_factory=lambda: RecognizeParams(threshold=0.7))
+    """Shape matching. The threshold is lower than the matcher's default: at the detail
+    altitude a building's roofs at different heights are seen with perspective steps
+    between them (on ``paper`` the target scores 0.74–0.77, the other buildings ≤ 0.45)."""
+    model: ModelParams = field(default_factory=ModelParams)
+    viewpoints: ViewpointParams = field(default_factory=ViewpointParams)
+
+
+def to_dict(params: Params) -> dict[str, Any]:
+    """A JSON-ready nested dict (tuples become lists)."""
+    return json.loads(json.dumps(dataclasses.asdict(params)))  # type: ignore[no-any-return]
+
+
+def from_dict(data: dict[str, Any], *, source: str = "parameters") -> Params:
+    """The inverse of :func:`to_dict`; unknown keys are errors listing the valid ones."""
+    return _apply(Params(), _flatten(data), source=source)
+
+
+def with_overrides(params: Params, pairs: dict[str, str], *, source: str = "--set") -> Params:
+    """``params`` with dotted keys set from strings (``{"mission.detail_alt_m": "25"}``)."""
+    return _apply(params, pairs, source=source)
+
+
+def valid_keys() -> tuple[str, ...]:
+    """Every dotted key that ``--set`` accepts."""
+    return tuple(_flatten(to_dict(Params())))
+
+
+def _flatten(data: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, value in data.items():
+        path = f"{prefix}{key}"
+        if isinstance(value, dict):
+            out.update(_flatten(value, f"{path}."))
+        else:
+            out[path] = value
+    return out
+
+
+def _apply(params: Params, pairs: dict[str, Any], *, source: str) -> Params:
+    grouped: dict[str, dict[str, Any]] = {}
+    known = valid_keys()
+    for key, raw in pairs.items():
+        if key not in known:
+            raise InputError(f"{source}: unknown parameter {key!r}; valid: {', '.join(known)}")
+        group, name = key.split(".", 1)
+        sub = getattr(params, group)
+        hint = typing.get_type_hints(type(sub))[name]
+        grouped.setdefault(group, {})[name] = _convert(raw, hint, key, source)
+    changed: dict[str, Any] = {}
+    for group, values in grouped.items():
+        try:
+            changed[group] = dataclasses.replace(getattr(params, group), **values)
+        except InputError as exc:
+            raise InputError(f"{source}: {exc}") from None
+    return dataclasses.replace(params, **changed)
+
+
+def _convert(raw: Any, hint: Any, key: str, source: str) -> Any:
+    if not isinstance(raw, str):  # from a parsed file: JSON types, lists for tuples
+        return _to_tuples(raw)
+    try:
+        if hint is bool:
+            if raw.lower() not in ("true", "false", "1", "0", "yes", "no"):
+                raise ValueError(raw)
+            return raw.lower() in ("true", "1", "yes")
+        if hint is int:
+            return int(raw)
+        if hint is float:
+            return float(raw)
+        return _to_tuples(json.loads(raw))
+    except ValueError:
+        raise InputError(f"{source}: {key}={raw!r} is not a valid {_name(hint)}") from None
+
+
+def _to_tuples(value: Any) -> Any:
+    if isinstance(value, list):
+        return tuple(_to_tuples(v) for v in value)
+    return value
+
+
+def _name(hint: Any) -> str:
+    return getattr(hint, "__name__", str(hint))

@@ -1,0 +1,236 @@
+"""The paper's scenario, step by step: overview, points of interest, recognition, the three
+photos for the model, and the model. Each step is a generator run by :class:`Mission`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from uavtool.mission.observations import Photo
+from uavtool.mission.outputs import (
+    Level,
+    ModelBuilt,
+    Plan,
+    PointOfInterest,
+    Recognition,
+    Shapes,
+    Status,
+    Viewpoints,
+)
+from uavtool.nav import (
+    Viewpoint,
+    ViewpointFailure,
+    ground_polygon,
+    min_area_rect,
+    plan_viewpoints,
+    route_length_m,
+    top_viewpoint,
+    visit_order,
+)
+from uavtool.nav import ground_point as nav_ground_point
+from uavtool.vision import Shape, VectorizeParams, best_match, vectorize
+from uavtool.vision.errors import VisionError
+from uavtool.vision.merge import merge_touching
+from uavtool.vision.model3d import View, build_model, central_shape, model_glb, same_colour
+from uavtool.vision.vectorize import hue_distance_deg
+
+if TYPE_CHECKING:
+    from uavtool.mission.mission import Mission, Wait
+
+# Hue window for "the same building" in the side photos (walls are shaded darker than roofs).
+_SIDE_HUE_TOLERANCE_DEG = 15.0
+
+
+@dataclass(frozen=True, slots=True)
+class _Found:
+    poi: PointOfInterest
+    photo: Photo
+    shape: Shape
+    score: float
+
+
+def fly(m: Mission) -> Wait[None]:
+    """The whole flight up to (not including) the return home."""
+    p = m.params.mission
+    yield from m.wait_until(lambda _t: True, 0.0)  # the first telemetry
+    last = m.last
+    assert last is not None  # wait_until returned on telemetry
+    if last.armed and not last.landed:
+        m.event(Level.INFO, "already flying: taking control in GUIDED")
+        yield from m.set_mode("GUIDED")
+    else:
+        m.event(Level.INFO, f"taking off to {p.overview_alt_m:g} m")
+        yield from m.arm_and_take_off(p.overview_alt_m)
+    here = m.last.pos_enu_m if m.last else (0.0, 0.0, 0.0)
+    yield from m.move((here[0], here[1], p.overview_alt_m), None, "overview position")
+
+    overview = yield from m.photo("overview", -90.0)
+    shapes = _vectorize(m, overview, m.params.vectorize)
+    pois = _points_of_interest(m, overview, shapes)
+    if not pois:
+        raise m.end(Status.NO_MATCH, "the overview photo shows no building")
+    start = (m.last.pos_enu_m[0], m.last.pos_enu_m[1]) if m.last else (0.0, 0.0)
+    points = [poi.pos_en_m for poi in pois]
+    order = visit_order(start, points)
+    m.plan = Plan(overview.frame_index, pois, order, route_length_m(start, points, order))
+    m.emit(m.plan)
+    m.event(Level.INFO, f"{len(pois)} points of interest; visiting order {list(order)}")
+
+    found = yield from _search(m, pois, order)
+    if found is None:
+        return
+    m.matched_poi = found.poi.index
+    m.match_score = found.score
+    obstacles = [
+        ground_polygon(s.polygon_px, overview.pose, overview.intrinsics, plane_z_m=p.roof_plane_z_m)
+        for i, s in enumerate(shapes)
+        if i != found.poi.shape_index
+    ]
+    yield from _model(m, found, obstacles)
+
+
+def _vectorize(
+    m: Mission, photo: Photo, params: VectorizeParams, *, nadir: bool = True
+) -> tuple[Shape, ...]:
+    shapes = vectorize(photo.image_rgb, params)
+    if nadir:
+        shapes = merge_touching(shapes, gap_px=m.params.mission.roof_gap_px)
+    m.emit(Shapes(photo.frame_index, photo.tag, shapes))
+    return shapes
+
+
+def _points_of_interest(
+    m: Mission, overview: Photo, shapes: tuple[Shape, ...]
+) -> tuple[PointOfInterest, ...]:
+    p = m.params.mission
+    pois: list[PointOfInterest] = []
+    for i, shape in enumerate(shapes):
+        if shape.area_px < p.min_poi_area_px:
+            continue
+        u, v = shape.centroid_px
+        pos = nav_ground_point(u, v, overview.pose, overview.intrinsics, plane_z_m=p.roof_plane_z_m)
+        pois.append(PointOfInterest(len(pois), i, pos, shape.colour_rgb, shape.area_px))
+    return tuple(pois)
+
+
+def _search(
+    m: Mission, pois: tuple[PointOfInterest, ...], order: tuple[int, ...]
+) -> Wait[_Found | None]:
+    """Visit the points of interest in order; the best match (the first one unless
+    ``visit_all``), or None after reporting that nothing matched."""
+    p = m.params.mission
+    best: _Found | None = None
+    best_score, best_poi = 0.0, -1
+    for k in order:
+        poi = pois[k]
+        x, y = poi.pos_en_m
+        yield from m.move((x, y, p.detail_alt_m), None, f"point of interest {k}")
+        photo = yield from m.photo(f"poi-{k}", -90.0)
+        shapes = _vectorize(m, photo, m.params.vectorize)
+        m.visited.append(k)
+        centre = central_shape(shapes, photo.intrinsics)
+        candidate = next((i for i, s in enumerate(shapes) if s is centre), -1)
+        if candidate >= 0:
+            _, matches = best_match(m.target, shapes, m.params.recognize)
+            scores = tuple(match.score for match in matches)
+            score = scores[candidate]
+        else:
+            scores, score = (), 0.0
+        matched = candidate >= 0 and score >= m.params.recognize.threshold
+        hue_limit = p.match_hue_tolerance_deg
+        if matched and centre is not None and hue_limit > 0:
+            matched = hue_distance_deg(centre.colour_rgb, m.target.colour_rgb) <= hue_limit
+        m.emit(Recognition(photo.frame_index, k, scores, candidate, score, matched))
+        m.event(
+            Level.INFO,
+            f"point of interest {k}: {'MATCH' if matched else 'no match'} (score {score:.3f})",
+        )
+        if score > best_score:
+            best_score, best_poi = score, k
+        if matched and centre is not None and (best is None or score > best.score):
+            best = _Found(poi, photo, centre, score)
+            if not p.visit_all:
+                break
+    if best is None:
+        where = f" at point of interest {best_poi}" if best_poi >= 0 else ""
+        raise m.end(
+            Status.NO_MATCH, f"no building matched the target (best score {best_score:.3f}{where})"
+        )
+    m.event(Level.INFO, f"target is point of interest {best.poi.index} (score {best.score:.3f})")
+    return best
+
+
+def _model(
+    m: Mission, found: _Found, obstacles: list[tuple[tuple[float, float], ...]]
+) -> Wait[None]:
+    """Top, front and right photos from planned viewpoints, then the model."""
+    p = m.params.mission
+    footprint = ground_polygon(
+        found.shape.polygon_px, found.photo.pose, found.photo.intrinsics, plane_z_m=p.roof_plane_z_m
+    )
+    rect = min_area_rect(footprint)
+    front, right = plan_viewpoints(rect, obstacles, found.photo.intrinsics, m.params.viewpoints)
+    front_heading = (
+        front.heading_deg if isinstance(front, Viewpoint) else (rect.long_axis_deg + 90.0) % 360.0
+    )
+    top = top_viewpoint(rect, front_heading, alt_m=p.detail_alt_m)
+    yield from m.move(top.pos_enu_m, top.heading_deg, "top viewpoint")
+    top_photo = yield from m.photo("top", -90.0)
+    top_shapes = _vectorize(m, top_photo, m.params.vectorize)
+    obj = central_shape(top_shapes, top_photo.intrinsics)
+    if obj is None:
+        raise m.end(Status.ABORTED, "the top photo shows no building")
+    # The top photo is centred on the building: plan the side photos from its footprint.
+    footprint = ground_polygon(
+        obj.polygon_px, top_photo.pose, top_photo.intrinsics, plane_z_m=p.roof_plane_z_m
+    )
+    rect = min_area_rect(footprint)
+    front, right = plan_viewpoints(rect, obstacles, top_photo.intrinsics, m.params.viewpoints)
+    m.emit(Viewpoints(footprint, top, front, right))
+
+    views: dict[str, View] = {}
+    for vp in (front, right):
+        if isinstance(vp, ViewpointFailure):
+            m.event(Level.WARNING, f"{vp.name} viewpoint impossible: {vp.reason}")
+            continue
+        if vp.fallback:
+            m.event(Level.INFO, f"{vp.name} viewpoint: {vp.fallback}")
+        x, y, z = vp.pos_enu_m
+        yield from m.move((x, y, p.detail_alt_m), vp.heading_deg, f"above the {vp.name} viewpoint")
+        yield from m.move((x, y, z), vp.heading_deg, f"{vp.name} viewpoint")
+        photo = yield from m.photo(vp.name, 0.0)
+        shapes = _vectorize(m, photo, m.params.side_vectorize, nadir=False)
+        silhouette = same_colour(shapes, obj.colour_rgb, hue_tolerance_deg=_SIDE_HUE_TOLERANCE_DEG)
+        views[vp.name] = View(silhouette, photo.pose, photo.intrinsics)
+        yield from m.move(
+            (x, y, p.detail_alt_m), vp.heading_deg, f"climb from the {vp.name} viewpoint"
+        )
+
+    missing = [name for name in ("front", "right") if name not in views]
+    if missing:
+        m.event(Level.WARNING, f"model not built: no {' or '.join(missing)} photo")
+        return
+    try:
+        model = build_model(
+            View((obj,), top_photo.pose, top_photo.intrinsics),
+            views["front"],
+            views["right"],
+            m.params.model,
+        )
+    except VisionError as exc:
+        m.event(Level.ERROR, f"model not built: {exc}")
+        return
+    mesh = model.mesh
+    m.model = ModelBuilt(
+        tuple(tuple(v) for v in mesh.vertices.tolist()),
+        tuple(tuple(f) for f in mesh.faces.tolist()),
+        model_glb(model),
+        model.height_m,
+        float(mesh.volume),
+    )
+    m.emit(m.model)
+    m.model_built = True
+    m.event(
+        Level.INFO,
+        f"model built: height {model.height_m:.2f} m, volume {float(mesh.volume):.1f} m³",
+    )

@@ -1,0 +1,269 @@
+"""``uavtool fly`` as a library call: connect (or start the built-in SITL), fly the mission,
+record it, and summarise the flight."""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import itertools
+import json
+import math
+import time
+from collections.abc import Callable, Iterator
+from contextlib import ExitStack, contextmanager
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+
+from uavtool import __version__
+from uavtool.camera import CameraPose, Intrinsics
+from uavtool.errors import InputError, LinkError
+from uavtool.images import png_decode, png_encode
+from uavtool.link import VehicleLink, open_transport
+from uavtool.mission import Level, Mission, Outcome, Params, Status, Telemetry
+from uavtool.mission.params import to_dict
+from uavtool.recording import RecordingWriter
+from uavtool.runner.camera import open_camera
+from uavtool.runner.evaluate import Evaluation, evaluate
+from uavtool.runner.params import set_vehicle_params
+from uavtool.runner.record import MissionRecorder
+from uavtool.runner.runner import Progress, Runner, RunnerConfig
+from uavtool.world import Scene, load_scene, render, scene_to_dict
+
+_TARGET_VIEW_M = 30.0  # the default target picture: from this far above its roof
+
+
+@dataclass(frozen=True, slots=True)
+class FlyConfig:
+    """What ``uavtool fly`` options set. ``connect`` None starts the built-in SITL."""
+
+    connect: str | None = None
+    scene: str = "paper"
+    target: Path | None = None
+    camera: str = "sim"
+    speedup: float = 20.0
+    record: Path | None = None
+    """None: ``recordings/<UTC time>.mcap``."""
+    no_record: bool = False
+    params: Params = field(default_factory=Params)
+    vehicle_params: tuple[tuple[str, float], ...] = ()
+    seed: int = 0
+    noise: bool = False
+    wind: tuple[float, float] = (0.0, 0.0)
+    link_outages_s: tuple[tuple[float, float], ...] = ()
+    hfov_deg: float = 60.0
+    size_px: tuple[int, int] = (640, 480)
+    connect_timeout_s: float = 30.0
+    command_line: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class FlightSummary:
+    outcome: Outcome
+    evaluation: Evaluation
+    route_length_m: float
+    flight_time_s: float
+    frames: int
+    recording: Path | None
+    wall_time_s: float
+    vehicle: str
+
+
+def default_recording_path(now: datetime | None = None) -> Path:
+    stamp = (now or datetime.now(UTC)).strftime("%Y%m%dT%H%M%SZ")
+    return Path("recordings") / f"{stamp}.mcap"
+
+
+def target_picture(scene: Scene, intrinsics: Intrinsics) -> bytes:
+    """The scene's target building alone, photographed from above (PNG)."""
+    building = scene.target_building
+    xs = [x for blk in building.blocks for x, _ in blk.footprint_enu_m]
+    ys = [y for blk in building.blocks for _, y in blk.footprint_enu_m]
+    top = max(blk.top_m for blk in building.blocks)
+    centre = ((min(xs) + max(xs)) / 2.0, (min(ys) + max(ys)) / 2.0, top + _TARGET_VIEW_M)
+    alone = dataclasses.replace(scene, buildings=(building,))
+    return png_encode(render(alone, CameraPose(centre, 0.0, -90.0), intrinsics))
+
+
+def fly(
+    config: FlyConfig,
+    *,
+    progress: Progress | None = None,
+    status: Callable[[str], None] | None = None,
+) -> FlightSummary:
+    """Fly one mission; raises InputError on bad input, LinkError when the vehicle cannot be
+    reached. ``progress`` hears each mission event, ``status`` the set-up steps."""
+    say = status or (lambda _text: None)
+    wall0 = time.monotonic()
+    scene = load_scene(config.scene)
+    w, h = config.size_px
+    intrinsics = Intrinsics.from_hfov(width_px=w, height_px=h, hfov_deg=config.hfov_deg)
+    target_png = _read_target(config.target) if config.target else target_picture(scene, intrinsics)
+    mission = Mission(config.params, png_decode(target_png, where="target"))
+    camera = open_camera(
+        config.camera,
+        scene=scene,
+        intrinsics=intrinsics,
+        noise_seed=config.seed if config.noise else None,
+    )
+    with ExitStack() as stack:
+        stack.callback(camera.close)
+        connect = config.connect
+        if connect is None:
+            connect = stack.enter_context(_builtin_sitl(config, scene))
+            say(f"built-in SITL at {connect}, speed-up {config.speedup:g}x, scene {scene.name!r}")
+        path = None if config.no_record else (config.record or default_recording_path())
+        recorder = None
+        if path is not None:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            writer = stack.enter_context(
+                RecordingWriter(path, metadata=_metadata(config, scene, connect))
+            )
+            recorder = MissionRecorder(writer)
+            recorder.target(target_png)
+        link = VehicleLink(open_transport(connect), tap=recorder.mavlink if recorder else None)
+        stack.callback(link.close)
+        link.wait_vehicle(config.connect_timeout_s)
+        home = link.state.home
+        assert home is not None
+        say(
+            f"vehicle {link.target_system} on {link.name}, "
+            f"home {home.lat_deg:.6f},{home.lon_deg:.6f}"
+        )
+        if recorder is not None:
+            recorder.home = home
+            recorder.note(Level.INFO, f"connected to sysid {link.target_system} on {link.name}")
+        if config.vehicle_params:
+            set_vehicle_params(link, config.vehicle_params)
+        time_scale = config.speedup if config.connect is None else 1.0
+        runner = Runner(
+            link,
+            camera,
+            mission,
+            recorder=recorder,
+            scene_origin=scene.home if config.camera == "sim" else None,
+            config=RunnerConfig(time_scale=time_scale),
+            progress=progress,
+        )
+        try:
+            outcome = runner.run()
+        except KeyboardInterrupt:
+            _abort(link, recorder, "interrupted by the user: RTL sent")
+            raise
+        evaluation = evaluate(runner, scene if config.camera == "sim" else None)
+        summary = FlightSummary(
+            outcome,
+            evaluation,
+            _route_length(runner.route),
+            _flight_time(runner.route),
+            runner.frames,
+            path,
+            time.monotonic() - wall0,
+            link.name,
+        )
+        if recorder is not None:
+            recorder.outcome(summary_record(summary))
+    return summary
+
+
+def summary_record(s: FlightSummary) -> dict[str, object]:
+    o = s.outcome
+    record: dict[str, object] = {
+        "status": o.status.value,
+        "reason": o.reason,
+        "visited": list(o.visited),
+        "matched_poi": o.matched_poi,
+        "match_score": round(o.match_score, 4),
+        "model_built": o.model_built,
+        "route_length_m": round(s.route_length_m, 1),
+        "flight_time_s": round(s.flight_time_s, 1),
+        "frames": s.frames,
+    }
+    e = s.evaluation
+    if e.matched_building:
+        record["matched_building"] = e.matched_building
+        record["target_building"] = e.target_building
+    if e.model_iou is not None:
+        record["model_iou"] = round(e.model_iou, 4)
+    return record
+
+
+def _read_target(path: Path) -> bytes:
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise InputError(f"--target {path}: cannot read: {exc.strerror}") from None
+    png_decode(data, where=f"--target {path}")  # fail now, not mid-flight
+    return data
+
+
+@contextmanager
+def _builtin_sitl(config: FlyConfig, scene: Scene) -> Iterator[str]:
+    from uavtool.sitl import Sitl, SitlConfig  # noqa: PLC0415 - only when flying the built-in one
+
+    sitl_config = SitlConfig(
+        endpoints=("tcpin:127.0.0.1:0",),
+        home=scene.home,
+        home_heading_deg=scene.home_heading_deg,
+        speedup=config.speedup,
+        seed=config.seed,
+        wind_speed_ms=config.wind[0],
+        wind_dir_deg=config.wind[1],
+        link_outages_s=config.link_outages_s,
+    )
+    with Sitl(sitl_config) as vehicle:
+        yield f"tcp:127.0.0.1:{vehicle.ports[0]}"
+        if vehicle.error is not None:
+            raise LinkError(f"the built-in SITL stopped: {vehicle.error}")
+
+
+def _metadata(config: FlyConfig, scene: Scene, connect: str) -> dict[str, dict[str, str]]:
+    return {
+        "mission": {"params": json.dumps(to_dict(config.params)), "tool_version": __version__},
+        "scene": {"name": scene.name, "json": json.dumps(scene_to_dict(scene))},
+        "seeds": {
+            "sitl": str(config.seed),
+            "camera_noise": str(config.seed) if config.noise else "",
+        },
+        "vehicle": {
+            "connect": connect,
+            "builtin": str(config.connect is None).lower(),
+            "camera": config.camera,
+        },
+        "command_line": {"argv": json.dumps(list(config.command_line))},
+    }
+
+
+def _abort(link: VehicleLink, recorder: MissionRecorder | None, why: str) -> None:
+    from uavtool.mavlink.dialect import COPTER_MODES  # noqa: PLC0415
+    from uavtool.mavlink.dialect import mavlink as M  # noqa: PLC0415
+
+    with contextlib.suppress(LinkError):  # best effort: the link may be what failed
+        link.command_long(
+            M.MAV_CMD_DO_SET_MODE, M.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, COPTER_MODES["RTL"]
+        )
+    if recorder is not None:
+        recorder.note(Level.WARNING, why)
+        recorder.outcome({"status": "interrupted", "reason": why})
+
+
+def _route_length(route: list[tuple[int, tuple[float, float, float]]]) -> float:
+    total = 0.0
+    for (_, a), (_, b) in itertools.pairwise(route):
+        total += math.dist(a, b)
+    return total
+
+
+def _flight_time(route: list[tuple[int, tuple[float, float, float]]]) -> float:
+    return (route[-1][0] - route[0][0]) / 1000.0 if len(route) > 1 else 0.0
+
+
+__all__ = [
+    "FlightSummary",
+    "FlyConfig",
+    "Status",
+    "Telemetry",
+    "default_recording_path",
+    "fly",
+    "target_picture",
+]

@@ -1,0 +1,158 @@
+"""What a flight writes into its recording, on which topics (README, "Recording format").
+
+The authoritative streams are ``/mission/observations`` (every observation, in the order the
+mission consumed it, numbered by ``step``) and ``/mission/outputs`` (every output, numbered by
+``n``, with the ``step`` that produced it): replay reads these. Photos go to ``/camera/*``,
+telemetry also to ``/vehicle/*``, events also to ``/mission/events`` and the model's GLB to
+``/mission/model`` so Foxglove and Rerun show them natively.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from typing import Any
+
+from uavtool.geo import GeoPoint, geo_from_enu
+from uavtool.images import png_encode
+from uavtool.mission import Event, Level, ModelBuilt, Observation, Output, Photo, Telemetry
+from uavtool.mission.codec import encode_observation, encode_output
+from uavtool.recording import (
+    CameraCalibration,
+    CompressedImage,
+    Direction,
+    FrameTransform,
+    LocationFix,
+    LogEntry,
+    LogLevel,
+    Model3D,
+    Pose,
+    PosesInFrame,
+    RecordingWriter,
+)
+
+OBSERVATIONS = "/mission/observations"
+OUTPUTS = "/mission/outputs"
+TARGET = "/mission/target"
+EVENTS = "/mission/events"
+MODEL = "/mission/model"
+IMAGE = "/camera/image"
+CALIBRATION = "/camera/calibration"
+CAMERA_POSE = "/camera/pose"
+FIX = "/vehicle/fix"
+POSE = "/vehicle/pose"
+
+_OBS_SCHEMA = {
+    "title": "uavtool.Observation",
+    "description": "What the mission consumed, in order: Telemetry, CommandResult, Photo "
+    "(pixels on /camera/image, same frame_index), LinkLost, LinkRestored.",
+    "type": "object",
+    "properties": {"step": {"type": "integer"}, "type": {"type": "string"}},
+    "required": ["step", "type"],
+}
+_OUT_SCHEMA = {
+    "title": "uavtool.Output",
+    "description": "What the mission produced, in order: commands (SetMode, Arm, Takeoff, "
+    "GoTo, SetGimbal, TakePhoto), Event, Shapes, Plan, Recognition, Viewpoints, ModelBuilt, "
+    "Outcome.",
+    "type": "object",
+    "properties": {
+        "n": {"type": "integer"},
+        "step": {"type": "integer"},
+        "type": {"type": "string"},
+    },
+    "required": ["n", "step", "type"],
+}
+_LEVELS = {Level.INFO: LogLevel.INFO, Level.WARNING: LogLevel.WARNING, Level.ERROR: LogLevel.ERROR}
+
+
+def now_ns() -> int:
+    """Receive time for the recording's ``log_time`` (the runner's clock, not the mission's)."""
+    return time.time_ns()
+
+
+class MissionRecorder:
+    """Writes a flight into ``writer``. ``home`` is the vehicle's home (for WGS-84 fixes)."""
+
+    def __init__(self, writer: RecordingWriter) -> None:
+        self.writer = writer
+        self.home: GeoPoint | None = None
+        writer.add_json_topic(OBSERVATIONS, schema_name="uavtool.Observation", schema=_OBS_SCHEMA)
+        writer.add_json_topic(OUTPUTS, schema_name="uavtool.Output", schema=_OUT_SCHEMA)
+        self._outputs = 0
+
+    def mavlink(self, direction: str, frame: bytes) -> None:
+        self.writer.write_mavlink(
+            frame,
+            direction=Direction.IN if direction == "in" else Direction.OUT,
+            log_time_ns=now_ns(),
+        )
+
+    def target(self, png: bytes) -> None:
+        self.writer.write(TARGET, CompressedImage(png, frame_id="target"), log_time_ns=now_ns())
+
+    def observation(self, step: int, obs: Observation) -> None:
+        t = now_ns()
+        vehicle_ns = _vehicle_ns(obs)
+        if isinstance(obs, Photo):
+            self.writer.write(
+                IMAGE,
+                CompressedImage(png_encode(obs.image_rgb)),
+                log_time_ns=t,
+                publish_time_ns=vehicle_ns,
+            )
+            self.writer.write(
+                CALIBRATION,
+                CameraCalibration.from_intrinsics(obs.intrinsics),
+                log_time_ns=t,
+                publish_time_ns=vehicle_ns,
+            )
+            self.writer.write(
+                CAMERA_POSE,
+                FrameTransform.from_camera_pose(obs.pose),
+                log_time_ns=t,
+                publish_time_ns=vehicle_ns,
+            )
+        elif isinstance(obs, Telemetry):
+            pose = Pose.from_enu_heading(obs.pos_enu_m, obs.heading_deg)
+            self.writer.write(
+                POSE, PosesInFrame((pose,)), log_time_ns=t, publish_time_ns=vehicle_ns
+            )
+            if self.home is not None:
+                x, y, z = obs.pos_enu_m
+                geo = geo_from_enu(self.home, x, y, z)
+                self.writer.write(
+                    FIX,
+                    LocationFix(geo.lat_deg, geo.lon_deg, geo.alt_amsl_m),
+                    log_time_ns=t,
+                    publish_time_ns=vehicle_ns,
+                )
+        payload = {"step": step, **encode_observation(obs)}
+        self.writer.write_json(OBSERVATIONS, payload, log_time_ns=t, publish_time_ns=vehicle_ns)
+
+    def outputs(self, step: int, outputs: list[Output]) -> None:
+        t = now_ns()
+        for out in outputs:
+            self._outputs += 1
+            payload = {"n": self._outputs, "step": step, **encode_output(out)}
+            self.writer.write_json(OUTPUTS, payload, log_time_ns=t)
+            if isinstance(out, Event):
+                self.writer.write(EVENTS, LogEntry(_LEVELS[out.level], out.text), log_time_ns=t)
+            elif isinstance(out, ModelBuilt):
+                self.writer.write(MODEL, Model3D(out.glb), log_time_ns=t)
+
+    def note(self, level: Level, text: str, *, name: str = "runner") -> None:
+        """A runner event (connection, vehicle STATUSTEXT …) on the events topic only."""
+        self.writer.write(EVENTS, LogEntry(_LEVELS[level], text, name=name), log_time_ns=now_ns())
+
+    def outcome(self, record: dict[str, Any]) -> None:
+        self.writer.add_metadata("outcome", {k: _text(v) for k, v in record.items()})
+
+
+def _vehicle_ns(obs: Observation) -> int | None:
+    ms = getattr(obs, "time_boot_ms", None)
+    return ms * 1_000_000 if isinstance(ms, int) and ms > 0 else None
+
+
+def _text(value: Any) -> str:
+    return value if isinstance(value, str) else json.dumps(value)

@@ -1,0 +1,226 @@
+"""The imperative shell around the mission: reads the link, turns what the vehicle says into
+observations, feeds them to the mission one at a time, executes its commands, takes its
+photos, and records every input and output.
+
+It waits on telemetry, never on fixed sleeps. Its only clocks are the link's silence (wall
+time scaled by the vehicle's speed-up) and, for command acknowledgements, vehicle time.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from uavtool.geo import GeoPoint, enu_from_geo
+from uavtool.link import VehicleLink
+from uavtool.mavlink.dialect import mavlink as M
+from uavtool.mission import (
+    Command,
+    CommandResult,
+    Event,
+    Level,
+    LinkLost,
+    LinkRestored,
+    Mission,
+    Observation,
+    Outcome,
+    Output,
+    Photo,
+    SetGimbal,
+    TakePhoto,
+    Telemetry,
+)
+from uavtool.runner.camera import CameraSource
+from uavtool.runner.record import MissionRecorder
+from uavtool.runner.vehicle import RESULT_NAMES, camera_pose, send_command, telemetry
+
+Progress = Callable[[str, Telemetry | None], None]
+"""Told each mission event, with the latest telemetry."""
+
+
+@dataclass(frozen=True, slots=True)
+class RunnerConfig:
+    """``time_scale``: vehicle seconds per wall second (the SITL's speed-up, 1 for a real
+    vehicle). Timeouts are in vehicle seconds."""
+
+    time_scale: float = 1.0
+    ack_timeout_s: float = 3.0
+    link_timeout_s: float = 3.0
+    min_link_timeout_wall_s: float = 0.5
+    link_report_s: float = 1.0
+
+
+class Runner:
+    """Flies ``mission`` on ``link`` with ``camera``; ``scene_origin`` is the geographic
+    origin of the camera's world (the scene's home) when it is simulated."""
+
+    def __init__(
+        self,
+        link: VehicleLink,
+        camera: CameraSource,
+        mission: Mission,
+        *,
+        recorder: MissionRecorder | None,
+        scene_origin: GeoPoint | None = None,
+        config: RunnerConfig = RunnerConfig(),
+        progress: Progress | None = None,
+    ) -> None:
+        self.link = link
+        self.camera = camera
+        self.mission = mission
+        self.recorder = recorder
+        self.config = config
+        self.progress = progress or (lambda _text, _t: None)
+        self.scene_origin = scene_origin
+        self.step = 0
+        self.frames = 0
+        self.coalesced = 0  # telemetry snapshots superseded before the mission saw them
+        self.route: list[tuple[int, tuple[float, float, float]]] = []  # (time_boot_ms, ENU)
+        self._queue: deque[Observation] = deque()
+        self._pending: dict[int, tuple[int, int]] = {}  # MAV_CMD -> (action id, vehicle ms)
+        self._gimbal = (0.0, 0.0)
+        self._last: Telemetry | None = None
+        self._silent_since: float | None = None
+        self._lost_reported = 0.0
+        self._link_lost = False
+        self._last_heartbeat = 0.0
+        self.scene_offset = (0.0, 0.0)  # vehicle home in the scene's frame (east, north)
+
+    # --- the loop ---------------------------------------------------------------------------
+
+    def run(self) -> Outcome:
+        home = self.link.state.home
+        if home is None:
+            raise RuntimeError("Runner.run needs the vehicle's home (VehicleLink.wait_vehicle)")
+        self.home = home
+        if self.scene_origin is not None:
+            east, north, _ = enu_from_geo(self.scene_origin, home)
+            self.scene_offset = (east, north)
+        self._handle(self.mission.start())
+        last_rx = time.monotonic()
+        while True:
+            self._drain()
+            if self.mission.done:
+                break
+            msgs = self.link.poll(0.02)
+            now = time.monotonic()
+            if msgs:
+                if self._link_lost:
+                    self._link_lost = False
+                    self._queue.append(LinkRestored(self._silent_s(now, last_rx)))
+                last_rx = now
+                for msg in msgs:
+                    self._on_message(msg)
+            else:
+                self._check_silence(now, last_rx)
+            if now - self._last_heartbeat > 1.0:
+                self._heartbeat(now)
+        assert self.mission.outcome is not None
+        return self.mission.outcome
+
+    def _drain(self) -> None:
+        while self._queue and self.mission.outcome is None:
+            obs = self._queue.popleft()
+            self.step += 1
+            if self.recorder is not None:
+                self.recorder.observation(self.step, obs)
+            outputs = self.mission.step(obs)
+            self._handle(outputs)
+
+    def _handle(self, outputs: list[Output]) -> None:
+        if self.recorder is not None:
+            self.recorder.outputs(self.step, outputs)
+        for out in outputs:
+            if isinstance(out, TakePhoto):
+                self._queue.append(self._photo(out))
+            elif isinstance(out, Command):
+                self._command(out)
+            elif isinstance(out, Event):
+                self.progress(out.text, self.mission.last)
+
+    # --- vehicle messages -------------------------------------------------------------------
+
+    def _on_message(self, msg: object) -> None:
+        kind = msg.get_type()  # type: ignore[attr-defined]
+        if kind == "GLOBAL_POSITION_INT":
+            t = telemetry(self.link, self._gimbal)
+            if t is not None:
+                self._last = t
+                if self._queue and isinstance(self._queue[-1], Telemetry):
+                    # The mission wants the vehicle's state now, not a backlog of it: keep
+                    # only the newest snapshot between two other observations.
+                    self._queue[-1] = t
+                    self.coalesced += 1
+                else:
+                    self._queue.append(t)
+                if not t.landed:
+                    self.route.append((t.time_boot_ms, t.pos_enu_m))
+                self._expire_acks(t.time_boot_ms)
+        elif kind == "COMMAND_ACK":
+            self._on_ack(msg)
+        elif kind == "HEARTBEAT":
+            # Pace our heartbeat by the vehicle's: at any speed-up the vehicle hears us as
+            # often as it speaks, so its ground-station failsafe never fires by accident.
+            self._heartbeat(time.monotonic())
+        elif kind == "STATUSTEXT" and self.recorder is not None:
+            self.recorder.note(Level.INFO, f"vehicle: {msg.text}", name="vehicle")  # type: ignore[attr-defined]
+
+    def _on_ack(self, msg: object) -> None:
+        command, result = msg.command, msg.result  # type: ignore[attr-defined]
+        pending = self._pending.get(command)
+        if pending is None or result == M.MAV_RESULT_IN_PROGRESS:
+            return
+        del self._pending[command]
+        accepted = result == M.MAV_RESULT_ACCEPTED
+        detail = "" if accepted else f"refused ({RESULT_NAMES.get(result, result)})"
+        self._queue.append(CommandResult(pending[0], accepted, detail))
+
+    def _expire_acks(self, now_ms: int) -> None:
+        limit_ms = self.config.ack_timeout_s * 1000.0
+        for command, (action_id, sent_ms) in list(self._pending.items()):
+            if now_ms - sent_ms > limit_ms:
+                del self._pending[command]
+                detail = f"no COMMAND_ACK in {self.config.ack_timeout_s:g} s"
+                self._queue.append(CommandResult(action_id, False, detail))
+
+    def _check_silence(self, now: float, last_rx: float) -> None:
+        c = self.config
+        wall_limit = max(c.link_timeout_s / c.time_scale, c.min_link_timeout_wall_s)
+        if now - last_rx < wall_limit:
+            return
+        if not self._link_lost or now - self._lost_reported >= c.link_report_s / c.time_scale:
+            self._link_lost = True
+            self._lost_reported = now
+            self._queue.append(LinkLost(self._silent_s(now, last_rx)))
+
+    def _silent_s(self, now: float, last_rx: float) -> float:
+        return round((now - last_rx) * self.config.time_scale, 3)
+
+    def _heartbeat(self, now: float) -> None:
+        self._last_heartbeat = now
+        self.link.heartbeat()
+
+    # --- executing outputs ------------------------------------------------------------------
+
+    def _command(self, cmd: Command) -> None:
+        if isinstance(cmd, SetGimbal):
+            self._gimbal = (cmd.pitch_deg, cmd.yaw_deg)
+        sent = send_command(self.link, cmd, self.home)
+        if sent.mav_cmd == 0:
+            self._queue.append(CommandResult(cmd.id, True, "sent"))
+        else:
+            now_ms = self._last.time_boot_ms if self._last is not None else 0
+            self._pending[sent.mav_cmd] = (cmd.id, now_ms)
+
+    def _photo(self, cmd: TakePhoto) -> Photo:
+        t = self._last
+        assert t is not None  # the mission photographs only after telemetry
+        pose = camera_pose(t)
+        image = self.camera.capture(camera_pose(t, offset_enu_m=self.scene_offset))
+        photo = Photo(
+            cmd.id, self.frames, cmd.tag, t.time_boot_ms, pose, self.camera.intrinsics, image
+        )
+        self.frames += 1
+        return photo

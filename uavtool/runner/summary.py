@@ -1,0 +1,48 @@
+"""Human-readable progress lines and the end-of-flight summary (no printing here)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from uavtool.mission import Telemetry
+
+if TYPE_CHECKING:
+    from uavtool.runner.fly import FlightSummary
+
+
+def format_progress(text: str, t: Telemetry | None) -> str:
+    if t is None:
+        return f"[{'':>7s}] {text}"
+    x, y, z = t.pos_enu_m
+    return f"[{t.time_boot_ms / 1000:6.1f}s] {t.mode:<7s} E{x:6.1f} N{y:6.1f} U{z:5.1f}  {text}"
+
+
+def format_summary(s: FlightSummary) -> str:
+    o, e = s.outcome, s.evaluation
+    lines = [
+        "",
+        f"outcome        {o.status.value}: {o.reason}",
+        f"flight         {s.flight_time_s:.1f} s sim, route {s.route_length_m:.1f} m, "
+        f"{s.frames} photos, {s.wall_time_s:.1f} s wall",
+    ]
+    visited = [
+        f"poi {k}" + (f" ({e.visited[i]})" if i < len(e.visited) else "")
+        for i, k in enumerate(o.visited)
+    ]
+    lines.append(f"visited        {', '.join(visited) if visited else 'none'}")
+    if o.matched_poi >= 0:
+        name = f" = building {e.matched_building!r}" if e.matched_building else ""
+        truth = ""
+        if e.target_building:
+            ok = "correct" if e.matched_building == e.target_building else "WRONG"
+            truth = f" ({ok}: the target is {e.target_building!r})"
+        lines.append(f"matched        poi {o.matched_poi}{name}, score {o.match_score:.3f}{truth}")
+    else:
+        lines.append("matched        nothing")
+    if o.model_built:
+        iou = f", IoU vs ground truth {e.model_iou:.3f}" if e.model_iou is not None else ""
+        lines.append(f"model          built{iou}")
+    else:
+        lines.append("model          not built")
+    lines.append(f"recording      {s.recording if s.recording else '(not recorded)'}")
+    return "\n".join(lines)

@@ -1,0 +1,59 @@
+"""Joining the roofs of one building: seen from above, a building whose blocks have different
+heights shows one roof per block, split by a thin strip of wall. Same-coloured shapes closer
+than a gap are merged into one outline (a morphological closing of the polygons)."""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely  # type: ignore[import-untyped]
+
+from uavtool.vision.shapes import Shape
+
+
+def merge_touching(shapes: tuple[Shape, ...], *, gap_px: float) -> tuple[Shape, ...]:
+    """Shapes of one colour less than ``gap_px`` apart become one shape (union closed by
+    ``gap_px / 2``, mitred so corners stay sharp); others are returned unchanged, in order.
+    The merged shape takes the place of its first member."""
+    if gap_px <= 0.0 or len(shapes) < 2:
+        return shapes
+    polys = [shapely.Polygon(s.polygon_px, list(s.holes_px)) for s in shapes]
+    group = list(range(len(shapes)))
+
+    def root(i: int) -> int:
+        while group[i] != i:
+            i = group[i]
+        return i
+
+    for i in range(len(shapes)):
+        for j in range(i + 1, len(shapes)):
+            if (
+                shapes[i].colour_rgb == shapes[j].colour_rgb
+                and polys[i].distance(polys[j]) < gap_px
+            ):
+                group[root(j)] = root(i)
+    members: dict[int, list[int]] = {}
+    for i in range(len(shapes)):
+        members.setdefault(root(i), []).append(i)
+    out: list[Shape] = []
+    for first, idx in sorted(members.items()):
+        if len(idx) == 1:
+            out.append(shapes[first])
+            continue
+        half = gap_px / 2.0
+        union = shapely.union_all([polys[i].buffer(half, join_style="mitre") for i in idx])
+        closed = union.buffer(-half, join_style="mitre")
+        if not isinstance(closed, shapely.Polygon) or closed.is_empty:
+            out.extend(shapes[i] for i in idx)  # did not close into one outline: keep apart
+            continue
+        closed = closed.simplify(0.5, preserve_topology=True)
+        out.append(
+            Shape.from_rings(
+                colour_rgb=shapes[first].colour_rgb,
+                polygon_px=np.asarray(closed.exterior.coords[:-1], dtype=np.float64),
+                holes_px=tuple(
+                    np.asarray(r.coords[:-1], dtype=np.float64) for r in closed.interiors
+                ),
+                cut_by_border=any(shapes[i].cut_by_border for i in idx),
+            )
+        )
+    return tuple(out)
