@@ -19,7 +19,8 @@ from collections.abc import Callable, Generator
 from typing import TypeVar
 
 from uavtool.geo import wrap_180
-from uavtool.mission.errors import MissionInputError, MissionStateError
+from uavtool.mission.analysis import target_shapes
+from uavtool.mission.errors import MissionStateError
 from uavtool.mission.observations import (
     CommandResult,
     LinkLost,
@@ -48,7 +49,6 @@ from uavtool.mission.outputs import (
     Vec3,
 )
 from uavtool.mission.params import Params
-from uavtool.vision import Shape, vectorize
 
 T = TypeVar("T")
 Wait = Generator[None, Observation, T]
@@ -76,11 +76,7 @@ class Mission:
 
     def __init__(self, params: Params, target_rgb: U8Array) -> None:
         self.params = params
-        target_shapes = vectorize(target_rgb, params.vectorize)
-        if not target_shapes:
-            raise MissionInputError("target image: no coloured shape found in it")
-        self.target_shapes = target_shapes
-        self.target: Shape = max(target_shapes, key=lambda s: s.area_px)
+        self.target_shapes, self.target = target_shapes(params, target_rgb)
         self.outcome: Outcome | None = None
         self.last: Telemetry | None = None
         self.visited: list[int] = []

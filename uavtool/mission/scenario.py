@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from uavtool.mission.analysis import judge, nadir_shapes, side_shapes
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import (
     Level,
@@ -28,11 +29,9 @@ from uavtool.nav import (
     visit_order,
 )
 from uavtool.nav import ground_point as nav_ground_point
-from uavtool.vision import Shape, VectorizeParams, best_match, vectorize
+from uavtool.vision import Shape
 from uavtool.vision.errors import VisionError
-from uavtool.vision.merge import merge_touching
 from uavtool.vision.model3d import View, build_model, central_shape, model_glb, same_colour
-from uavtool.vision.vectorize import hue_distance_deg
 
 if TYPE_CHECKING:
     from uavtool.mission.mission import Mission, Wait
@@ -65,7 +64,7 @@ def fly(m: Mission) -> Wait[None]:
     yield from m.move((here[0], here[1], p.overview_alt_m), None, "overview position")
 
     overview = yield from m.photo("overview", -90.0)
-    shapes = _vectorize(m, overview, m.params.vectorize)
+    shapes = _vectorize(m, overview)
     pois = _points_of_interest(m, overview, shapes)
     if not pois:
         raise m.end(Status.NO_MATCH, "the overview photo shows no building")
@@ -89,12 +88,11 @@ def fly(m: Mission) -> Wait[None]:
     yield from _model(m, found, obstacles)
 
 
-def _vectorize(
-    m: Mission, photo: Photo, params: VectorizeParams, *, nadir: bool = True
-) -> tuple[Shape, ...]:
-    shapes = vectorize(photo.image_rgb, params)
+def _vectorize(m: Mission, photo: Photo, *, nadir: bool = True) -> tuple[Shape, ...]:
     if nadir:
-        shapes = merge_touching(shapes, gap_px=m.params.mission.roof_gap_px)
+        shapes = nadir_shapes(m.params, photo.image_rgb)
+    else:
+        shapes = side_shapes(m.params, photo.image_rgb)
     m.emit(Shapes(photo.frame_index, photo.tag, shapes))
     return shapes
 
@@ -126,21 +124,12 @@ def _search(
         x, y = poi.pos_en_m
         yield from m.move((x, y, p.detail_alt_m), None, f"point of interest {k}")
         photo = yield from m.photo(f"poi-{k}", -90.0)
-        shapes = _vectorize(m, photo, m.params.vectorize)
+        shapes = _vectorize(m, photo)
         m.visited.append(k)
-        centre = central_shape(shapes, photo.intrinsics)
-        candidate = next((i for i, s in enumerate(shapes) if s is centre), -1)
-        if candidate >= 0:
-            _, matches = best_match(m.target, shapes, m.params.recognize)
-            scores = tuple(match.score for match in matches)
-            score = scores[candidate]
-        else:
-            scores, score = (), 0.0
-        matched = candidate >= 0 and score >= m.params.recognize.threshold
-        hue_limit = p.match_hue_tolerance_deg
-        if matched and centre is not None and hue_limit > 0:
-            matched = hue_distance_deg(centre.colour_rgb, m.target.colour_rgb) <= hue_limit
-        m.emit(Recognition(photo.frame_index, k, scores, candidate, score, matched))
+        j = judge(m.params, m.target, shapes, photo.intrinsics)
+        centre = shapes[j.candidate] if j.candidate >= 0 else None
+        score, matched = j.score, j.matched
+        m.emit(Recognition(photo.frame_index, k, j.scores, j.candidate, score, matched))
         m.event(
             Level.INFO,
             f"point of interest {k}: {'MATCH' if matched else 'no match'} (score {score:.3f})",
@@ -176,7 +165,7 @@ def _model(
     top = top_viewpoint(rect, front_heading, alt_m=p.detail_alt_m)
     yield from m.move(top.pos_enu_m, top.heading_deg, "top viewpoint")
     top_photo = yield from m.photo("top", -90.0)
-    top_shapes = _vectorize(m, top_photo, m.params.vectorize)
+    top_shapes = _vectorize(m, top_photo)
     obj = central_shape(top_shapes, top_photo.intrinsics)
     if obj is None:
         raise m.end(Status.ABORTED, "the top photo shows no building")
@@ -199,7 +188,7 @@ def _model(
         yield from m.move((x, y, p.detail_alt_m), vp.heading_deg, f"above the {vp.name} viewpoint")
         yield from m.move((x, y, z), vp.heading_deg, f"{vp.name} viewpoint")
         photo = yield from m.photo(vp.name, 0.0)
-        shapes = _vectorize(m, photo, m.params.side_vectorize, nadir=False)
+        shapes = _vectorize(m, photo, nadir=False)
         silhouette = same_colour(shapes, obj.colour_rgb, hue_tolerance_deg=_SIDE_HUE_TOLERANCE_DEG)
         views[vp.name] = View(silhouette, photo.pose, photo.intrinsics)
         yield from m.move(

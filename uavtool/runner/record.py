@@ -30,17 +30,18 @@ from uavtool.recording import (
     PosesInFrame,
     RecordingWriter,
 )
-
-OBSERVATIONS = "/mission/observations"
-OUTPUTS = "/mission/outputs"
-TARGET = "/mission/target"
-EVENTS = "/mission/events"
-MODEL = "/mission/model"
-IMAGE = "/camera/image"
-CALIBRATION = "/camera/calibration"
-CAMERA_POSE = "/camera/pose"
-FIX = "/vehicle/fix"
-POSE = "/vehicle/pose"
+from uavtool.recording.topics import (
+    CALIBRATION,
+    CAMERA_POSE,
+    EVENTS,
+    FIX,
+    IMAGE,
+    MODEL,
+    OBSERVATIONS,
+    OUTPUTS,
+    POSE,
+    TARGET,
+)
 
 _OBS_SCHEMA = {
     "title": "uavtool.Observation",
@@ -130,16 +131,22 @@ class MissionRecorder:
         payload = {"step": step, **encode_observation(obs)}
         self.writer.write_json(OBSERVATIONS, payload, log_time_ns=t, publish_time_ns=vehicle_ns)
 
-    def outputs(self, step: int, outputs: list[Output]) -> None:
-        t = now_ns()
+    def outputs(self, step: int, outputs: list[Output], *, log_time_ns: int | None = None) -> None:
+        t = now_ns() if log_time_ns is None else log_time_ns
         for out in outputs:
             self._outputs += 1
-            payload = {"n": self._outputs, "step": step, **encode_output(out)}
-            self.writer.write_json(OUTPUTS, payload, log_time_ns=t)
+            self.output_json(self._outputs, step, encode_output(out), log_time_ns=t)
             if isinstance(out, Event):
                 self.writer.write(EVENTS, LogEntry(_LEVELS[out.level], out.text), log_time_ns=t)
             elif isinstance(out, ModelBuilt):
                 self.writer.write(MODEL, Model3D(out.glb), log_time_ns=t)
+
+    def output_json(self, n: int, step: int, data: dict[str, Any], *, log_time_ns: int) -> None:
+        self.writer.write_json(OUTPUTS, {"n": n, "step": step, **data}, log_time_ns=log_time_ns)
+
+    @staticmethod
+    def level(level: Level) -> LogLevel:
+        return _LEVELS[level]
 
     def note(self, level: Level, text: str, *, name: str = "runner") -> None:
         """A runner event (connection, vehicle STATUSTEXT …) on the events topic only."""

@@ -1,0 +1,146 @@
+"""``uavtool replay``: re-run a recorded mission from its observations."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import click
+
+from uavtool.errors import InputError
+
+
+@click.command()
+@click.argument("recording", type=click.Path(path_type=Path))
+@click.option(
+    "--check",
+    is_flag=True,
+    help="Every output must equal the recorded one exactly (exit 1 if not).",
+)
+@click.option(
+    "--set",
+    "settings",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="Override a mission parameter (repeatable), e.g. vectorize.rdp_epsilon_px=3.",
+)
+@click.option(
+    "--params",
+    "params_file",
+    type=click.Path(path_type=Path),
+    default=None,
+    help="JSON file of parameters (nested or dotted keys) to override.",
+)
+@click.option(
+    "--out",
+    type=click.Path(path_type=Path),
+    default=None,
+    help="Write the replay as a new recording.",
+)
+@click.option("--vision-only", is_flag=True, help="Only re-run vectorize/match on every frame.")
+@click.option("-q", "--quiet", is_flag=True, help="No progress bar.")
+def replay(
+    recording: Path,
+    check: bool,
+    settings: tuple[str, ...],
+    params_file: Path | None,
+    out: Path | None,
+    vision_only: bool,
+    quiet: bool,
+) -> None:
+    """Feed RECORDING's observations to a fresh mission and compare every output.
+
+    \b
+    Examples:
+      uavtool replay --check recordings/golden/paper.mcap
+      uavtool replay recordings/golden/paper.mcap --set recognize.threshold=0.9
+      uavtool replay flight.mcap --set vectorize.rdp_epsilon_px=3 --out replayed.mcap
+    """
+    from uavtool.mission.params import with_overrides
+    from uavtool.replay import load_flight, reanalyse_frames
+    from uavtool.replay import replay as run_replay
+    from uavtool.replay.write import write_replay
+
+    flight = load_flight(recording)
+    overrides: dict[str, object] = {}
+    if params_file is not None:
+        overrides.update(_params_file(params_file))
+    for text in settings:
+        key, sep, value = text.partition("=")
+        if not sep:
+            raise InputError(f"--set {text!r}: expected KEY=VALUE")
+        overrides[key.strip()] = value.strip()
+    params = with_overrides(flight.params, overrides)  # type: ignore[arg-type]
+    changed = bool(overrides)
+    if flight.truncated:
+        click.echo(
+            f"{recording}: truncated recording: replaying the {len(flight.observations)} observations it holds",
+            err=True,
+        )
+    if not vision_only:
+        with (
+            click.progressbar(length=len(flight.observations), label="replay", file=sys.stderr)
+            if not quiet
+            else _NoBar() as bar
+        ):
+            last = [0]
+
+            def progress(done: int, _total: int) -> None:
+                bar.update(done - last[0])
+                last[0] = done
+
+            result = run_replay(flight, params, progress=progress)
+        click.echo(
+            f"{recording}: {result.steps} observations replayed, {len(result.outputs)} outputs "
+            f"({len(flight.outputs)} recorded)"
+        )
+        if result.first_difference is None and result.divergence is None:
+            click.echo("identical: every output equals the recorded one")
+        elif result.first_difference is not None:
+            click.echo(f"first difference: {result.first_difference.describe()}")
+        if result.divergence is not None:
+            click.echo(f"diverged at step {result.divergence.step}: {result.divergence.reason}")
+            click.echo("mission stopped there; per-frame vision continues on every recorded frame")
+        if out is not None:
+            write_replay(recording, out, result.outputs, result.glbs, params)
+            click.echo(f"wrote {out}")
+    if changed or vision_only:
+        for change in reanalyse_frames(flight, params):
+            if change.changed or vision_only:
+                click.echo(change.describe())
+    if check and not vision_only and result.first_difference is not None:
+        sys.exit(1)
+
+
+class _NoBar:
+    def __enter__(self) -> _NoBar:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        pass
+
+    def update(self, n: int) -> None:
+        pass
+
+
+def _params_file(path: Path) -> dict[str, object]:
+    try:
+        data = json.loads(path.read_text())
+    except OSError as exc:
+        raise InputError(f"--params {path}: cannot read: {exc.strerror}") from None
+    except ValueError as exc:
+        raise InputError(f"--params {path}: not JSON: {exc}") from None
+    if not isinstance(data, dict):
+        raise InputError(f"--params {path}: expected a JSON object")
+    flat: dict[str, object] = {}
+
+    def walk(prefix: str, value: object) -> None:
+        if isinstance(value, dict):
+            for k, v in value.items():
+                walk(f"{prefix}{k}.", v)
+        else:
+            flat[prefix.rstrip(".")] = value
+
+    walk("", data)
+    return flat

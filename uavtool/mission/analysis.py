@@ -1,0 +1,63 @@
+"""The mission's per-photo vision, as plain functions of (parameters, photo): what the mission
+does with each frame, and what replay re-runs on every recorded frame."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from uavtool.camera import Intrinsics
+from uavtool.mission.errors import MissionInputError
+from uavtool.mission.observations import U8Array
+from uavtool.mission.params import Params
+from uavtool.vision import Shape, best_match, vectorize
+from uavtool.vision.merge import merge_touching
+from uavtool.vision.model3d import central_shape
+from uavtool.vision.vectorize import hue_distance_deg
+
+
+def nadir_shapes(params: Params, image_rgb: U8Array) -> tuple[Shape, ...]:
+    """Shapes of a photo from above: roofs, with one building's roofs joined."""
+    shapes = vectorize(image_rgb, params.vectorize)
+    return merge_touching(shapes, gap_px=params.mission.roof_gap_px)
+
+
+def side_shapes(params: Params, image_rgb: U8Array) -> tuple[Shape, ...]:
+    """Shapes of a photo from the side (walls and roofs)."""
+    return vectorize(image_rgb, params.side_vectorize)
+
+
+def target_shapes(params: Params, target_rgb: U8Array) -> tuple[tuple[Shape, ...], Shape]:
+    """The target picture's shapes and the target (the largest)."""
+    shapes = nadir_shapes(params, target_rgb)
+    if not shapes:
+        raise MissionInputError("target image: no coloured shape found in it")
+    return shapes, max(shapes, key=lambda s: s.area_px)
+
+
+@dataclass(frozen=True, slots=True)
+class Judgement:
+    """A nadir photo at a point of interest compared with the target: ``scores`` per shape,
+    ``candidate`` the shape the photo is centred on (−1 none), its ``score``, and whether it
+    is a match (shape score at the threshold and, if asked, a hue close to the target's)."""
+
+    scores: tuple[float, ...]
+    candidate: int
+    score: float
+    matched: bool
+
+
+def judge(
+    params: Params, target: Shape, shapes: tuple[Shape, ...], intrinsics: Intrinsics
+) -> Judgement:
+    centre = central_shape(shapes, intrinsics)
+    candidate = next((i for i, s in enumerate(shapes) if s is centre), -1)
+    if centre is None or candidate < 0:
+        return Judgement((), -1, 0.0, False)
+    _, matches = best_match(target, shapes, params.recognize)
+    scores = tuple(match.score for match in matches)
+    score = scores[candidate]
+    matched = score >= params.recognize.threshold
+    hue_limit = params.mission.match_hue_tolerance_deg
+    if matched and hue_limit > 0:
+        matched = hue_distance_deg(centre.colour_rgb, target.colour_rgb) <= hue_limit
+    return Judgement(scores, candidate, score, matched)

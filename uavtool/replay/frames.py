@@ -1,0 +1,91 @@
+"""Per-frame re-analysis: the mission's vision (vectorize, and for photos at points of interest
+the comparison with the target) re-run on every recorded photo, and what changed."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from uavtool.mission import Params, Photo
+from uavtool.mission.analysis import judge, nadir_shapes, side_shapes, target_shapes
+from uavtool.replay.load import RecordedFlight
+
+_SIDE_TAGS = ("front", "right")
+
+
+@dataclass(frozen=True, slots=True)
+class FrameChange:
+    """One photo, recorded vs re-analysed: shape counts, and for points of interest the
+    candidate's score and the match decision (None where the frame was not judged)."""
+
+    frame_index: int
+    tag: str
+    shapes_before: int
+    shapes_after: int
+    score_before: float | None
+    score_after: float | None
+    matched_before: bool | None
+    matched_after: bool | None
+
+    @property
+    def changed(self) -> bool:
+        return (
+            self.shapes_before != self.shapes_after
+            or self.score_before != self.score_after
+            or self.matched_before != self.matched_after
+        )
+
+    def describe(self) -> str:
+        parts = [f"shapes {self.shapes_before} → {self.shapes_after}"]
+        if self.score_after is not None:
+            before = "—" if self.score_before is None else f"{self.score_before:.3f}"
+            parts.append(f"match score {before} → {self.score_after:.3f}")
+            if self.matched_before == self.matched_after:
+                parts.append("decision unchanged")
+            else:
+                parts.append(f"decision {_word(self.matched_before)} → {_word(self.matched_after)}")
+        return f"frame {self.frame_index} ({self.tag}): " + ", ".join(parts)
+
+
+def reanalyse_frames(flight: RecordedFlight, params: Params) -> list[FrameChange]:
+    """Every recorded photo through the mission's vision with ``params``, beside the recorded
+    results."""
+    recorded_shapes: dict[int, int] = {}
+    recorded_judgement: dict[int, dict[str, Any]] = {}
+    for out in flight.outputs:
+        kind = out.data.get("type")
+        if kind == "Shapes":
+            recorded_shapes[int(out.data["frame_index"])] = len(out.data["shapes"])
+        elif kind == "Recognition":
+            recorded_judgement[int(out.data["frame_index"])] = out.data
+    _, target = target_shapes(params, flight.target_rgb)
+    changes = []
+    for obs in flight.observations:
+        if not isinstance(obs, Photo):
+            continue
+        side = obs.tag in _SIDE_TAGS
+        shapes = side_shapes(params, obs.image_rgb) if side else nadir_shapes(params, obs.image_rgb)
+        score_after = matched_after = score_before = matched_before = None
+        if obs.tag.startswith("poi-"):
+            j = judge(params, target, shapes, obs.intrinsics)
+            score_after, matched_after = j.score, j.matched
+            before = recorded_judgement.get(obs.frame_index)
+            if before is not None:
+                score_before, matched_before = float(before["score"]), bool(before["matched"])
+        changes.append(
+            FrameChange(
+                obs.frame_index,
+                obs.tag,
+                recorded_shapes.get(obs.frame_index, 0),
+                len(shapes),
+                score_before,
+                score_after,
+                matched_before,
+                matched_after,
+            )
+        )
+    return changes
+
+
+def _word(matched: bool | None) -> str:
+    return "—" if matched is None else ("match" if matched else "no match")

@@ -1,0 +1,115 @@
+"""A recorded flight as replay needs it: the parameters, the target picture, every observation
+in the order the mission consumed it (photos with their pixels), and every recorded output.
+Nothing else is read: not the scene, not the vehicle, not the network."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from uavtool.errors import InputError
+from uavtool.images import png_decode
+from uavtool.mission import Observation, Params
+from uavtool.mission.codec import decode_observation
+from uavtool.mission.observations import U8Array
+from uavtool.mission.params import from_dict
+from uavtool.recording import CompressedImage, JsonDocument, RecordingReader
+from uavtool.recording.topics import IMAGE, OBSERVATIONS, OUTPUTS, TARGET
+
+
+class ReplayInputError(InputError):
+    """The recording cannot be replayed (not a mission recording, frames missing …)."""
+
+
+@dataclass(frozen=True, slots=True)
+class RecordedOutput:
+    """One recorded output: its number ``n``, the ``step`` (observation) that produced it, and
+    its JSON form without those two keys."""
+
+    n: int
+    step: int
+    data: dict[str, Any]
+
+
+@dataclass(frozen=True, slots=True)
+class RecordedFlight:
+    path: Path
+    params: Params
+    params_json: dict[str, Any]
+    target_rgb: U8Array
+    observations: tuple[Observation, ...]
+    outputs: tuple[RecordedOutput, ...]
+    truncated: bool
+    tool_version: str
+
+
+def load_flight(path: str | Path) -> RecordedFlight:
+    """Read a recording made by ``uavtool fly``; raises a one-line InputError naming the file
+    and what is missing or wrong."""
+    path = Path(path)
+    with RecordingReader(path) as reader:
+        meta = dict(reader.metadata)
+        if "mission" not in meta or OBSERVATIONS not in reader.topics():
+            raise ReplayInputError(
+                f"{path}: not a mission recording (no mission parameters or "
+                f"{OBSERVATIONS}); record one with `uavtool fly`"
+            )
+        try:
+            params_json = json.loads(meta["mission"]["params"])
+        except (KeyError, ValueError):
+            raise ReplayInputError(
+                f"{path}: metadata 'mission' holds no readable parameters"
+            ) from None
+        params = from_dict(params_json, source=f"{path}: recorded parameters")
+        tool_version = meta.get("uavtool", {}).get("version", "?")
+        target: U8Array | None = None
+        images: list[bytes] = []
+        raw_obs: list[dict[str, Any]] = []
+        outputs: list[RecordedOutput] = []
+        topics = [t for t in (TARGET, IMAGE, OBSERVATIONS, OUTPUTS) if t in reader.topics()]
+        for entry in reader.entries(topics):
+            value = entry.value
+            if entry.topic == TARGET and isinstance(value, CompressedImage):
+                target = png_decode(value.data, where=f"{path}: target picture")
+            elif entry.topic == IMAGE and isinstance(value, CompressedImage):
+                images.append(value.data)
+            elif entry.topic == OBSERVATIONS and isinstance(value, JsonDocument):
+                raw_obs.append(dict(value.payload))
+            elif entry.topic == OUTPUTS and isinstance(value, JsonDocument):
+                data = dict(value.payload)
+                n, step = int(data.pop("n")), int(data.pop("step"))
+                outputs.append(RecordedOutput(n, step, data))
+        truncated = not reader.health.whole
+    if target is None:
+        raise ReplayInputError(f"{path}: the target picture ({TARGET}) is missing")
+    observations = []
+    for i, data in enumerate(raw_obs, start=1):
+        if data.get("step") != i:
+            raise ReplayInputError(
+                f"{path}: observation {i} is missing (next recorded is step {data.get('step')})"
+            )
+        image = None
+        if data.get("type") == "Photo":
+            frame = int(data.get("frame_index", -1))
+            if not 0 <= frame < len(images):
+                raise ReplayInputError(
+                    f"{path}: photo frame {frame} (step {i}) is missing from {IMAGE} "
+                    f"({len(images)} frames recorded)"
+                )
+            image = png_decode(images[frame], where=f"{path}: frame {frame}")
+        try:
+            observations.append(decode_observation(data, image))
+        except InputError as exc:
+            raise ReplayInputError(f"{path}: step {i}: {exc}") from None
+    return RecordedFlight(
+        path,
+        params,
+        params_json,
+        target,
+        tuple(observations),
+        tuple(outputs),
+        truncated,
+        tool_version,
+    )

@@ -1,0 +1,188 @@
+"""Replay: the recorded observations, in order, through a fresh mission; every output compared
+with the recorded one (ArduPilot's Replay works the same way: log every input, demand every
+output back exactly).
+
+With the recorded parameters the outputs must be equal bit for bit (``--check``). With other
+parameters the mission may decide differently; when it would command something the recording
+did not (so the recorded observations no longer answer it), the mission is stopped at that
+step and replay says why. Per-frame vision is re-run on every recorded photo regardless.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from uavtool.mission import Mission, ModelBuilt, Output, Params
+from uavtool.mission.codec import encode_output
+from uavtool.replay.load import RecordedFlight, RecordedOutput
+
+Progress = Callable[[int, int], None]
+"""Called with (observations done, total)."""
+
+_COMMANDS = frozenset({"SetMode", "Arm", "Takeoff", "GoTo", "SetGimbal", "TakePhoto"})
+
+
+@dataclass(frozen=True, slots=True)
+class Difference:
+    """The first place where replayed and recorded outputs differ."""
+
+    step: int
+    n: int
+    kind: str
+    path: str
+    recorded: Any
+    replayed: Any
+
+    def describe(self) -> str:
+        where = f"step {self.step}, output {self.n} ({self.kind})"
+        field_ = f" field {self.path}" if self.path else ""
+        return (
+            f"{where}{field_}: recorded {_short(self.recorded)}, replayed {_short(self.replayed)}"
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class Divergence:
+    """Where the mission's decisions left the recording, and why."""
+
+    step: int
+    reason: str
+
+
+@dataclass(slots=True)
+class ReplayResult:
+    outputs: list[RecordedOutput] = field(default_factory=list)
+    """Every replayed output (numbered like the recording's)."""
+    steps: int = 0
+    """Observations fed to the mission."""
+    first_difference: Difference | None = None
+    divergence: Divergence | None = None
+    finished: bool = False
+    glbs: dict[int, bytes] = field(default_factory=dict)
+    """GLB bytes of each replayed model, by output number."""
+
+    @property
+    def identical(self) -> bool:
+        return self.first_difference is None and self.divergence is None
+
+
+def replay(
+    flight: RecordedFlight,
+    params: Params | None = None,
+    *,
+    progress: Progress | None = None,
+) -> ReplayResult:
+    """Feed the recorded observations to a fresh mission built with ``params`` (default: the
+    recorded ones) and compare its outputs with the recording's, step by step."""
+    mission = Mission(params if params is not None else flight.params, flight.target_rgb)
+    cmp = _Comparison(flight.outputs)
+    total = len(flight.observations)
+    cmp.emit(0, mission.start())
+    for step, obs in enumerate(flight.observations, start=1):
+        if mission.done:
+            cmp.diverge(step, "the mission ended before the recording did")
+            break
+        cmp.result.steps = step
+        cmp.emit(step, mission.step(obs))
+        if cmp.result.divergence is not None:
+            break
+        if progress is not None and (step % 200 == 0 or step == total):
+            progress(step, total)
+    result = cmp.result
+    result.finished = mission.done
+    if result.identical and len(result.outputs) < len(flight.outputs) and not flight.truncated:
+        missing = flight.outputs[len(result.outputs)]
+        result.first_difference = Difference(
+            missing.step, missing.n, str(missing.data.get("type")), "", missing.data, "nothing"
+        )
+    return result
+
+
+class _Comparison:
+    """Positional comparison of all outputs (for ``--check``), and of the commands alone (to
+    find where the mission's decisions leave the recording)."""
+
+    def __init__(self, recorded: tuple[RecordedOutput, ...]) -> None:
+        self.result = ReplayResult()
+        self._recorded = iter(recorded)
+        self._commands = iter([r for r in recorded if r.data.get("type") in _COMMANDS])
+
+    def diverge(self, step: int, reason: str) -> None:
+        if self.result.divergence is None:
+            self.result.divergence = Divergence(step, reason)
+
+    def emit(self, step: int, outputs: list[Output]) -> None:
+        for out in outputs:
+            data = encode_output(out)
+            n = len(self.result.outputs) + 1
+            self.result.outputs.append(RecordedOutput(n, step, data))
+            if isinstance(out, ModelBuilt):
+                self.result.glbs[n] = out.glb
+            if self.result.first_difference is None:
+                self._check(step, n, data, next(self._recorded, None))
+            if data["type"] in _COMMANDS and self.result.divergence is None:
+                expected = next(self._commands, None)
+                if expected is None or _first_diff(expected.data, data)[0] is not None:
+                    self.diverge(step, _why(expected, data))
+
+    def _check(
+        self, step: int, n: int, data: dict[str, Any], expected: RecordedOutput | None
+    ) -> None:
+        kind = str(data["type"])
+        if expected is None:
+            self.result.first_difference = Difference(step, n, kind, "", "nothing", data)
+        elif expected.step != step:
+            self.result.first_difference = Difference(step, n, kind, "step", expected.step, step)
+        else:
+            path, a, b = _first_diff(expected.data, data)
+            if path is not None:
+                self.result.first_difference = Difference(step, n, kind, path, a, b)
+
+
+def _why(expected: RecordedOutput | None, data: dict[str, Any]) -> str:
+    if expected is None:
+        return f"the mission would send {_short(data)}, which the recording never did"
+    if expected.data.get("type") != data.get("type"):
+        return (
+            f"the mission would send {_short(data)} where the recording has "
+            f"{_short(expected.data)}; the recorded observations no longer answer it"
+        )
+    return (
+        f"the mission would send {_short(data)} instead of the recorded {_short(expected.data)}; "
+        "no photo was taken there"
+    )
+
+
+def _first_diff(a: Any, b: Any, path: str = "") -> tuple[str | None, Any, Any]:
+    """The dotted path of the first difference between two JSON trees (floats compared
+    exactly), or (None, …) when equal."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        for key in list(a) + [k for k in b if k not in a]:
+            if key not in a or key not in b:
+                return f"{path}.{key}".lstrip("."), a.get(key, "<absent>"), b.get(key, "<absent>")
+            found = _first_diff(a[key], b[key], f"{path}.{key}")
+            if found[0] is not None:
+                return found
+        return None, None, None
+    if isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            return f"{path}.length".lstrip("."), len(a), len(b)
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            found = _first_diff(x, y, f"{path}[{i}]")
+            if found[0] is not None:
+                return found
+        return None, None, None
+    if type(a) is not type(b) and not (isinstance(a, (int, float)) and isinstance(b, (int, float))):
+        return path.lstrip(".") or "value", a, b
+    return (None, None, None) if a == b else (path.lstrip(".") or "value", a, b)
+
+
+def _short(value: Any, limit: int = 120) -> str:
+    if isinstance(value, dict) and "type" in value:
+        body = ", ".join(f"{k}={_short(v, 40)}" for k, v in value.items() if k != "type")
+        text = f"{value['type']}({body})"
+    else:
+        text = repr(value)
+    return text if len(text) <= limit else text[: limit - 1] + "…"

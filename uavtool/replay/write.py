@@ -1,0 +1,94 @@
+"""``replay --out``: a new recording with the original's inputs and the replayed outputs, which
+``uavtool view`` can show beside the original."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from uavtool.mission import Level, Params
+from uavtool.mission.params import to_dict
+from uavtool.recording import (
+    JsonDocument,
+    LogEntry,
+    MavlinkFrame,
+    Model3D,
+    RecordingReader,
+    RecordingWriter,
+)
+from uavtool.recording.topics import EVENTS, MODEL, OBSERVATIONS, OUTPUTS
+from uavtool.replay.load import RecordedOutput
+from uavtool.runner.record import MissionRecorder
+
+_LEVELS = {"info": Level.INFO, "warning": Level.WARNING, "error": Level.ERROR}
+_REGENERATED = {OUTPUTS, MODEL}
+
+
+def write_replay(
+    source: Path, out: Path, outputs: list[RecordedOutput], glbs: dict[int, bytes], params: Params
+) -> None:
+    """Copy ``source``'s inputs into ``out`` and write ``outputs`` (with each model's GLB from
+    ``glbs`` by output number) at the log time of the observation that produced them."""
+    with RecordingReader(source) as reader:
+        meta = {
+            name: record
+            for name, record in reader.metadata
+            if name not in ("uavtool", "outcome", "mission")
+        }
+        meta["mission"] = {"params": json.dumps(to_dict(params))}
+        meta["replay"] = {"source": str(source)}
+        with RecordingWriter(out, metadata=meta) as writer:
+            recorder = MissionRecorder(writer)
+            pending = list(outputs)
+            last_t = 0
+            for entry in reader.entries():
+                topic, value, t = entry.topic, entry.value, entry.log_time_ns
+                if topic.startswith("/mavlink/") and not isinstance(value, MavlinkFrame):
+                    continue  # the writer rebuilds the decoded views from the raw frames
+                if topic in _REGENERATED or (
+                    topic == EVENTS and isinstance(value, LogEntry) and value.name == "mission"
+                ):
+                    continue
+                if topic == OBSERVATIONS and isinstance(value, JsonDocument):
+                    step = int(value.payload["step"])
+                    pending = _flush(recorder, pending, step - 1, last_t or t, glbs)
+                    writer.write_json(
+                        OBSERVATIONS,
+                        value.payload,
+                        log_time_ns=t,
+                        publish_time_ns=entry.publish_time_ns,
+                    )
+                    last_t = t
+                elif isinstance(value, MavlinkFrame):
+                    writer.write_mavlink(
+                        value.data,
+                        direction=value.direction,
+                        log_time_ns=t,
+                        publish_time_ns=entry.publish_time_ns,
+                    )
+                elif isinstance(value, JsonDocument):
+                    continue  # other JSON channels: not inputs
+                else:
+                    writer.write(topic, value, log_time_ns=t, publish_time_ns=entry.publish_time_ns)
+            _flush(recorder, pending, 1 << 62, last_t or 1, glbs)
+
+
+def _flush(
+    recorder: MissionRecorder,
+    pending: list[RecordedOutput],
+    up_to_step: int,
+    t: int,
+    glbs: dict[int, bytes],
+) -> list[RecordedOutput]:
+    while pending and pending[0].step <= up_to_step:
+        out = pending.pop(0)
+        recorder.output_json(out.n, out.step, out.data, log_time_ns=t)
+        kind = out.data.get("type")
+        if kind == "Event":
+            level = _LEVELS.get(str(out.data.get("level")), Level.INFO)
+            recorder.writer.write(
+                EVENTS, LogEntry(recorder.level(level), str(out.data["text"])), log_time_ns=t
+            )
+        elif kind == "ModelBuilt" and out.n in glbs:
+            recorder.writer.write(MODEL, Model3D(glbs[out.n]), log_time_ns=t)
+    return pending
