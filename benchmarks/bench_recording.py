@@ -2,10 +2,12 @@
 
     python benchmarks/bench_recording.py [--quick]
 
-Each case writes the same bytes both ways (zstd chunks); our writer adds the lock, the
-per-channel sequence numbers, the 1 s / 1 MiB chunk policy and (by default) an fsync per
-second of log time. Serialization (json.dumps, Protobuf) is counted on both sides. Prints
-MB/s of message data, messages/s and the ratio (goal: writer >= 0.8x of bare).
+Each case writes the very same file both ways (checked byte for byte): zstd chunks closed
+after each second of log time, the same header and metadata. Our writer adds the lock, topic
+checks, per-channel sequence numbers and, by default, an fsync of each closed chunk (on a
+background thread); the bare Writer never fsyncs. Serialization (json.dumps, Protobuf) is
+counted on both sides; in the MAVLink case only ours decodes the frames. Prints MB/s of
+message data, messages/s and the ratio (goal: writer >= 0.8x of bare, fsync on).
 """
 
 from __future__ import annotations
@@ -19,12 +21,15 @@ from pathlib import Path
 import cv2
 import numpy as np
 from mcap.reader import make_reader
-from mcap.writer import Writer
+from mcap.writer import CompressionType, Writer
 
+from uavtool import __version__
 from uavtool.recording import CompressedImage, Direction, RecordingReader, RecordingWriter, foxglove
-from uavtool.recording.schemas import dumps
+from uavtool.recording.schemas import DEFAULT_DIALECT, MavlinkDecoder, dumps, mavlink_schema
+from uavtool.recording.writer import LIBRARY, TOOL_METADATA
 
 T0 = 1_700_000_000_000_000_000
+CHUNK_NS = 1_000_000_000  # RecordingWriter's default chunk interval
 
 
 def _telemetry(n: int) -> list[dict[str, object]]:
@@ -96,31 +101,53 @@ def _row(label: str, seconds: float, n: int, nbytes: int, ref: float | None = No
     print(f"  {label:<34} {nbytes / seconds / 1e6:8.1f} MB/s {n / seconds:10.0f} msg/s{ratio}")
 
 
+class _Bare:
+    """The bare mcap `Writer` set up to write exactly what `RecordingWriter` writes: same
+    header and first metadata record, zstd, and a chunk closed after each second of log time
+    (mcap's own policy is size only, so the loop does what our writer does internally)."""
+
+    def __init__(self, path: Path) -> None:
+        self._file = path.open("wb")
+        self.w = Writer(self._file, chunk_size=1 << 62, compression=CompressionType.ZSTD)
+        self.w.start(profile="", library=LIBRARY)
+        tool = {"version": __version__, "dialect": DEFAULT_DIALECT, "mavlink": "2.0"}
+        self.w.add_metadata(TOOL_METADATA, tool)
+        self._start_ns: int | None = None
+
+    def add(self, cid: int, t: int, data: bytes, seq: int) -> None:
+        self.w.add_message(cid, log_time=t, data=data, publish_time=t, sequence=seq)
+        if self._start_ns is None:
+            self._start_ns = t
+        elif t - self._start_ns >= CHUNK_NS:
+            self.w.flush()
+            self._start_ns = None
+
+    def finish(self) -> None:
+        self.w.finish()
+        self._file.close()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--quick", action="store_true", help="smaller inputs")
     args = parser.parse_args()
     n_json, n_png, repeats = (20_000, 300, 3) if args.quick else (100_000, 1500, 5)
-    tmp = Path(tempfile.mkdtemp(prefix="bench_rec_"))
+    with tempfile.TemporaryDirectory(prefix="bench_rec_") as tmp:
+        _run(Path(tmp), n_json, n_png, repeats)
+
+
+def _run(tmp: Path, n_json: int, n_png: int, repeats: int) -> None:
     telemetry, frames, mav = _telemetry(n_json), _png_frames(n_png), _mavlink(n_json)
     json_bytes = sum(len(dumps(d)) for d in telemetry)
     dt_json, dt_png = 2_000_000, 100_000_000  # 500 Hz telemetry, 10 Hz camera (log time)
 
     def bare_json() -> None:
-        with (tmp / "bare_json.mcap").open("wb") as f:
-            w = Writer(f)
-            w.start()
-            sid = w.register_schema("t.Telemetry", "jsonschema", b"{}")
-            cid = w.register_channel("/telemetry", "json", sid)
-            for i, d in enumerate(telemetry):
-                w.add_message(
-                    cid,
-                    log_time=T0 + i * dt_json,
-                    data=dumps(d),
-                    publish_time=T0 + i * dt_json,
-                    sequence=i,
-                )
-            w.finish()
+        bare = _Bare(tmp / "bare_json.mcap")
+        sid = bare.w.register_schema("t.Telemetry", "jsonschema", b"{}")
+        cid = bare.w.register_channel("/telemetry", "json", sid)
+        for i, d in enumerate(telemetry):
+            bare.add(cid, T0 + i * dt_json, dumps(d), i)
+        bare.finish()
 
     def ours_json(fsync: bool) -> Callable[[], None]:
         def run() -> None:
@@ -135,18 +162,14 @@ def main() -> None:
     png_bytes = sum(len(b) for b in images)
 
     def bare_png() -> None:
-        with (tmp / "bare_png.mcap").open("wb") as f:
-            w = Writer(f)
-            w.start()
-            sid = w.register_schema(
-                "foxglove.CompressedImage", "protobuf", foxglove.schema_data(CompressedImage)
-            )
-            cid = w.register_channel("/camera/image", "protobuf", sid)
-            for i, p in enumerate(frames):
-                t = T0 + i * dt_png
-                data = foxglove.encode(CompressedImage(p), t)
-                w.add_message(cid, log_time=t, data=data, publish_time=t, sequence=i)
-            w.finish()
+        bare = _Bare(tmp / "bare_png.mcap")
+        schema = foxglove.schema_data(CompressedImage)
+        sid = bare.w.register_schema("foxglove.CompressedImage", "protobuf", schema)
+        cid = bare.w.register_channel("/camera/image", "protobuf", sid)
+        for i, p in enumerate(frames):
+            t = T0 + i * dt_png
+            bare.add(cid, t, foxglove.encode(CompressedImage(p), t), i)
+        bare.finish()
 
     def ours_png(fsync: bool) -> Callable[[], None]:
         def run() -> None:
@@ -156,41 +179,49 @@ def main() -> None:
 
         return run
 
-    raw_and_json = [(f, dumps({"header": {}, "x": i})) for i, (_d, f) in enumerate(mav)]
+    decoder = MavlinkDecoder()
+    decoded = [decoder.decode(f) for _d, f in mav]
     mav_bytes = sum(len(f) for _d, f in mav)
 
-    def bare_mav() -> None:  # the bytes of both channels, no decoding
-        with (tmp / "bare_mav.mcap").open("wb") as f:
-            w = Writer(f)
-            w.start()
-            raw = w.register_channel("/mavlink/raw", "mavlink", 0)
-            sid = w.register_schema("GLOBAL_POSITION_INT", "jsonschema", b"{}")
-            dec = w.register_channel("/mavlink/in/GLOBAL_POSITION_INT", "json", sid)
-            for i, (frame, js) in enumerate(raw_and_json):
-                t = T0 + i * dt_json
-                w.add_message(raw, log_time=t, data=frame, publish_time=t, sequence=i)
-                w.add_message(dec, log_time=t, data=js, publish_time=t, sequence=i)
-            w.finish()
+    def bare_mav() -> None:  # the same two messages per frame, decoded beforehand
+        bare = _Bare(tmp / "bare_mav.mcap")
+        raw = dec = 0
+        meta = {"direction": "in", "dialect": DEFAULT_DIALECT}
+        for i, ((_d, frame), js) in enumerate(zip(mav, decoded, strict=True)):
+            t = T0 + i * dt_json
+            if not raw:
+                raw = bare.w.register_channel("/mavlink/raw", "mavlink", 0, meta)
+            bare.add(raw, t, frame, i)
+            assert js is not None
+            if not dec:
+                name, schema = mavlink_schema(DEFAULT_DIALECT, js[0])
+                sid = bare.w.register_schema(name, "jsonschema", schema)
+                dec = bare.w.register_channel(f"/mavlink/in/{js[1]}", "json", sid)
+            bare.add(dec, t, dumps(js[2]), i)
+        bare.finish()
 
     def ours_mav() -> None:
-        with RecordingWriter(tmp / "ours_mav.mcap", fsync=True) as w:
+        with RecordingWriter(tmp / "ours_mav.mcap") as w:
             for i, (d, frame) in enumerate(mav):
                 w.write_mavlink(frame, direction=d, log_time_ns=T0 + i * dt_json)
 
     print(f"writer: telemetry JSON, {n_json} dicts ({json_bytes / n_json:.0f} B), 500 Hz log time")
     ref, a, b = _best(bare_json, ours_json(True), ours_json(False), repeats=repeats)
+    _same(tmp, "json")
     _row("bare mcap Writer (+json.dumps)", ref, n_json, json_bytes)
-    _row("RecordingWriter.write_json fsync", a, n_json, json_bytes, ref)
-    _row("RecordingWriter.write_json no fsync", b, n_json, json_bytes, ref)
+    _row("RecordingWriter.write_json (fsync)", a, n_json, json_bytes, ref)
+    _row("RecordingWriter.write_json fsync=False", b, n_json, json_bytes, ref)
     kib = png_bytes / n_png / 1024
     print(f"writer: PNG frames, {n_png} frames ({kib:.1f} KiB), 10 Hz log time")
     ref, a, b = _best(bare_png, ours_png(True), ours_png(False), repeats=repeats)
+    _same(tmp, "png")
     _row("bare mcap Writer (+Protobuf)", ref, n_png, png_bytes)
-    _row("RecordingWriter.write image fsync", a, n_png, png_bytes, ref)
-    _row("RecordingWriter.write image no fsync", b, n_png, png_bytes, ref)
+    _row("RecordingWriter.write image (fsync)", a, n_png, png_bytes, ref)
+    _row("RecordingWriter.write image fsync=False", b, n_png, png_bytes, ref)
     print(f"writer: MAVLink, {n_json} frames -> raw + decoded JSON (2 messages each)")
     ref, a = _best(bare_mav, ours_mav, repeats=repeats)
-    _row("bare mcap Writer (pre-encoded bytes)", ref, n_json, mav_bytes)
+    _same(tmp, "mav")
+    _row("bare mcap Writer (decoded beforehand)", ref, n_json, mav_bytes)
     _row("RecordingWriter.write_mavlink (decodes)", a, n_json, mav_bytes, ref)
 
     for name, n, nbytes in (("ours_json", n_json, json_bytes), ("ours_png", n_png, png_bytes)):
@@ -210,7 +241,12 @@ def main() -> None:
         ref, a = _best(bare_read, our_read, repeats=repeats)
         _row("bare mcap reader (log_time_order=False)", ref, n, nbytes)
         _row("RecordingReader.messages", a, n, nbytes, ref)
-    print(f"(files in {tmp})")
+
+
+def _same(tmp: Path, case: str) -> None:
+    """Both writers must have written the very same file, or the comparison means nothing."""
+    if (tmp / f"bare_{case}.mcap").read_bytes() != (tmp / f"ours_{case}.mcap").read_bytes():
+        raise SystemExit(f"{case}: bare and RecordingWriter files differ")
 
 
 if __name__ == "__main__":

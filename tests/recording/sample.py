@@ -87,6 +87,7 @@ def write_sample(
     rate_hz: int = 100,
     chunk_interval_ns: int = 1_000_000_000,
     chunk_bytes: int = 1 << 20,
+    fsync: bool = False,
 ) -> int:
     """Write a deterministic recording; returns the number of messages written."""
     frames = mavlink_frames(int(seconds * rate_hz))
@@ -97,7 +98,7 @@ def write_sample(
         metadata=metadata,
         chunk_interval_ns=chunk_interval_ns,
         chunk_bytes=chunk_bytes,
-        fsync=False,
+        fsync=fsync,
     ) as writer:
         writer.add_json_topic(
             "/mission/observations", schema_name="test.Observation", schema=OBS_SCHEMA

@@ -1,30 +1,29 @@
 """`RecordingWriter`: one thread-safe, crash-safe, deterministic MCAP writer per mission.
 
-Crash safety: the open chunk lives in memory until it is closed, so the writer closes it and
-hands the bytes to the OS whenever it spans ``chunk_interval_ns`` of log time (default 1 s;
-then, with ``fsync=True``, also asks the OS to put it on disk) or reaches ``chunk_bytes``.
-A SIGKILL or power cut therefore loses at most about one interval of data.
+What is recorded lives here: topics, schemas, channels, per-channel sequence numbers, the
+JSON view of MAVLink frames, one lock so several threads can share the writer. Where the
+bytes go and how durably (1 s chunks handed to the OS, background fsync, failures) is
+`RecordingSink`'s job; the MCAP bytes themselves are `McapEncoder`'s.
 
 Determinism: the writer never reads a clock or a random source; every time comes from the
 caller, so identical calls give a byte-identical file (the header names the uavtool and
-mcap versions).
+mcap versions; `McapEncoder` writes the bytes mcap's own `Writer` would).
 """
 
 from __future__ import annotations
 
-import os
+import struct
 import threading
 from collections.abc import Mapping
 from pathlib import Path
 from types import TracebackType
-from typing import Any, BinaryIO
+from typing import Any
 
-from mcap.writer import LIBRARY_IDENTIFIER, CompressionType
-from mcap.writer import Writer as McapWriter
+from mcap.writer import LIBRARY_IDENTIFIER
 
 from uavtool import __version__
 from uavtool.recording import foxglove
-from uavtool.recording.errors import create_file
+from uavtool.recording.errors import RecordingError
 from uavtool.recording.schemas import (
     DEFAULT_DIALECT,
     JSON_ENCODING,
@@ -37,18 +36,23 @@ from uavtool.recording.schemas import (
     mavlink_schema,
     mavlink_topic,
 )
+from uavtool.recording.sink import RecordingSink
 from uavtool.recording.values import Direction
 
 LIBRARY = f"uavtool/{__version__}; {LIBRARY_IDENTIFIER}"
 TOOL_METADATA = "uavtool"  # name of the metadata record the writer adds itself
 
-_NEVER = 1 << 62  # chunk size given to mcap: we decide when chunks close
-_RECORD_OVERHEAD = 31  # bytes a Message record adds around its data inside a chunk
-
 
 def _check_topic(topic: str) -> None:
     if not topic.startswith("/") or topic.startswith("/mavlink/"):
         raise ValueError(f"topic {topic!r}: must start with '/' and not with '/mavlink/'")
+
+
+def _check_metadata(name: str, record: Mapping[str, str]) -> None:
+    if name == TOOL_METADATA:
+        raise ValueError(f"metadata name {name!r} is reserved for the writer")
+    if not all(isinstance(k, str) and isinstance(v, str) for k, v in record.items()):
+        raise ValueError(f"metadata {name!r}: keys and values must be str")
 
 
 class RecordingWriter:
@@ -58,7 +62,8 @@ class RecordingWriter:
     string key/value pairs, written first after a ``uavtool`` record (tool version, dialect).
     Every ``write_*`` takes ``log_time_ns`` (receive time, > 0, one epoch per file) and
     optionally ``publish_time_ns`` (vehicle time; defaults to the log time). Raises
-    `ValueError` on misuse (time ≤ 0, unregistered topic, NaN in JSON, writing after close).
+    `ValueError` on misuse (time ≤ 0, unregistered topic, NaN in JSON, writing after close)
+    and `RecordingError` once a write or fsync has failed (disk full, I/O error).
     """
 
     def __init__(
@@ -72,19 +77,11 @@ class RecordingWriter:
         fsync: bool = True,
     ) -> None:
         self._decoder = MavlinkDecoder(dialect)  # checks the dialect before creating a file
+        for name, record in (metadata or {}).items():
+            _check_metadata(name, record)
         self.dialect = dialect
         self.path = Path(path)
-        self._file: BinaryIO = create_file(path)
-        # typed Any: mcap's Writer methods are not annotated
-        self._mcap: Any = McapWriter(
-            self._file, chunk_size=_NEVER, compression=CompressionType.ZSTD
-        )
         self._lock = threading.Lock()
-        self._interval_ns = chunk_interval_ns
-        self._budget = chunk_bytes
-        self._fsync = fsync
-        self._chunk_start_ns: int | None = None
-        self._chunk_size = 0
         self._closed = False
         self._message_count = 0
         self._schemas: dict[tuple[str, bytes], int] = {}
@@ -92,11 +89,15 @@ class RecordingWriter:
         self._topic_kind: dict[str, Any] = {}  # topic -> value type or JSON schema name
         self._json_topics: dict[str, int] = {}  # topic -> channel id
         self._sequence: dict[int, int] = {}
-        self._mcap.start(profile="", library=LIBRARY)
         tool = {"version": __version__, "dialect": dialect, "mavlink": "2.0"}
-        self._mcap.add_metadata(TOOL_METADATA, tool)
-        for name, record in (metadata or {}).items():
-            self.add_metadata(name, record)
+        self._sink = RecordingSink(
+            self.path,
+            library=LIBRARY,
+            metadata=[(TOOL_METADATA, tool), *(metadata or {}).items()],
+            interval_ns=chunk_interval_ns,
+            budget_bytes=chunk_bytes,
+            fsync=fsync,
+        )
 
     # --- lifecycle ---------------------------------------------------------------------------
 
@@ -109,41 +110,42 @@ class RecordingWriter:
         exc: BaseException | None,
         tb: TracebackType | None,
     ) -> None:
-        self.close()
+        try:
+            self.close()
+        except RecordingError:
+            # the failure already propagating from a write says the same: do not mask it
+            if not (isinstance(exc, RecordingError) and exc.path == str(self.path)):
+                raise
 
     @property
     def message_count(self) -> int:
         return self._message_count
 
     def flush(self) -> None:
-        """Close the open chunk and hand everything to the OS now (e.g. before a long pause)."""
+        """Close the open chunk, hand it to the OS and (with ``fsync``) wait until it is on
+        disk, e.g. before a long pause. Other threads keep writing meanwhile."""
         with self._lock:
             self._check_open()
-            self._close_chunk(sync=self._fsync)
+            self._sink.close_chunk()
+        self._sink.wait_synced()
 
     def close(self) -> None:
-        """Write the summary (indexes, statistics) and close the file. Idempotent."""
+        """Write the summary (indexes, statistics), wait for every fsync and close the file.
+        Idempotent. Raises `RecordingError` if any write or fsync failed: the file is then
+        not whole (`uavtool info --recover` rescues what it holds)."""
         with self._lock:
-            if self._closed:
-                return
-            self._closed = True
-            self._mcap.finish()
-            self._file.flush()
-            if self._fsync:
-                os.fsync(self._file.fileno())
-            self._file.close()
+            if not self._closed:
+                self._closed = True
+                self._sink.close()
 
     # --- metadata and channels ---------------------------------------------------------------
 
     def add_metadata(self, name: str, record: Mapping[str, str]) -> None:
         """Add a named metadata record (e.g. the mission outcome at the end)."""
-        if name == TOOL_METADATA:
-            raise ValueError(f"metadata name {name!r} is reserved for the writer")
-        if not all(isinstance(k, str) and isinstance(v, str) for k, v in record.items()):
-            raise ValueError(f"metadata {name!r}: keys and values must be str")
+        _check_metadata(name, record)
         with self._lock:
             self._check_open()
-            self._mcap.add_metadata(name, dict(record))
+            self._sink.add_metadata(name, dict(record))
 
     def add_json_topic(self, topic: str, *, schema_name: str, schema: Mapping[str, Any]) -> None:
         """Declare a JSON topic with its JSON schema; `write_json` then writes to it."""
@@ -243,15 +245,16 @@ class RecordingWriter:
     # --- internals (called with the lock held) -----------------------------------------------
 
     def _check_open(self) -> None:
+        # a failed write or fsync is raised by the sink on the next write, metadata or flush
         if self._closed:
             raise ValueError(f"{self.path}: the recording is closed")
 
     def _schema(self, name: str, encoding: str, data: bytes) -> int:
         schema_id = self._schemas.get((name, data))
         if schema_id is None:
-            schema_id = self._mcap.register_schema(name=name, encoding=encoding, data=data)
+            schema_id = self._sink.register_schema(name, encoding, data)
             self._schemas[(name, data)] = schema_id
-        return int(schema_id)
+        return schema_id
 
     def _channel(
         self,
@@ -261,11 +264,7 @@ class RecordingWriter:
         schema_id: int,
         meta: dict[str, str] | None = None,
     ) -> int:
-        channel_id = int(
-            self._mcap.register_channel(
-                topic=topic, message_encoding=encoding, schema_id=schema_id, metadata=meta or {}
-            )
-        )
+        channel_id = self._sink.register_channel(topic, encoding, schema_id, meta or {})
         self._channels[key] = channel_id
         self._sequence[channel_id] = 0
         return channel_id
@@ -277,20 +276,9 @@ class RecordingWriter:
             raise ValueError(f"log_time_ns must be a positive int, got {log_time_ns!r}")
         publish = log_time_ns if publish_time_ns is None else publish_time_ns
         sequence = self._sequence[channel_id]
+        try:
+            self._sink.add(channel_id, sequence, log_time_ns, publish, data)
+        except struct.error as exc:  # raised before anything was added
+            raise ValueError(f"times must fit an unsigned 64-bit int: {exc}") from exc
         self._sequence[channel_id] = sequence + 1
-        self._mcap.add_message(channel_id, log_time_ns, data, publish, sequence)
         self._message_count += 1
-        self._chunk_size += len(data) + _RECORD_OVERHEAD
-        if self._chunk_start_ns is None:
-            self._chunk_start_ns = log_time_ns
-        if log_time_ns - self._chunk_start_ns >= self._interval_ns:
-            self._close_chunk(sync=self._fsync)
-        elif self._chunk_size >= self._budget:
-            self._close_chunk(sync=False)
-
-    def _close_chunk(self, *, sync: bool) -> None:
-        self._mcap.flush()  # closes the chunk, writes it and its indexes, flushes the stream
-        if sync:
-            os.fsync(self._file.fileno())
-        self._chunk_start_ns = None
-        self._chunk_size = 0
