@@ -1,0 +1,25 @@
+"""Shared flights: the expensive normal flights run once per session."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.mission.driver import Flown, fly
+from uavtool.mission import MissionParams, Params
+from uavtool.world import Scene, load_scene
+
+
+@pytest.fixture(scope="session")
+def paper() -> Scene:
+    return load_scene("paper")
+
+
+@pytest.fixture(scope="session")
+def paper_flight(paper: Scene) -> Flown:
+    """The default mission on ``paper``: stops at the first match, builds the model."""
+    return fly(paper)
+
+
+@pytest.fixture(scope="session")
+def visit_all_flight(paper: Scene) -> Flown:
+    return fly(paper, Params(mission=MissionParams(visit_all=True)))

@@ -1,0 +1,68 @@
+"""Scenes made for one branch of the mission, built from ``paper`` as plain data."""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+from uavtool.mission import MissionParams, Params
+from uavtool.world import Scene, load_scene, scene_from_dict, scene_to_dict
+
+# Wall colours: hues far from the red target and from each other.
+_WALLS = {
+    "north": ((40, 90, 220), (-12.0, 8.0, 12.0, 10.0)),
+    "south": ((60, 170, 70), (-12.0, -10.0, 12.0, -8.0)),
+    "west": ((230, 200, 40), (-13.0, -6.5, -11.0, 6.5)),
+    "east": ((140, 70, 190), (11.0, -6.5, 13.0, 6.5)),
+}
+
+
+def with_mission(**changes: Any) -> Params:
+    """Default parameters with some ``mission.*`` values changed."""
+    return Params(mission=dataclasses.replace(MissionParams(), **changes))
+
+
+def _paper() -> dict[str, Any]:
+    return scene_to_dict(load_scene("paper"))
+
+
+def _red(data: dict[str, Any]) -> dict[str, Any]:
+    return next(b for b in data["buildings"] if b["name"] == "red")
+
+
+def _box(name: str, colour: tuple[int, int, int], box: tuple[float, ...]) -> dict[str, Any]:
+    x0, y0, x1, y1 = box
+    ring = [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+    return {"name": name, "color": list(colour), "blocks": [{"footprint": ring, "top_m": 8.0}]}
+
+
+def walled(sides: tuple[str, ...]) -> Scene:
+    """Paper's red building moved to home, with 8 m high walls 4-6 m from it on ``sides``
+    (``north``, ``south``, ``west``, ``east``): a wall on both long sides blocks every front
+    viewpoint, one on both short sides every right one (obstacles count as infinitely tall)."""
+    data = _paper()
+    red = _red(data)
+    for block in red["blocks"]:
+        block["footprint"] = [[x - 10.0, y + 8.0] for x, y in block["footprint"]]
+    walls = [_box(side, *_WALLS[side]) for side in sides]
+    data.update(name="walled-" + "-".join(sides), buildings=[red, *walls])
+    return scene_from_dict(data, source="walled")
+
+
+def cross_target() -> Scene:
+    """Paper with the red building replaced by a red cross: its picture matches nothing."""
+    data = _paper()
+    cross = [[8, -10], [10, -10], [10, -14], [12, -14], [12, -10], [14, -10], [14, -8]]
+    cross += [[12, -8], [12, -4], [10, -4], [10, -8], [8, -8]]
+    _red(data)["blocks"] = [{"footprint": cross, "top_m": 6.0}]
+    return scene_from_dict(data, source="cross")
+
+
+def out_of_view() -> Scene:
+    """Only the red building, 150 m east: the overview photo from home shows nothing."""
+    data = _paper()
+    red = _red(data)
+    for block in red["blocks"]:
+        block["footprint"] = [[x + 150.0, y] for x, y in block["footprint"]]
+    data.update(name="out-of-view", buildings=[red])
+    return scene_from_dict(data, source="out-of-view")

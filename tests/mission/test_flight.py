@@ -1,0 +1,252 @@
+"""Whole flights on a scripted vehicle: what the mission finds, where it flies and
+photographs, what it builds, and how it ends when nothing matches or a view is blocked."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import pytest
+import shapely  # type: ignore[import-untyped]
+
+from tests.mission import scenes
+from tests.mission.driver import Flight, Flown, fly
+from uavtool.geo import wrap_180
+from uavtool.mission import (
+    Command,
+    Event,
+    ModelBuilt,
+    Outcome,
+    Photo,
+    Plan,
+    Recognition,
+    SetMode,
+    Status,
+    Viewpoints,
+)
+from uavtool.nav import Viewpoint, ViewpointFailure
+from uavtool.runner.evaluate import model_iou
+from uavtool.world import Scene, building_footprint, load_scene
+
+Point = tuple[float, float]
+
+
+def _photos(flight: Flight) -> dict[str, Photo]:
+    return {obs.tag: obs for obs in flight.observations if isinstance(obs, Photo)}
+
+
+def _building_at(scene: Scene, point: Point) -> str:
+    p = shapely.Point(point)
+    return min(scene.buildings, key=lambda b: building_footprint(b).distance(p)).name
+
+
+def _route_m(start: Point, points: list[Point], order: tuple[int, ...]) -> float:
+    stops = [start, *(points[k] for k in order)]
+    return sum(math.dist(a, b) for a, b in itertools.pairwise(stops))
+
+
+def _nearest_neighbour_m(start: Point, points: list[Point]) -> float:
+    here, left, total = start, list(range(len(points))), 0.0
+    while left:
+        k = min(left, key=lambda i: math.dist(here, points[i]))
+        total += math.dist(here, points[k])
+        here = points[k]
+        left.remove(k)
+    return total
+
+
+def assert_home_safely(flown: Flown) -> None:
+    """After the mission's end at most RTL is commanded, and the vehicle lands at home."""
+    flight = flown.flight
+    end = next(
+        i
+        for i, o in enumerate(flight.outputs)
+        if isinstance(o, Event) and o.text.startswith("mission ends")
+    )
+    after = [o for o in flight.outputs[end:] if isinstance(o, Command)]
+    assert all(c == SetMode(c.id, "RTL") for c in after) and len(after) <= 1
+    assert flight.texts()[-1] == "landed and disarmed"
+    fake = flown.fake
+    assert fake.landed and not fake.armed
+    assert math.hypot(fake.pos[0], fake.pos[1]) < 0.1
+
+
+# --- the paper's flight -----------------------------------------------------------------------
+
+
+def test_paper_matches_the_red_building_and_builds_its_model(
+    paper: Scene, paper_flight: Flown
+) -> None:
+    flight = paper_flight.flight
+    outcome = flight.outcome
+    assert outcome.status is Status.COMPLETED
+    assert outcome.model_built and outcome.reason == "model built"
+    (plan,) = flight.of_type(Plan)
+    poi = plan.pois[outcome.matched_poi]
+    assert building_footprint(paper.building("red")).contains(shapely.Point(poi.pos_en_m))
+    assert outcome.visited[-1] == outcome.matched_poi  # stopped at the first match
+    recognitions = flight.of_type(Recognition)
+    assert [r.matched for r in recognitions] == [False] * (len(recognitions) - 1) + [True]
+    (model,) = flight.of_type(ModelBuilt)
+    assert flight.outputs.index(model) < len(flight.outputs) - 1  # before the Outcome
+    iou = model_iou(model.vertices_m, model.faces, paper)
+    assert iou > 0.8, f"model IoU {iou:.3f} against the red building"
+    assert_home_safely(paper_flight)
+
+
+def test_paper_points_of_interest_are_the_four_buildings(paper: Scene, paper_flight: Flown) -> None:
+    (plan,) = paper_flight.flight.of_type(Plan)
+    names = []
+    for poi in plan.pois:
+        name = _building_at(paper, poi.pos_en_m)
+        # the roof centroid projected on the roof plane lands on (or within 1 m of) the roof
+        assert building_footprint(paper.building(name)).distance(shapely.Point(poi.pos_en_m)) < 1.0
+        names.append(name)
+    assert sorted(names) == ["blue", "purple", "red", "yellow"]
+
+
+@pytest.mark.parametrize("flight_name", ["paper_flight", "visit_all_flight"])
+def test_visiting_order_is_short(flight_name: str, request: pytest.FixtureRequest) -> None:
+    flown: Flown = request.getfixturevalue(flight_name)
+    flight = flown.flight
+    (plan,) = flight.of_type(Plan)
+    start_xyz = _photos(flight)["overview"].pose.pos_enu_m
+    start = (start_xyz[0], start_xyz[1])
+    points = [poi.pos_en_m for poi in plan.pois]
+    assert sorted(plan.order) == list(range(len(points)))
+    assert plan.route_m == pytest.approx(_route_m(start, points, plan.order))
+    best = min(_route_m(start, points, p) for p in itertools.permutations(range(len(points))))
+    assert plan.route_m <= _nearest_neighbour_m(start, points) + 1e-9
+    assert plan.route_m <= best * 1.05
+    visited = flight.outcome.visited
+    assert visited == plan.order[: len(visited)]
+    poi_photos = [
+        obs.tag
+        for obs in flight.observations
+        if isinstance(obs, Photo) and obs.tag.startswith("poi-")
+    ]
+    assert poi_photos == [f"poi-{k}" for k in visited]
+
+
+def test_photos_are_taken_where_planned(paper_flight: Flown) -> None:
+    """Each photo's camera pose is the one the mission planned, within its tolerances."""
+    flight = paper_flight.flight
+    p = paper_flight.mission.params.mission
+    photos = _photos(flight)
+    (plan,) = flight.of_type(Plan)
+    (views,) = flight.of_type(Viewpoints)
+    assert isinstance(views.front, Viewpoint) and isinstance(views.right, Viewpoint)
+    expected: dict[str, tuple[tuple[float, float, float], float | None, float]] = {
+        "overview": ((0.0, 0.0, p.overview_alt_m), None, -90.0)
+    }
+    for k in flight.outcome.visited:
+        x, y = plan.pois[k].pos_en_m
+        expected[f"poi-{k}"] = ((x, y, p.detail_alt_m), None, -90.0)
+    for vp in (views.top, views.front, views.right):
+        expected[vp.name] = (vp.pos_enu_m, vp.heading_deg, vp.pitch_deg)
+    assert sorted(photos) == sorted(expected)
+    for tag, (pos, heading, pitch) in expected.items():
+        pose = photos[tag].pose
+        assert math.dist(pose.pos_enu_m, pos) <= p.arrive_radius_m, tag
+        assert abs(pose.pitch_deg - pitch) <= p.gimbal_tolerance_deg, tag
+        if heading is not None:
+            assert abs(wrap_180(pose.heading_deg - heading)) <= p.heading_tolerance_deg, tag
+
+
+def test_command_ids_count_from_one(paper_flight: Flown) -> None:
+    ids = [o.id for o in paper_flight.flight.outputs if isinstance(o, Command)]
+    assert ids == list(range(1, len(ids) + 1))
+    assert isinstance(paper_flight.flight.outputs[-1], Outcome)
+    assert paper_flight.mission.outcome == paper_flight.flight.outcome
+
+
+def test_visit_all_visits_all_four_and_keeps_the_red_one(
+    paper: Scene, visit_all_flight: Flown
+) -> None:
+    flight = visit_all_flight.flight
+    outcome = flight.outcome
+    (plan,) = flight.of_type(Plan)
+    assert outcome.status is Status.COMPLETED and outcome.model_built
+    assert outcome.visited == plan.order and len(outcome.visited) == 4
+    red = building_footprint(paper.building("red"))
+    assert red.contains(shapely.Point(plan.pois[outcome.matched_poi].pos_en_m))
+    matched = [r.poi for r in flight.of_type(Recognition) if r.matched]
+    assert matched == [outcome.matched_poi]
+    assert_home_safely(visit_all_flight)
+
+
+# --- the other built-in scenes ------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", ["blocked-front", "dense"])
+def test_builtin_scene_matches_its_target(name: str) -> None:
+    scene = load_scene(name)
+    flown = fly(scene)
+    outcome = flown.outcome
+    assert outcome.status is Status.COMPLETED
+    (plan,) = flown.flight.of_type(Plan)
+    target = building_footprint(scene.target_building)
+    assert target.contains(shapely.Point(plan.pois[outcome.matched_poi].pos_en_m))
+    if name == "blocked-front":
+        # the south side is blocked by the warehouse: the front photo falls back north
+        (views,) = flown.flight.of_type(Viewpoints)
+        assert isinstance(views.front, Viewpoint) and "opposite side" in views.front.fallback
+        warehouse = building_footprint(scene.building("green"))
+        x, y, _ = views.front.pos_enu_m
+        assert warehouse.distance(shapely.Point(x, y)) >= 4.0
+        assert "front viewpoint: opposite side" in flown.flight.texts()
+        assert outcome.model_built
+    assert_home_safely(flown)
+
+
+# --- nothing matches, viewpoints blocked ------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("scene_name", "why", "visits"),
+    [("paper", "no building matched the target", 4), ("out-of-view", "shows no building", 0)],
+)
+def test_no_match_reports_and_lands(scene_name: str, why: str, visits: int) -> None:
+    if scene_name == "paper":
+        flown = fly(load_scene("paper"), target_scene=scenes.cross_target())
+    else:
+        flown = fly(scenes.out_of_view())
+    outcome = flown.outcome
+    assert outcome.status is Status.NO_MATCH
+    assert why in outcome.reason
+    assert len(outcome.visited) == visits and outcome.matched_poi == -1
+    assert not outcome.model_built
+    assert not flown.flight.of_type(ModelBuilt) and not flown.flight.of_type(Viewpoints)
+    assert not any(r.matched for r in flown.flight.of_type(Recognition))
+    assert SetMode(flown.flight.of_type(SetMode)[-1].id, "RTL") in flown.flight.outputs
+    assert_home_safely(flown)
+
+
+@pytest.mark.parametrize(
+    ("sides", "impossible"),
+    [(("north", "south", "west", "east"), ("front", "right")), (("north", "south"), ("front",))],
+)
+def test_blocked_viewpoint_is_reported_and_the_flight_completes(
+    sides: tuple[str, ...], impossible: tuple[str, ...]
+) -> None:
+    flown = fly(scenes.walled(sides))
+    flight = flown.flight
+    outcome = flight.outcome
+    assert outcome.status is Status.COMPLETED
+    assert outcome.matched_poi >= 0 and not outcome.model_built
+    assert outcome.reason == "target found; model not built"
+    (views,) = flight.of_type(Viewpoints)
+    photos = _photos(flight)
+    for name in ("front", "right"):
+        vp = getattr(views, name)
+        if name in impossible:
+            assert isinstance(vp, ViewpointFailure)
+            text = next(t for t in flight.texts() if t.startswith(f"{name} viewpoint impossible"))
+            assert "no line of sight" in text  # says why, per candidate
+            assert name not in photos
+        else:
+            assert isinstance(vp, Viewpoint)
+            assert name in photos  # builds what it can: the possible photo is still taken
+    assert f"model not built: no {' or '.join(impossible)} photo" in flight.texts()
+    assert not flight.of_type(ModelBuilt)
+    assert_home_safely(flown)
