@@ -48,6 +48,7 @@ class FakeVehicle:
     ``refuse`` / ``ignore``: command key (see :func:`command_key`; ``SetMode`` matches every
     mode) → how many of those commands to refuse / leave unanswered before behaving.
     ``stuck``: GoTo targets are taken but the vehicle never moves toward them.
+    ``airborne``: start there, armed and in LOITER, instead of on the ground at home.
     Rates: horizontal ``speed_m_s``, vertical ``climb_m_s``, yaw and gimbal in degrees/s.
     """
 
@@ -64,6 +65,7 @@ class FakeVehicle:
         refuse: dict[str, int] | None = None,
         ignore: dict[str, int] | None = None,
         stuck: bool = False,
+        airborne: Vec3 | None = None,
     ) -> None:
         self.scene = scene
         self.intrinsics = intrinsics
@@ -88,6 +90,8 @@ class FakeVehicle:
         self.goal_heading_deg: float | None = None
         self.goal_pitch_deg = 0.0
         self.rtl_cruise_m = rtl_alt_m
+        if airborne is not None:  # already flying, as a pilot left it
+            self.pos, self.mode, self.armed, self.landed = airborne, "LOITER", True, False
         self.frames = 0
         self.received: list[Command] = []  # every command that reached the vehicle
 

@@ -1,0 +1,260 @@
+"""Every way the flight can go wrong: refused and unanswered commands, a vehicle that never
+arrives, a pilot taking over, the link going quiet; and driving the mission wrongly."""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+
+import numpy as np
+import pytest
+
+from tests.mission import scenes
+from tests.mission.driver import NO_ACK, At, Flight, Flown, LinkOutage, PilotMode, fly, target_rgb
+from tests.mission.fakes import REFUSED, command_key
+from tests.mission.test_flight import assert_home_safely
+from uavtool.mission import (
+    Arm,
+    Command,
+    GoTo,
+    LinkLost,
+    LinkRestored,
+    Mission,
+    MissionInputError,
+    MissionStateError,
+    Params,
+    Plan,
+    SetMode,
+    Status,
+    Takeoff,
+    TakePhoto,
+    Telemetry,
+    Viewpoints,
+)
+from uavtool.world import Scene
+
+
+def _sent_ms(flight: Flight, kind: str) -> list[int]:
+    """Vehicle times at which commands of ``kind`` (see command_key) were issued."""
+    return [
+        step.time_ms
+        for step in flight.steps
+        for o in step.outputs
+        if isinstance(o, Command) and command_key(o) == kind
+    ]
+
+
+def _commands(outputs: Sequence[object]) -> list[Command]:
+    return [o for o in outputs if isinstance(o, Command)]
+
+
+# --- commands refused, unanswered, moves that never arrive --------------------------------------
+
+
+@pytest.mark.parametrize("kind", ["Takeoff", "SetGimbal"])
+@pytest.mark.parametrize("answer", ["refuse", "ignore"])
+def test_command_failing_four_times_aborts_with_rtl(paper: Scene, kind: str, answer: str) -> None:
+    """Refused (COMMAND_ACK not accepted) or unanswered (the runner's ACK timeout) four times:
+    the mission gives up, sends RTL and watches the vehicle land."""
+    always = {kind: 10**6}
+    flown = fly(paper, refuse=always) if answer == "refuse" else fly(paper, ignore=always)
+    detail = REFUSED if answer == "refuse" else NO_ACK
+    outcome = flown.outcome
+    assert outcome.status is Status.ABORTED
+    assert outcome.reason.endswith(f"failed 4 times: {detail}")
+    sent = _sent_ms(flown.flight, kind)
+    assert len(sent) == 4
+    p = flown.mission.params.mission
+    wait_ms = p.retry_wait_s * 1000 + (0 if answer == "refuse" else 3000)
+    assert all(b - a >= wait_ms for a, b in itertools.pairwise(sent))
+    warnings = [t for t in flown.flight.texts() if t.endswith(" of 4)")]
+    assert [w.split("(attempt ")[1] for w in warnings] == [f"{k} of 4)" for k in range(1, 5)]
+    assert SetMode(flown.flight.of_type(SetMode)[-1].id, "RTL") in flown.flight.outputs
+    assert_home_safely(flown)
+
+
+def test_transient_refusals_and_silence_are_retried(paper: Scene) -> None:
+    """Pre-arm checks failing for a while, a lost ACK, a gimbal refused 3 of 4 times."""
+    flown = fly(paper, refuse={"Arm": 5, "SetGimbal": 3}, ignore={"Takeoff": 1})
+    assert flown.outcome.status is Status.COMPLETED and flown.outcome.model_built
+    assert len(flown.flight.of_type(Arm)) == 6
+    assert len(flown.flight.of_type(Takeoff)) == 2
+    assert f"take-off to 45 m: {NO_ACK} (attempt 1 of 4)" in flown.flight.texts()
+    assert f"gimbal to -90°: {REFUSED} (attempt 3 of 4)" in flown.flight.texts()
+
+
+def test_arming_refused_for_too_long_aborts_on_the_ground(paper: Scene) -> None:
+    flown = fly(paper, refuse={"Arm": 10**6})
+    outcome = flown.outcome
+    assert outcome.status is Status.ABORTED
+    assert outcome.reason == f"arming refused for 60 s: {REFUSED}"
+    end_ms = flown.flight.steps[-1].time_ms
+    assert 60_000 <= end_ms <= 65_000
+    # never armed, so nothing to bring home: no take-off, no RTL
+    assert not flown.flight.of_type(Takeoff)
+    assert [c.mode for c in flown.flight.of_type(SetMode)] == ["GUIDED"]
+    assert flown.flight.texts()[-1] == "landed and disarmed"
+
+
+def test_rtl_unanswered_while_finishing_still_reports(paper: Scene) -> None:
+    flown = fly(paper, ignore={"SetGimbal": 10**6, "SetMode:RTL": 10**6})
+    outcome = flown.outcome
+    assert outcome.status is Status.ABORTED and "gimbal" in outcome.reason
+    assert f"while finishing: mode RTL failed 4 times: {NO_ACK}" in flown.flight.texts()
+    assert len(flown.flight.of_type(SetMode)) == 1 + 4  # GUIDED, then RTL four times
+
+
+def test_move_never_arriving_is_retried_then_aborts(paper: Scene) -> None:
+    flown = fly(paper, stuck=True)
+    flight = flown.flight
+    outcome = flight.outcome
+    assert outcome.status is Status.ABORTED
+    assert outcome.reason.endswith("position never reached")
+    assert outcome.visited == ()
+    (plan,) = flight.of_type(Plan)
+    first = plan.pois[plan.order[0]].pos_en_m
+    goals = [g for g in flight.of_type(GoTo) if g.pos_enu_m[:2] == first]
+    assert len(goals) == 4
+    sent = _sent_ms(flight, "GoTo")[-4:]
+    slack_ms = flown.mission.params.mission.move_slack_s * 1000
+    assert all(b - a >= slack_ms for a, b in itertools.pairwise(sent))
+    assert sum("not reached in" in t for t in flight.texts()) == 4
+    assert_home_safely(flown)  # RTL still flies home: only GUIDED targets are ignored
+
+
+def test_already_flying_takes_control_in_guided(paper: Scene) -> None:
+    flown = fly(paper, airborne=(3.0, -2.0, 30.0))
+    assert flown.flight.texts()[0] == "already flying: taking control in GUIDED"
+    assert not flown.flight.of_type(Arm) and not flown.flight.of_type(Takeoff)
+    assert flown.outcome.status is Status.COMPLETED
+    assert_home_safely(flown)
+
+
+# --- someone else flies ----------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("after", [Plan, Viewpoints])
+@pytest.mark.parametrize("pilot_lands", [True, False])
+def test_pilot_takeover_stops_all_commands(paper: Scene, after: type, pilot_lands: bool) -> None:
+    script: tuple[PilotMode, ...] = (PilotMode(At(after=after), "LOITER"),)
+    if pilot_lands:
+        script += (PilotMode(At(after=after, delay_s=5.0), "LAND"),)
+    flown = fly(paper, scenes.with_mission(land_timeout_s=30.0), script=script)
+    flight = flown.flight
+    assert flight.outcome.status is Status.TAKEOVER
+    assert flight.outcome.reason == "mode changed to LOITER by the pilot or a failsafe"
+    seen = next(
+        i
+        for i, s in enumerate(flight.steps)
+        if isinstance(s.observation, Telemetry) and s.observation.mode == "LOITER"
+    )
+    assert _commands(flight.outputs_from(seen)) == []
+    assert not flight.of_type(Viewpoints) if after is Plan else flight.of_type(Viewpoints)
+    texts = flight.texts()
+    assert "no more commands; watching until the vehicle lands" in texts
+    if pilot_lands:
+        assert texts[-1] == "landed and disarmed"
+        assert flown.fake.landed and not flown.fake.armed
+    else:
+        assert texts[-1] == "still flying when the mission stopped watching"
+        end_ms = flight.steps[-1].time_ms
+        assert end_ms - flight.steps[seen].time_ms == pytest.approx(30_000, abs=200)
+
+
+# --- the link goes quiet ---------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("when", ["searching", "overview photo"])
+def test_brief_link_loss_waits_and_resumes(paper: Scene, when: str) -> None:
+    """6 s of silence: the mission commands nothing until the link is back, then carries on.
+    An outage starting with the overview photo swallows the first GoTo: the move is retried."""
+    at = At(after=Plan) if when == "searching" else At(after=TakePhoto)
+    flown = fly(paper, script=(LinkOutage(at, 6.0),))
+    flight = flown.flight
+    assert flight.outcome.status is Status.COMPLETED and flight.outcome.model_built
+    assert [o.silent_s for o in flight.observations if isinstance(o, LinkLost)] == [3.0, 4.0, 5.0]
+    assert [o.silent_s for o in flight.observations if isinstance(o, LinkRestored)] == [6.0]
+    lost, back = flight.first_step(LinkLost), flight.first_step(LinkRestored)
+    assert _commands([o for s in flight.steps[lost : back + 1] for o in s.outputs]) == []
+    texts = flight.texts()
+    assert any(t.startswith("link lost (3.0 s of silence): waiting") for t in texts)
+    assert "link restored after 6.0 s" in texts
+    assert any("not reached in" in t for t in texts) is (when == "overview photo")
+    assert_home_safely(flown)
+
+
+def test_failsafe_during_link_loss_ends_the_mission_without_commands(paper: Scene) -> None:
+    outage = LinkOutage(At(after=Plan), 10.0, failsafe_mode="RTL", failsafe_after_s=5.0)
+    flown = fly(paper, script=(outage,))
+    flight = flown.flight
+    assert flight.outcome.status is Status.LINK_LOST
+    assert flight.outcome.reason == "mode changed to RTL by the vehicle's failsafe"
+    assert _commands(flight.outputs_from(flight.first_step(LinkLost))) == []
+    # it ends on the first telemetry after the link is back: the failsafe flies from here
+    last = flight.observations[-1]
+    assert isinstance(last, Telemetry) and last.mode == "RTL"
+    assert isinstance(flight.observations[-2], LinkRestored)
+
+
+@pytest.mark.parametrize(("abort_s", "failsafe"), [(30.0, None), (30.0, "RTL"), (10.0, None)])
+def test_link_lost_too_long_ends_the_mission(
+    paper: Scene, abort_s: float, failsafe: str | None
+) -> None:
+    outage = LinkOutage(At(after=Plan), 120.0, failsafe_mode=failsafe)
+    flown = fly(paper, scenes.with_mission(link_lost_abort_s=abort_s), script=(outage,))
+    flight = flown.flight
+    assert flight.outcome.status is Status.LINK_LOST
+    assert flight.outcome.reason == f"no link for {abort_s + 1:.0f} s"
+    last = flight.observations[-1]
+    assert isinstance(last, LinkLost) and last.silent_s == abort_s + 1.0
+    assert _commands(flight.outputs_from(flight.first_step(LinkLost))) == []
+
+
+def test_pilot_takeover_after_a_restored_link_is_a_takeover(paper: Scene) -> None:
+    """Once the link is back and the mission has resumed, a later mode change is someone
+    else's doing, not the link-loss failsafe's: TAKEOVER, and the landing is watched."""
+    script = (
+        LinkOutage(At(after=Plan), 6.0),
+        PilotMode(At(after=Viewpoints), "LOITER"),
+        PilotMode(At(after=Viewpoints, delay_s=5.0), "LAND"),
+    )
+    flown = fly(paper, script=script)
+    outcome = flown.outcome
+    assert (outcome.status, outcome.reason) == (
+        Status.TAKEOVER,
+        "mode changed to LOITER by the pilot or a failsafe",
+    )
+    assert flown.flight.texts()[-1] == "landed and disarmed"
+
+
+# --- driving the mission wrongly -------------------------------------------------------------
+
+
+def test_stepping_after_the_end_raises(paper_flight: Flown) -> None:
+    mission = paper_flight.mission
+    assert mission.done
+    with pytest.raises(MissionStateError, match="ended"):
+        mission.step(paper_flight.flight.observations[-1])
+    with pytest.raises(MissionStateError, match="already started"):
+        mission.start()
+
+
+def test_stepping_after_an_abort_raises(paper: Scene) -> None:
+    flown = fly(paper, refuse={"Takeoff": 10**6})
+    with pytest.raises(MissionStateError, match="ended"):
+        flown.mission.step(flown.flight.observations[-1])
+
+
+def test_stepping_before_start_raises(paper: Scene) -> None:
+    mission = Mission(Params(), target_rgb(paper))
+    telemetry = Telemetry(
+        100, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.0, "STABILIZE", False, True, 0.0, 0.0, 100
+    )
+    with pytest.raises(MissionStateError, match="start"):
+        mission.step(telemetry)
+
+
+def test_target_without_a_shape_is_an_input_error() -> None:
+    grey = np.full((480, 640, 3), 128, dtype=np.uint8)
+    with pytest.raises(MissionInputError, match="target image"):
+        Mission(Params(), grey)
