@@ -40,28 +40,35 @@ def refine_rings(
     dense_px: list[FloatArray], kept: list[list[int]], *, min_edge_px: float, max_shift_px: float
 ) -> list[FloatArray]:
     """:func:`refine_corners` of several rings at once (the line fits share array calls)."""
-    points = [d.tolist() for d in dense_px]
-    spans = [_long_edges(pts, k, min_edge_px) for pts, k in zip(points, kept, strict=True)]
-    lines = _fit_spans(dense_px, spans)
+    # The RDP vertices as Python floats, by dense index: every span starts and ends at one.
+    vertices = [
+        dict(zip(k, d[k].tolist(), strict=True)) for d, k in zip(dense_px, kept, strict=True)
+    ]
+    spans = [
+        _long_edges(len(d), k, v, min_edge_px)
+        for d, k, v in zip(dense_px, kept, vertices, strict=True)
+    ]
+    lines = _fit_spans(dense_px, spans, vertices)
     out: list[FloatArray] = []
     for r, dense in enumerate(dense_px):
-        if len(kept[r]) < 3:
-            out.append(dense[kept[r]].copy())
-            continue
-        corners = _corners(dense, points[r], spans[r], lines[r], max_shift_px)
+        corners = None
+        if len(kept[r]) >= 3:
+            corners = _corners(dense, vertices[r], spans[r], lines[r], max_shift_px)
         out.append(dense[kept[r]].copy() if corners is None else corners)
     return out
 
 
-def _long_edges(pts: list[list[float]], kept: list[int], min_edge_px: float) -> list[Span]:
+def _long_edges(
+    n: int, kept: list[int], vertices: dict[int, list[float]], min_edge_px: float
+) -> list[Span]:
     """The edges of the RDP ring long enough to fit a line to."""
-    n, m = len(pts), len(kept)
+    m = len(kept)
     if m < 3:
         return []
     spans: list[Span] = []
     for e in range(m):
         first, last = kept[e], kept[(e + 1) % m]
-        (x0, y0), (x1, y1) = pts[first], pts[last]
+        (x0, y0), (x1, y1) = vertices[first], vertices[last]
         if (last - first) % n >= 2 and math.hypot(x1 - x0, y1 - y0) >= min_edge_px:
             spans.append((first, last))
     return spans
@@ -69,7 +76,7 @@ def _long_edges(pts: list[list[float]], kept: list[int], min_edge_px: float) -> 
 
 def _corners(
     dense: FloatArray,
-    pts: list[list[float]],
+    vertices: dict[int, list[float]],
     spans: list[Span],
     lines: list[Line],
     max_shift_px: float,
@@ -83,7 +90,7 @@ def _corners(
         (_, _, dx1, dy1), (_, _, dx2, dy2) = lines[k], lines[j]
         if abs(dx1 * dy2 - dy1 * dx2) < _MIN_SINE and dx1 * dx2 + dy1 * dy2 > 0.0:
             spans[k] = (spans[k][0], spans[j][1])
-            lines[k] = _fit_spans([dense], [[spans[k]]])[0][0]
+            lines[k] = _fit_span(dense, spans[k], vertices)
             del spans[j], lines[j]
             k = max(k - 1, 0) if j > k else k - 1
             continue
@@ -95,13 +102,13 @@ def _corners(
         cx1, cy1, dx1, dy1 = lines[k - 1]
         cx2, cy2, dx2, dy2 = lines[k]
         end_prev, start_next = spans[k - 1][1], spans[k][0]
-        vx, vy = pts[end_prev]
+        vx, vy = vertices[end_prev]
         cross = dx1 * dy2 - dy1 * dx2
         if abs(cross) < _MIN_SINE:
             # Parallel edges joined by a stub (a small step): keep the stub's ends.
             corners.append((vx, vy))
             if start_next != end_prev:
-                wx, wy = pts[start_next]
+                wx, wy = vertices[start_next]
                 corners.append((wx, wy))
             continue
         t = ((cx2 - cx1) * dy2 - (cy2 - cy1) * dx2) / cross
@@ -115,7 +122,9 @@ def _corners(
     return np.array(corners, dtype=np.float64)
 
 
-def _fit_spans(dense_px: list[FloatArray], spans: list[list[Span]]) -> list[list[Line]]:
+def _fit_spans(
+    dense_px: list[FloatArray], spans: list[list[Span]], vertices: list[dict[int, list[float]]]
+) -> list[list[Line]]:
     """A total-least-squares line through the dense points of each span, without the end
     points when there are enough (an RDP vertex next to a corner may lie on the next edge),
     its direction pointing the way the outline runs — so the two antiparallel sides of a
@@ -134,32 +143,66 @@ def _fit_spans(dense_px: list[FloatArray], spans: list[list[Span]]) -> list[list
     if not starts:
         return [[] for _ in spans]
     # Each ring doubled so a span running past the last point is a plain slice.
-    xs = np.concatenate([np.concatenate([d[:, 0], d[:, 0]]) for d in dense_px])
-    ys = np.concatenate([np.concatenate([d[:, 1], d[:, 1]]) for d in dense_px])
+    xs = np.concatenate([d[:, 0] for d in dense_px for _ in (0, 1)])
+    ys = np.concatenate([d[:, 1] for d in dense_px for _ in (0, 1)])
     count_arr = np.array(counts)
     offsets = np.cumsum(count_arr) - count_arr
-    idx = np.arange(int(count_arr.sum())) + np.repeat(np.array(starts) - offsets, count_arr)
+    idx = np.repeat(np.array(starts) - offsets, count_arr)
+    idx += np.arange(len(idx))
     gx, gy = xs[idx], ys[idx]
     gxl, gyl = gx.tolist(), gy.tolist()
     bounds = list(zip(offsets.tolist(), (offsets + count_arr).tolist(), strict=True))
     cxs = [math.fsum(gxl[a:b]) / (b - a) for a, b in bounds]
     cys = [math.fsum(gyl[a:b]) / (b - a) for a, b in bounds]
-    dx = gx - np.repeat(np.array(cxs), count_arr)
-    dy = gy - np.repeat(np.array(cys), count_arr)
-    sxx_t, syy_t, sxy_t = (dx * dx).tolist(), (dy * dy).tolist(), (dx * dy).tolist()
+    gx -= np.repeat(np.array(cxs), count_arr)
+    gy -= np.repeat(np.array(cys), count_arr)
+    sxx_t, syy_t, sxy_t = (gx * gx).tolist(), (gy * gy).tolist(), (gx * gy).tolist()
     out: list[list[Line]] = []
     s = 0
-    for dense, ring_spans in zip(dense_px, spans, strict=True):
+    for ring_spans, ring_vertices in zip(spans, vertices, strict=True):
         ring_lines: list[Line] = []
         for first, last in ring_spans:
             a, b = bounds[s]
-            sxx, syy, sxy = math.fsum(sxx_t[a:b]), math.fsum(syy_t[a:b]), math.fsum(sxy_t[a:b])
-            angle = 0.5 * math.atan2(2.0 * sxy, sxx - syy)
-            ux, uy = math.cos(angle), math.sin(angle)
-            chord = dense[last] - dense[first]
-            if ux * float(chord[0]) + uy * float(chord[1]) < 0.0:
-                ux, uy = -ux, -uy
-            ring_lines.append((cxs[s], cys[s], ux, uy))
+            sums = (math.fsum(sxx_t[a:b]), math.fsum(syy_t[a:b]), math.fsum(sxy_t[a:b]))
+            ring_lines.append(
+                _line(cxs[s], cys[s], sums, ring_vertices[first], ring_vertices[last])
+            )
             s += 1
         out.append(ring_lines)
     return out
+
+
+def _fit_span(dense: FloatArray, span: Span, vertices: dict[int, list[float]]) -> Line:
+    """:func:`_fit_spans` of one span (the same arithmetic, without the batching)."""
+    n = len(dense)
+    first, last = span
+    count = (last - first) % n + 1
+    trim = 1 if count >= 6 else 0
+    i0, k = first + trim, count - 2 * trim
+    pts = dense[i0 : i0 + k] if i0 + k <= n else np.concatenate([dense[i0:], dense[: i0 + k - n]])
+    px, py = pts[:, 0], pts[:, 1]
+    cx, cy = math.fsum(px.tolist()) / k, math.fsum(py.tolist()) / k
+    dx, dy = px - cx, py - cy
+    sums = (
+        math.fsum((dx * dx).tolist()),
+        math.fsum((dy * dy).tolist()),
+        math.fsum((dx * dy).tolist()),
+    )
+    return _line(cx, cy, sums, vertices[first], vertices[last])
+
+
+def _line(
+    cx: float,
+    cy: float,
+    sums: tuple[float, float, float],
+    start: list[float],
+    end: list[float],
+) -> Line:
+    """The principal axis of centred second moments ``(sxx, syy, sxy)``, pointing from
+    ``start`` towards ``end``."""
+    sxx, syy, sxy = sums
+    angle = 0.5 * math.atan2(2.0 * sxy, sxx - syy)
+    ux, uy = math.cos(angle), math.sin(angle)
+    if ux * (end[0] - start[0]) + uy * (end[1] - start[1]) < 0.0:
+        ux, uy = -ux, -uy
+    return cx, cy, ux, uy

@@ -7,6 +7,7 @@ a fixed order, so the same borders give the same rings on every machine.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -64,14 +65,19 @@ def offset_ring(ring_px: FloatArray, offset_px: float) -> FloatArray:
     """
     if offset_px == 0.0 or len(ring_px) < 3:
         return ring_px
-    d_next = np.concatenate([ring_px[1:], ring_px[:1]]) - ring_px
-    length = np.sqrt(d_next[:, 0] * d_next[:, 0] + d_next[:, 1] * d_next[:, 1])
-    length[length == 0.0] = 1.0
-    normal = np.stack([d_next[:, 1] / length, -d_next[:, 0] / length], axis=1)
-    n_prev = np.concatenate([normal[-1:], normal[:-1]])
-    dot = normal[:, 0] * n_prev[:, 0] + normal[:, 1] * n_prev[:, 1]
-    # Intersection of the two moved edge lines: offset · (n1 + n2) / (1 + n1·n2).
-    denom = np.maximum(1.0 + dot, 2.0 / (_MAX_MITRE * _MAX_MITRE))
-    scale = offset_px / denom
-    out: FloatArray = ring_px + (normal + n_prev) * scale[:, None]
-    return out
+    pts = ring_px.tolist()
+    normals: list[tuple[float, float]] = []
+    for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1], strict=True):
+        dx, dy = x1 - x0, y1 - y0
+        length = math.sqrt(dx * dx + dy * dy)
+        if length == 0.0:
+            length = 1.0
+        normals.append((dy / length, -dx / length))
+    min_denom = 2.0 / (_MAX_MITRE * _MAX_MITRE)
+    out: list[tuple[float, float]] = []
+    for (x, y), (nx, ny), (px, py) in zip(pts, normals, normals[-1:] + normals[:-1], strict=True):
+        # Intersection of the two moved edge lines: offset · (n1 + n2) / (1 + n1·n2).
+        denom = 1.0 + (nx * px + ny * py)
+        scale = offset_px / (denom if denom >= min_denom else min_denom)
+        out.append((x + (nx + px) * scale, y + (ny + py) * scale))
+    return np.array(out, dtype=np.float64)

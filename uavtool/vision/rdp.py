@@ -92,27 +92,37 @@ def rdp_rings_indices(rings_px: list[FloatArray], epsilon_px: float) -> list[Ind
         kept[k] = [(i + q) % n for q in np.flatnonzero(keep[off + i : off + i + n]).tolist()]
     # The cut points are kept unconditionally; drop either one that RDP would not need
     # (on a rasterised outline the farthest point is often next to the corner, not on it).
+    # Both checks go in one batch when the second cannot depend on the first (the two
+    # anchors are not neighbours, and dropping one still leaves more than three points).
     eps2 = epsilon_px * epsilon_px
-    for anchor_of in (1, 2):
-        check: list[tuple[int, int]] = []  # (ring, position of the anchor in its kept list)
+    pending = {k: [a, b] for k, (_, a, b) in chains.items()}
+    while pending:
+        check: list[tuple[int, int]] = []  # (ring, anchor)
         f: list[int] = []
         last: list[int] = []
-        for k, (off, a, b) in chains.items():
+        for k, anchors in pending.items():
             ring_kept = kept[k]
             m = len(ring_kept)
-            if m <= 3:
-                continue
-            pos = ring_kept.index(a if anchor_of == 1 else b)
-            prev, nxt = ring_kept[pos - 1], ring_kept[(pos + 1) % m]
-            check.append((k, pos))
-            f.append(off + prev)
-            last.append(off + (nxt if nxt > prev else nxt + len(rings_px[k])))
+            take = anchors[:1] if m > 3 else []
+            if len(anchors) == 2 and m >= 5:
+                gap = ring_kept.index(anchors[0]) - ring_kept.index(anchors[1])
+                if gap % m not in (1, m - 1):
+                    take = anchors
+            for anchor in take:
+                pos = ring_kept.index(anchor)
+                prev, nxt = ring_kept[pos - 1], ring_kept[(pos + 1) % m]
+                off = chains[k][0]
+                check.append((k, anchor))
+                f.append(off + prev)
+                last.append(off + (nxt if nxt > prev else nxt + len(rings_px[k])))
+            pending[k] = anchors[len(take) :] if take else []
+        pending = {k: anchors for k, anchors in pending.items() if anchors}
         if not check:
             break
         worst, _ = _farthest(xs, ys, np.array(f), np.array(last))
-        for (k, pos), d2 in zip(check, worst.tolist(), strict=True):
+        for (k, anchor), d2 in zip(check, worst.tolist(), strict=True):
             if d2 <= eps2:
-                del kept[k][pos]
+                kept[k].remove(anchor)
     for k, ring_kept in kept.items():
         out[k] = np.array(ring_kept, dtype=np.intp)
     return out

@@ -54,10 +54,10 @@ def signed_area(ring: FloatArray) -> float:
     """Shoelace area of a closed ring ``(n, 2)``; positive when the ring turns counter-clockwise
     in a y-up frame (clockwise as seen on screen, y down). Summed with ``math.fsum`` so the
     result does not depend on array layout."""
-    x = ring[:, 0]
-    y = ring[:, 1]
-    terms = x * _next(y) - _next(x) * y
-    return 0.5 * math.fsum(terms.tolist())
+    pts = ring.tolist()
+    return 0.5 * math.fsum(
+        x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1], strict=True)
+    )
 
 
 def orient(ring: FloatArray, *, positive: bool) -> FloatArray:
@@ -68,16 +68,18 @@ def orient(ring: FloatArray, *, positive: bool) -> FloatArray:
 
 
 def _area_moments(rings: tuple[FloatArray, ...]) -> tuple[float, float, float]:
+    # Plain float arithmetic: outlines have tens of vertices, where numpy's per-call cost
+    # dominates; each term is the same IEEE operation either way.
     area_terms: list[float] = []
     mu_terms: list[float] = []
     mv_terms: list[float] = []
     for ring in rings:
-        x0, y0 = ring[:, 0], ring[:, 1]
-        x1, y1 = _next(x0), _next(y0)
-        cross = x0 * y1 - x1 * y0
-        area_terms.extend(cross.tolist())
-        mu_terms.extend(((x0 + x1) * cross).tolist())
-        mv_terms.extend(((y0 + y1) * cross).tolist())
+        pts = ring.tolist()
+        for (x0, y0), (x1, y1) in zip(pts, pts[1:] + pts[:1], strict=True):
+            cross = x0 * y1 - x1 * y0
+            area_terms.append(cross)
+            mu_terms.append((x0 + x1) * cross)
+            mv_terms.append((y0 + y1) * cross)
     area = 0.5 * math.fsum(area_terms)
     return area, math.fsum(mu_terms) / 6.0, math.fsum(mv_terms) / 6.0
 
@@ -89,10 +91,5 @@ def _vertex_mean(ring: FloatArray) -> tuple[float, float]:
 
 def perimeter(ring: FloatArray) -> float:
     """Length of a closed ring ``(n, 2)``, summed in a fixed order."""
-    d = _next(ring) - ring
+    d = np.concatenate([ring[1:], ring[:1]]) - ring
     return math.fsum(np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]).tolist())
-
-
-def _next(a: FloatArray) -> FloatArray:
-    """``a`` shifted by one along the first axis, cyclically (``np.roll(a, -1)``, faster)."""
-    return np.concatenate([a[1:], a[:1]])

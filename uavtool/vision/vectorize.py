@@ -70,12 +70,19 @@ def vectorize(frame_rgb: U8Array, params: VectorizeParams | None = None) -> tupl
     if p.denoise_px > 1:
         # The median of class ids is always one of the ids present, so no class is invented.
         classes = cv2.medianBlur(classes, p.denoise_px)
+    val = val[box]
     regions: list[_Region] = []
     for k in range(1, n_classes + 1):
         mask = cv2.inRange(classes, k, k)
+        # Each colour is traced in its own bounding box (all of its pixels are inside).
+        bx, by, bw, bh = cv2.boundingRect(mask)
+        if bw == 0:
+            continue
+        sub = (slice(by, by + bh), slice(bx, bx + bw))
+        mask = mask[sub]
         if p.roof_only:
-            mask = brightest_shade(val[box], mask, p)
-        regions.extend(_regions(mask, (x0, y0), frame.shape[:2], k, p))
+            mask = brightest_shade(val[sub], mask, p)
+        regions.extend(_regions(mask, (x0 + bx, y0 + by), frame.shape[:2], k, p))
     rings = simplify_rings([c for r in regions for c in (r.outer, *r.holes)], p)
     shapes: list[tuple[int, float, int, Shape]] = []
     at = 0
