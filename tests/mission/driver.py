@@ -235,7 +235,10 @@ def target_rgb(scene: Scene, intrinsics: Intrinsics = INTRINSICS) -> U8Array:
 
 @dataclass(frozen=True, slots=True)
 class Flown:
+    """A finished run: the mission, its target picture, the vehicle and what was flown."""
+
     mission: Mission
+    target_rgb: U8Array
     fake: FakeVehicle
     flight: Flight
 
@@ -255,6 +258,7 @@ def fly(
 ) -> Flown:
     """A fresh mission looking for ``target_scene``'s (default ``scene``'s) target, flown on
     a fresh vehicle in ``scene`` (``vehicle``: :class:`FakeVehicle` options)."""
-    mission = Mission(params or Params(), target_rgb(target_scene or scene))
+    target = target_rgb(target_scene or scene)
+    mission = Mission(params or Params(), target)
     fake = FakeVehicle(scene, **vehicle)
-    return Flown(mission, fake, run(mission, fake, script=script, max_steps=max_steps))
+    return Flown(mission, target, fake, run(mission, fake, script=script, max_steps=max_steps))
