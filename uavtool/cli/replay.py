@@ -39,6 +39,12 @@ from uavtool.errors import InputError
     help="Write the replay as a new recording.",
 )
 @click.option("--vision-only", is_flag=True, help="Only re-run vectorize/match on every frame.")
+@click.option(
+    "--update-golden",
+    is_flag=True,
+    help="Rewrite RECORDING's outputs (and its .outputs.txt digest) with what the mission "
+    "produces now. Deliberate: only when behaviour is meant to change.",
+)
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar.")
 def replay(
     recording: Path,
@@ -47,6 +53,7 @@ def replay(
     params_file: Path | None,
     out: Path | None,
     vision_only: bool,
+    update_golden: bool,
     quiet: bool,
 ) -> None:
     """Feed RECORDING's observations to a fresh mission and compare every output.
@@ -62,6 +69,15 @@ def replay(
     from uavtool.replay import replay as run_replay
     from uavtool.replay.write import write_replay
 
+    if update_golden:
+        from uavtool.replay.golden import update_golden as update
+
+        before, after = update(recording)
+        click.echo(
+            f"{recording}: outputs rewritten ({before} → {after}); review the diff of "
+            f"{recording.with_suffix('.outputs.txt')}"
+        )
+        return
     flight = load_flight(recording)
     overrides: dict[str, object] = {}
     if params_file is not None:
@@ -73,9 +89,15 @@ def replay(
         overrides[key.strip()] = value.strip()
     params = with_overrides(flight.params, overrides)  # type: ignore[arg-type]
     changed = bool(overrides)
+    if flight.truncated and check:
+        raise InputError(
+            f"{recording}: the recording is truncated (cut while writing); --check needs a whole "
+            f"file. `uavtool info --recover {recording} -o fixed.mcap` saves what it holds"
+        )
     if flight.truncated:
         click.echo(
-            f"{recording}: truncated recording: replaying the {len(flight.observations)} observations it holds",
+            f"{recording}: truncated recording: replaying the "
+            f"{len(flight.observations)} observations it holds",
             err=True,
         )
     if not vision_only:
@@ -103,7 +125,9 @@ def replay(
             click.echo(f"diverged at step {result.divergence.step}: {result.divergence.reason}")
             click.echo("mission stopped there; per-frame vision continues on every recorded frame")
         if out is not None:
-            write_replay(recording, out, result.outputs, result.glbs, params)
+            write_replay(
+                recording, out, result.outputs, result.glbs, params, outcome=result.outcome
+            )
             click.echo(f"wrote {out}")
     if changed or vision_only:
         for change in reanalyse_frames(flight, params):

@@ -10,10 +10,13 @@ step and replay says why. Per-frame vision is re-run on every recorded photo reg
 
 from __future__ import annotations
 
+import json
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from uavtool.geo import wrap_180
 from uavtool.mission import Mission, ModelBuilt, Output, Params
 from uavtool.mission.codec import encode_output
 from uavtool.replay.load import RecordedFlight, RecordedOutput
@@ -64,6 +67,18 @@ class ReplayResult:
     """GLB bytes of each replayed model, by output number."""
 
     @property
+    def outcome(self) -> dict[str, str] | None:
+        """The replayed Outcome as an ``outcome`` metadata record (None if not reached)."""
+        for out in reversed(self.outputs):
+            if out.data.get("type") == "Outcome":
+                return {
+                    k: v if isinstance(v, str) else json.dumps(v)
+                    for k, v in out.data.items()
+                    if k != "type"
+                }
+        return None
+
+    @property
     def identical(self) -> bool:
         return self.first_difference is None and self.divergence is None
 
@@ -76,8 +91,9 @@ def replay(
 ) -> ReplayResult:
     """Feed the recorded observations to a fresh mission built with ``params`` (default: the
     recorded ones) and compare its outputs with the recording's, step by step."""
-    mission = Mission(params if params is not None else flight.params, flight.target_rgb)
-    cmp = _Comparison(flight.outputs)
+    p = params if params is not None else flight.params
+    mission = Mission(p, flight.target_rgb)
+    cmp = _Comparison(flight.outputs, p)
     total = len(flight.observations)
     cmp.emit(0, mission.start())
     for step, obs in enumerate(flight.observations, start=1):
@@ -104,8 +120,10 @@ class _Comparison:
     """Positional comparison of all outputs (for ``--check``), and of the commands alone (to
     find where the mission's decisions leave the recording)."""
 
-    def __init__(self, recorded: tuple[RecordedOutput, ...]) -> None:
+    def __init__(self, recorded: tuple[RecordedOutput, ...], params: Params) -> None:
         self.result = ReplayResult()
+        self._radius_m = params.mission.arrive_radius_m
+        self._heading_deg = params.mission.heading_tolerance_deg
         self._recorded = iter(recorded)
         self._commands = iter([r for r in recorded if r.data.get("type") in _COMMANDS])
 
@@ -124,8 +142,22 @@ class _Comparison:
                 self._check(step, n, data, next(self._recorded, None))
             if data["type"] in _COMMANDS and self.result.divergence is None:
                 expected = next(self._commands, None)
-                if expected is None or _first_diff(expected.data, data)[0] is not None:
+                if expected is None or not self._same_decision(expected.data, data):
                     self.diverge(step, _why(expected, data))
+
+    def _same_decision(self, recorded: dict[str, Any], replayed: dict[str, Any]) -> bool:
+        """The same command, or a move to within the arrival tolerances of the recorded one:
+        the recorded observations still answer it."""
+        if _first_diff(recorded, replayed)[0] is None:
+            return True
+        if recorded.get("type") != "GoTo" or replayed.get("type") != "GoTo":
+            return False
+        a, b = recorded["heading_deg"], replayed["heading_deg"]
+        if (a is None) != (b is None) or (
+            a is not None and abs(wrap_180(a - b)) > self._heading_deg
+        ):
+            return False
+        return bool(math.dist(recorded["pos_enu_m"], replayed["pos_enu_m"]) <= self._radius_m)
 
     def _check(
         self, step: int, n: int, data: dict[str, Any], expected: RecordedOutput | None

@@ -25,7 +25,13 @@ _REGENERATED = {OUTPUTS, MODEL}
 
 
 def write_replay(
-    source: Path, out: Path, outputs: list[RecordedOutput], glbs: dict[int, bytes], params: Params
+    source: Path,
+    out: Path,
+    outputs: list[RecordedOutput],
+    glbs: dict[int, bytes],
+    params: Params,
+    *,
+    outcome: dict[str, str] | None = None,
 ) -> None:
     """Copy ``source``'s inputs into ``out`` and write ``outputs`` (with each model's GLB from
     ``glbs`` by output number) at the log time of the observation that produced them."""
@@ -71,6 +77,7 @@ def write_replay(
                 else:
                     writer.write(topic, value, log_time_ns=t, publish_time_ns=entry.publish_time_ns)
             _flush(recorder, pending, 1 << 62, last_t or 1, glbs)
+            writer.add_metadata("outcome", outcome or {"status": "replay-diverged"})
 
 
 def _flush(

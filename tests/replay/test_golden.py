@@ -1,0 +1,19 @@
+"""Every golden recording replays bit for bit (through the uavtool pytest plugin)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from uavtool.replay import load_flight
+from uavtool.replay.golden import digest, digest_path
+from uavtool.testing import assert_replays_identically
+
+
+def test_golden_replays_identically(uavtool_recording: Path) -> None:
+    assert_replays_identically(uavtool_recording)
+
+
+def test_golden_digest_is_current(uavtool_recording: Path) -> None:
+    """The reviewable digest beside each golden matches its recorded outputs."""
+    expected = digest_path(uavtool_recording).read_text()
+    assert digest(load_flight(uavtool_recording).outputs) == expected

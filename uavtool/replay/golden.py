@@ -1,0 +1,70 @@
+"""Golden recordings: replayed with ``--check`` by the test suite, regenerated only by a
+deliberate ``uavtool replay --update-golden``. Each golden ``X.mcap`` has a text digest
+``X.outputs.txt`` beside it (one line per output, floats rounded) so that a change of
+behaviour shows as a readable diff in review."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from uavtool.replay.load import RecordedOutput, load_flight
+from uavtool.replay.replay import replay
+from uavtool.replay.write import write_replay
+
+
+def digest_path(recording: Path) -> Path:
+    return recording.with_suffix(".outputs.txt")
+
+
+def digest(outputs: list[RecordedOutput] | tuple[RecordedOutput, ...]) -> str:
+    """One line per output: number, step, type and its content, floats to 4 decimals."""
+    return "".join(f"{o.n:4d} {o.step:5d} {_line(o.data)}\n" for o in outputs)
+
+
+def _line(data: dict[str, Any]) -> str:
+    kind = data.get("type")
+    body = {k: v for k, v in data.items() if k != "type"}
+    if kind == "Shapes":
+        shapes = body.pop("shapes")
+        body["shapes"] = [
+            f"rgb{tuple(s['colour_rgb'])} {len(s['polygon_px'])} corners "
+            f"{len(s['holes_px'])} holes area {s['area_px']:.1f}"
+            for s in shapes
+        ]
+    elif kind == "ModelBuilt":
+        body["vertices_m"] = f"{len(body['vertices_m'])} vertices"
+        body["faces"] = f"{len(body['faces'])} faces"
+    return f"{kind} {json.dumps(_round(body), ensure_ascii=False)}"
+
+
+def _round(value: Any) -> Any:
+    if isinstance(value, float):
+        return round(value, 4)
+    if isinstance(value, list):
+        return [_round(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _round(v) for k, v in value.items()}
+    return value
+
+
+def update_golden(recording: Path) -> tuple[int, int]:
+    """Replay ``recording`` with its own parameters and rewrite its outputs (and digest) with
+    what the mission produces now. Returns (outputs before, outputs after). The observations
+    are kept: when the mission's decisions change, fly the golden again instead (see
+    ``recordings/README.md``) — this refuses a replay that diverges."""
+    flight = load_flight(recording)
+    result = replay(flight)
+    if result.divergence is not None:
+        from uavtool.replay.load import ReplayInputError  # noqa: PLC0415
+
+        raise ReplayInputError(
+            f"{recording}: the mission now diverges at step {result.divergence.step} "
+            f"({result.divergence.reason}); fly this golden again instead"
+        )
+    tmp = recording.with_suffix(".mcap.tmp")
+    write_replay(recording, tmp, result.outputs, result.glbs, flight.params, outcome=result.outcome)
+    tmp.replace(recording)
+    digest_path(recording).write_text(digest(result.outputs))
+    return len(flight.outputs), len(result.outputs)

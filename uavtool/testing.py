@@ -1,0 +1,54 @@
+"""A pytest plugin: your recordings become regression tests.
+
+Enabled automatically when uavtool is installed. Name folders of ``.mcap`` files in your
+pytest configuration::
+
+    [tool.pytest.ini_options]
+    uavtool_recordings = ["recordings/golden", "tests/flights"]
+
+and write one test that takes the ``uavtool_recording`` argument; it runs once per file::
+
+    from uavtool.testing import assert_replays_identically
+
+    def test_recording_replays(uavtool_recording):
+        assert_replays_identically(uavtool_recording)
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+_INI = "uavtool_recordings"
+
+
+def pytest_addoption(parser: Any) -> None:
+    parser.addini(_INI, "folders whose .mcap recordings uavtool_recording runs over", type="paths")
+
+
+def recordings(config: Any) -> list[Path]:
+    """Every ``.mcap`` in the configured folders, sorted."""
+    out: list[Path] = []
+    for folder in config.getini(_INI):
+        out.extend(sorted(Path(folder).glob("*.mcap")))
+    return out
+
+
+def pytest_generate_tests(metafunc: Any) -> None:
+    if "uavtool_recording" in metafunc.fixturenames:
+        paths = recordings(metafunc.config)
+        metafunc.parametrize("uavtool_recording", paths, ids=[p.name for p in paths])
+
+
+def assert_replays_identically(path: str | Path) -> None:
+    """Replay ``path`` with its recorded parameters; AssertionError with the first difference
+    (step, output, field, recorded vs replayed) unless every output is equal."""
+    from uavtool.replay import load_flight, replay  # noqa: PLC0415 - keep pytest start-up light
+
+    result = replay(load_flight(path))
+    if result.first_difference is not None:
+        raise AssertionError(f"{path}: {result.first_difference.describe()}")
+    if result.divergence is not None:
+        raise AssertionError(
+            f"{path}: diverged at step {result.divergence.step}: {result.divergence.reason}"
+        )
