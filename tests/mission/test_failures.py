@@ -23,6 +23,7 @@ from uavtool.mission import (
     MissionInputError,
     MissionStateError,
     Params,
+    Photo,
     Plan,
     SetMode,
     Status,
@@ -120,6 +121,25 @@ def test_move_never_arriving_is_retried_then_aborts(paper: Scene) -> None:
     assert all(b - a >= slack_ms for a, b in itertools.pairwise(sent))
     assert sum("not reached in" in t for t in flight.texts()) == 4
     assert_home_safely(flown)  # RTL still flies home: only GUIDED targets are ignored
+
+
+def test_take_off_accepted_but_never_climbing_aborts(paper: Scene) -> None:
+    flown = fly(paper, climb_m_s=0.0)
+    assert flown.outcome.status is Status.ABORTED
+    assert flown.outcome.reason == "take-off: 45 m never reached"
+    assert_home_safely(flown)
+
+
+def test_gimbal_never_reporting_its_pitch_warns_and_photographs_anyway(paper: Scene) -> None:
+    """A gimbal that reports another pitch than commanded: the mission waits, warns and takes
+    the photo at the reported pose (here: looking at the horizon, so it sees no roof)."""
+    flown = fly(paper, gimbal_rate_deg_s=0.0)
+    texts = flown.flight.texts()
+    assert "gimbal did not report -90°; photo anyway" in texts
+    (overview,) = [o for o in flown.flight.observations if isinstance(o, Photo)]
+    assert overview.tag == "overview" and overview.pose.pitch_deg == 0.0
+    assert flown.outcome.status is Status.NO_MATCH
+    assert_home_safely(flown)
 
 
 def test_already_flying_takes_control_in_guided(paper: Scene) -> None:
