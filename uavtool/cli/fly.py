@@ -79,6 +79,13 @@ def _pairs(values: tuple[str, ...], option: str) -> dict[str, str]:
     metavar="START:DURATION",
     help="Fault injection (built-in SITL): cut the link for DURATION s at sim time START.",
 )
+@click.option(
+    "--timeout",
+    default=30.0,
+    show_default=True,
+    type=float,
+    help="Seconds to wait for the vehicle to connect and report its home.",
+)
 @click.option("-q", "--quiet", is_flag=True, help="Print only the summary.")
 def fly(
     connect: str | None,
@@ -95,6 +102,7 @@ def fly(
     noise: bool,
     wind: str | None,
     outages: tuple[str, ...],
+    timeout: float,
     quiet: bool,
 ) -> None:
     """Search the scene for the target building, photograph it from three sides and build
@@ -141,6 +149,7 @@ def fly(
         wind=wind_pair,
         link_outages_s=tuple(parse_outage(o) for o in outages),
         command_line=tuple(sys.argv),
+        connect_timeout_s=timeout,
     )
 
     def echo(text: str) -> None:

@@ -136,8 +136,9 @@ class SerialTransport:
         self.port.close()
 
 
-def open_transport(text: str) -> Transport:
-    """Open a connection string; raises LinkError naming what is wrong."""
+def open_transport(text: str, *, timeout_s: float = 10.0) -> Transport:
+    """Open a connection string; raises LinkError naming what is wrong. A TCP vehicle that
+    refuses is retried for ``timeout_s`` (it may still be starting)."""
     kind, _, rest = text.partition(":")
     if text.startswith("/dev/") or kind in ("serial", "com") or kind.upper().startswith("COM"):
         device, baud = _serial_parts(text)
@@ -155,6 +156,8 @@ def open_transport(text: str) -> Transport:
         raise LinkError(f"connection {text!r}: port {port_text!r} is not a number") from None
     if not host or not 0 < port < 65536:
         raise LinkError(f"connection {text!r}: expected {kind}:HOST:PORT with a port 1-65535")
+    if kind == "tcp":
+        return TcpTransport(host, port, connect_timeout_s=timeout_s)
     return opener(host, port)
 
 

@@ -121,7 +121,10 @@ def fly(
             )
             recorder = MissionRecorder(writer)
             recorder.target(target_png)
-        link = VehicleLink(open_transport(connect), tap=recorder.mavlink if recorder else None)
+        link = VehicleLink(
+            open_transport(connect, timeout_s=config.connect_timeout_s),
+            tap=recorder.mavlink if recorder else None,
+        )
         stack.callback(link.close)
         link.wait_vehicle(config.connect_timeout_s)
         home = link.state.home

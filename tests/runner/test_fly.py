@@ -1,0 +1,125 @@
+"""uavtool fly end to end against the built-in SITL, and its errors."""
+
+from __future__ import annotations
+
+import socket
+import threading
+import time
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from uavtool.cli import cli
+from uavtool.mission import Params, Status
+from uavtool.mission.params import with_overrides
+from uavtool.recording import summarize
+from uavtool.replay import load_flight, replay
+from uavtool.runner.fly import FlyConfig, fly
+
+
+@pytest.fixture(scope="module")
+def paper_flight(tmp_path_factory: pytest.TempPathFactory) -> tuple[object, Path]:
+    path = tmp_path_factory.mktemp("fly") / "paper.mcap"
+    summary = fly(FlyConfig(record=path, speedup=30.0))
+    return summary, path
+
+
+def test_paper_mission_finds_the_red_building_and_builds_its_model(
+    paper_flight: tuple[object, Path],
+) -> None:
+    summary, path = paper_flight
+    o = summary.outcome  # type: ignore[attr-defined]
+    e = summary.evaluation  # type: ignore[attr-defined]
+    assert o.status is Status.COMPLETED, o.reason
+    assert e.matched_building == "red" == e.target_building
+    # Nearest neighbour from home: purple (north), yellow, blue, then red.
+    assert e.visited == ("purple", "yellow", "blue", "red")
+    assert o.model_built
+    assert e.model_iou is not None and e.model_iou > 0.85
+    assert summary.frames == 8  # type: ignore[attr-defined]
+
+
+def test_recording_is_whole_and_replays_identically(paper_flight: tuple[object, Path]) -> None:
+    _, path = paper_flight
+    info = summarize(path)
+    assert info.whole
+    assert info.outcome is not None and info.outcome["status"] == "completed"
+    assert replay(load_flight(path)).identical
+
+
+def test_fly_cli_prints_progress_and_summary(tmp_path: Path) -> None:
+    rec = tmp_path / "r.mcap"
+    result = CliRunner().invoke(
+        cli, ["fly", "--scene", "blocked-front", "--speedup", "30", "--record", str(rec)]
+    )
+    assert result.exit_code == 0, result.output
+    out = result.output
+    assert "points of interest; visiting order" in out
+    assert "viewpoint: opposite side" in out  # the front view must fall back
+    assert "matched        poi" in out and "(correct: the target is 'red')" in out
+    assert "IoU vs ground truth" in out
+    assert str(rec) in out
+    assert CliRunner().invoke(cli, ["info", str(rec)]).exit_code == 0
+
+
+def test_link_lost_for_good_ends_the_mission(tmp_path: Path) -> None:
+    params = with_overrides(Params(), {"mission.link_lost_abort_s": "8"})
+    summary = fly(
+        FlyConfig(
+            record=tmp_path / "lost.mcap",
+            speedup=30.0,
+            params=params,
+            link_outages_s=((40.0, 1000.0),),
+        )
+    )
+    assert summary.outcome.status is Status.LINK_LOST
+    assert "no link for" in summary.outcome.reason
+    assert summarize(tmp_path / "lost.mcap").whole
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--scene", "nowhere"], "nowhere"),
+        (["--target", "/nonexistent/target.png"], "--target /nonexistent/target.png"),
+        (["--connect", "bogus:1:2"], "connection 'bogus:1:2'"),
+        (["--connect", "tcp:127.0.0.1:1", "--timeout", "0.5"], "cannot connect"),
+        (["--set", "mission.nope=1"], "unknown parameter 'mission.nope'"),
+        (["--set", "mission.detail_alt_m=abc"], "is not a valid float"),
+        (["--camera", "webcam"], "--camera 'webcam'"),
+        (["--param", "WPNAV_SPEED"], "expected NAME=VALUE"),
+    ],
+)
+def test_bad_input_is_one_line_exit_2(tmp_path: Path, args: list[str], message: str) -> None:
+    result = CliRunner().invoke(cli, ["fly", "--record", str(tmp_path / "x.mcap"), *args])
+    assert result.exit_code == 2, result.output
+    assert message in result.output
+    assert "Traceback" not in result.output
+
+
+def test_garbage_instead_of_a_vehicle(tmp_path: Path) -> None:
+    """A TCP peer that only sends noise: no heartbeat, a clear error, exit 2."""
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(1)
+    port = server.getsockname()[1]
+
+    def noise() -> None:
+        conn, _ = server.accept()
+        with conn:
+            for i in range(1000):  # until the client gives up and hangs up
+                try:
+                    conn.sendall(bytes((i * 7 + k) % 256 for k in range(512)))
+                except OSError:
+                    return
+                time.sleep(0.005)
+
+    threading.Thread(target=noise, daemon=True).start()
+    result = CliRunner().invoke(
+        cli,
+        ["fly", "--connect", f"tcp:127.0.0.1:{port}", "--timeout", "1", "--no-record"],
+    )
+    server.close()
+    assert result.exit_code == 2, result.output
+    assert f"tcp:127.0.0.1:{port}: no heartbeat from a vehicle in 1 s" in result.output
