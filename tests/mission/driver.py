@@ -11,6 +11,7 @@ vehicle time, a mission step, or after the mission first emits some output.
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
@@ -30,6 +31,7 @@ from uavtool.mission import (
     Outcome,
     Output,
     Params,
+    SetMode,
     TakePhoto,
 )
 from uavtool.mission.observations import U8Array
@@ -262,3 +264,19 @@ def fly(
     mission = Mission(params or Params(), target)
     fake = FakeVehicle(scene, **vehicle)
     return Flown(mission, target, fake, run(mission, fake, script=script, max_steps=max_steps))
+
+
+def assert_home_safely(flown: Flown) -> None:
+    """After the mission's end at most RTL is commanded, and the vehicle lands at home."""
+    flight = flown.flight
+    end = next(
+        i
+        for i, o in enumerate(flight.outputs)
+        if isinstance(o, Event) and o.text.startswith("mission ends")
+    )
+    after = [o for o in flight.outputs[end:] if isinstance(o, Command)]
+    assert all(c == SetMode(c.id, "RTL") for c in after) and len(after) <= 1
+    assert flight.texts()[-1] == "landed and disarmed"
+    fake = flown.fake
+    assert fake.landed and not fake.armed
+    assert math.hypot(fake.pos[0], fake.pos[1]) < 0.1

@@ -10,9 +10,18 @@ import numpy as np
 import pytest
 
 from tests.mission import scenes
-from tests.mission.driver import NO_ACK, At, Flight, Flown, LinkOutage, PilotMode, fly, target_rgb
+from tests.mission.driver import (
+    NO_ACK,
+    At,
+    Flight,
+    Flown,
+    LinkOutage,
+    PilotMode,
+    assert_home_safely,
+    fly,
+    target_rgb,
+)
 from tests.mission.fakes import REFUSED, command_key
-from tests.mission.test_flight import assert_home_safely
 from uavtool.mission import (
     Arm,
     Command,
@@ -70,7 +79,7 @@ def test_command_failing_four_times_aborts_with_rtl(paper: Scene, kind: str, ans
     assert all(b - a >= wait_ms for a, b in itertools.pairwise(sent))
     warnings = [t for t in flown.flight.texts() if t.endswith(" of 4)")]
     assert [w.split("(attempt ")[1] for w in warnings] == [f"{k} of 4)" for k in range(1, 5)]
-    assert SetMode(flown.flight.of_type(SetMode)[-1].id, "RTL") in flown.flight.outputs
+    assert flown.flight.of_type(SetMode)[-1].mode == "RTL"
     assert_home_safely(flown)
 
 
@@ -169,7 +178,11 @@ def test_pilot_takeover_stops_all_commands(paper: Scene, after: type, pilot_land
         if isinstance(s.observation, Telemetry) and s.observation.mode == "LOITER"
     )
     assert _commands(flight.outputs_from(seen)) == []
-    assert not flight.of_type(Viewpoints) if after is Plan else flight.of_type(Viewpoints)
+    # what was done before the takeover is still reported
+    if after is Plan:
+        assert flight.outcome.visited == () and flight.outcome.matched_poi == -1
+    else:
+        assert flight.outcome.visited and flight.outcome.matched_poi >= 0
     texts = flight.texts()
     assert "no more commands; watching until the vehicle lands" in texts
     if pilot_lands:

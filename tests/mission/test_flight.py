@@ -10,11 +10,10 @@ import pytest
 import shapely  # type: ignore[import-untyped]
 
 from tests.mission import scenes
-from tests.mission.driver import Flight, Flown, fly
+from tests.mission.driver import Flight, Flown, assert_home_safely, fly
 from uavtool.geo import wrap_180
 from uavtool.mission import (
     Command,
-    Event,
     ModelBuilt,
     Outcome,
     Photo,
@@ -53,22 +52,6 @@ def _nearest_neighbour_m(start: Point, points: list[Point]) -> float:
         here = points[k]
         left.remove(k)
     return total
-
-
-def assert_home_safely(flown: Flown) -> None:
-    """After the mission's end at most RTL is commanded, and the vehicle lands at home."""
-    flight = flown.flight
-    end = next(
-        i
-        for i, o in enumerate(flight.outputs)
-        if isinstance(o, Event) and o.text.startswith("mission ends")
-    )
-    after = [o for o in flight.outputs[end:] if isinstance(o, Command)]
-    assert all(c == SetMode(c.id, "RTL") for c in after) and len(after) <= 1
-    assert flight.texts()[-1] == "landed and disarmed"
-    fake = flown.fake
-    assert fake.landed and not fake.armed
-    assert math.hypot(fake.pos[0], fake.pos[1]) < 0.1
 
 
 # --- the paper's flight -----------------------------------------------------------------------
@@ -218,7 +201,7 @@ def test_no_match_reports_and_lands(scene_name: str, why: str, visits: int) -> N
     assert not outcome.model_built
     assert not flown.flight.of_type(ModelBuilt) and not flown.flight.of_type(Viewpoints)
     assert not any(r.matched for r in flown.flight.of_type(Recognition))
-    assert SetMode(flown.flight.of_type(SetMode)[-1].id, "RTL") in flown.flight.outputs
+    assert flown.flight.of_type(SetMode)[-1].mode == "RTL"
     assert_home_safely(flown)
 
 
