@@ -28,7 +28,7 @@ def paper_flight(tmp_path_factory: pytest.TempPathFactory) -> tuple[object, Path
 def test_paper_mission_finds_the_red_building_and_builds_its_model(
     paper_flight: tuple[object, Path],
 ) -> None:
-    summary, path = paper_flight
+    summary, _path = paper_flight
     o = summary.outcome  # type: ignore[attr-defined]
     e = summary.evaluation  # type: ignore[attr-defined]
     assert o.status is Status.COMPLETED, o.reason

@@ -41,7 +41,7 @@ def _pairs(values: tuple[str, ...], option: str) -> dict[str, str]:
     "--camera", default="sim", show_default=True, help="sim, opencv:N (device) or a stream URL."
 )
 @click.option(
-    "--speedup", default=20.0, show_default=True, type=float, help="Built-in SITL speed-up."
+    "--speedup", default=30.0, show_default=True, type=float, help="Built-in SITL speed-up."
 )
 @click.option(
     "--record",

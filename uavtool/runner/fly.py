@@ -41,7 +41,7 @@ class FlyConfig:
     scene: str = "paper"
     target: Path | None = None
     camera: str = "sim"
-    speedup: float = 20.0
+    speedup: float = 30.0
     record: Path | None = None
     """None: ``recordings/<UTC time>.mcap``."""
     no_record: bool = False
