@@ -222,6 +222,7 @@ class Mission:
 
     def _check_mode(self, t: Telemetry) -> None:
         if not self._expected_modes or t.mode in self._expected_modes:
+            self._link_was_lost = False  # the link came back and the vehicle kept its mode
             return
         who = "the vehicle's failsafe" if self._link_was_lost else "the pilot or a failsafe"
         status = Status.LINK_LOST if self._link_was_lost else Status.TAKEOVER
@@ -343,12 +344,16 @@ class Mission:
         p = self.params.mission
         yield from self.set_mode("GUIDED")
         start_ms = self.now_ms()
+        refused = 0
         while True:
             cmd = Arm(self._new_id())
             self._emit(cmd)
             result = yield from self._result(cmd.id)
             if result.accepted:
                 break
+            if not refused:
+                self._event(Level.WARNING, f"arming refused: {result.detail}; retrying")
+            refused += 1
             if self.now_ms() - start_ms > p.arm_wait_s * 1000.0:
                 raise _End(
                     Status.ABORTED, f"arming refused for {p.arm_wait_s:.0f} s: {result.detail}"
