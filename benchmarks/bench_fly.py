@@ -42,8 +42,10 @@ def main() -> None:
     print(f"  recorded:   median {rec:6.2f} s  (runs {', '.join(f'{t:.2f}' for t in recorded)})")
     print(f"  --no-record median {nor:6.2f} s  (runs {', '.join(f'{t:.2f}' for t in bare)})")
     print(f"  goal < 20 s: {'met' if rec < 20 else 'NOT met'}")
-    print(f"  recording overhead: {rec / nor:.3f}x of --no-record ({(rec / nor - 1) * 100:+.1f} %), "
-          f"goal <= 10 %: {'met' if rec / nor <= 1.10 else 'NOT met'}; file {size / 1e6:.2f} MB")
+    print(
+        f"  recording overhead: {rec / nor:.3f}x of --no-record ({(rec / nor - 1) * 100:+.1f} %), "
+        f"goal <= 10 %: {'met' if rec / nor <= 1.10 else 'NOT met'}; file {size / 1e6:.2f} MB"
+    )
 
 
 if __name__ == "__main__":
