@@ -23,6 +23,7 @@ class Syncer:
         self._requested = 0  # requests made so far
         self._synced = 0  # requests covered by a finished fsync
         self._stopping = False
+        self._ended = False  # the thread has returned (or died)
         self.failure: OSError | None = None  # set once, by the thread
         self._thread = threading.Thread(target=self._run, name=f"fsync {name}", daemon=True)
         self._thread.start()
@@ -37,7 +38,7 @@ class Syncer:
         """Block until every request made before this call is on disk or an fsync failed."""
         with self._cond:
             target = self._requested
-            while self._synced < target and self.failure is None and self._thread.is_alive():
+            while self._synced < target and self.failure is None and not self._ended:
                 self._cond.wait()
 
     def stop(self) -> None:
@@ -48,6 +49,14 @@ class Syncer:
         self._thread.join()
 
     def _run(self) -> None:
+        try:
+            self._serve()
+        finally:  # whatever ends the thread, nobody may keep waiting for it
+            with self._cond:
+                self._ended = True
+                self._cond.notify_all()
+
+    def _serve(self) -> None:
         while True:
             with self._cond:
                 while self._synced == self._requested and not self._stopping:
