@@ -26,6 +26,7 @@ _COMMANDS: tuple[tuple[str, str], ...] = (
     ("uavtool.cli.recording", "import_"),
     ("uavtool.cli.scene", "scene"),
     ("uavtool.cli.vision", "vision"),
+    ("uavtool.cli.view", "view"),
 )
 
 

@@ -1,0 +1,83 @@
+"""``uavtool view``: show a recording in Rerun (native viewer, web viewer or a .rrd file)."""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from pathlib import Path
+
+import click
+
+from uavtool.errors import InputError
+
+
+@click.command()
+@click.argument("recording", type=click.Path(path_type=Path))
+@click.option(
+    "--save",
+    type=click.Path(path_type=Path),
+    default=None,
+    metavar="OUT.rrd",
+    help="Write a Rerun file instead of opening a viewer (headless).",
+)
+@click.option("--web", is_flag=True, help="Serve the web viewer on localhost and print its URL.")
+@click.option(
+    "--compare",
+    type=click.Path(path_type=Path),
+    default=None,
+    metavar="OTHER.mcap",
+    help="A second recording (e.g. a replay) to show beside the first.",
+)
+@click.option("--port", default=9090, show_default=True, type=int, help="Web viewer port (--web).")
+@click.option(
+    "--grpc-port", default=9876, show_default=True, type=int, help="Data server port (--web)."
+)
+def view(
+    recording: Path,
+    save: Path | None,
+    web: bool,
+    compare: Path | None,
+    port: int,
+    grpc_port: int,
+) -> None:
+    """Show RECORDING (an MCAP file from `uavtool fly`) in Rerun: the scene, the route with
+    the photo positions, each frame with its vectors, points of interest, scores,
+    telemetry, the built model next to the true building, and the text log.
+
+    \b
+    Examples:
+      uavtool view recordings/paper.mcap                 # native viewer
+      uavtool view recordings/paper.mcap --web           # open the printed URL
+      uavtool view recordings/paper.mcap --save paper.rrd
+      uavtool view paper.mcap --compare paper-replay.mcap
+    """
+    from uavtool.view import view as show
+
+    if save is not None and web:
+        raise click.UsageError("--save and --web exclude each other")
+    if save is None and not web and sys.platform.startswith("linux"):
+        if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+            raise InputError("no display for the native viewer: use --web or --save OUT.rrd")
+    result = show(
+        recording, save=save, web=web, compare=compare, web_port=port, grpc_port=grpc_port
+    )
+    c = result.counts
+    summary = (
+        f"{c.frames} frames, {c.telemetry} telemetry samples, {c.shapes} shapes, "
+        f"{c.recognitions} recognitions, {c.models} model"
+    )
+    if save is not None:
+        click.echo(f"wrote {save}: {summary}")
+        return
+    if not web:
+        click.echo(f"sent to the Rerun viewer: {summary}")
+        result.viewer.close()
+        return
+    click.echo(f"web viewer: {result.url}")
+    click.echo(f"({summary}; Ctrl-C to stop)")
+    try:
+        while True:
+            time.sleep(3600)
+    finally:
+        result.viewer.close()

@@ -1,0 +1,9 @@
+"""Errors of the viewer: a recording it cannot show, a viewer it cannot start."""
+
+from __future__ import annotations
+
+from uavtool.errors import InputError
+
+
+class ViewError(InputError):
+    """A recording holds no mission to show, or the viewer cannot be served as asked."""

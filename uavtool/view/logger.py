@@ -1,0 +1,347 @@
+"""`MissionLogger`: turns a mission's observations and outputs into Rerun entities.
+
+It takes the same JSON dictionaries the recording holds on ``/mission/observations`` and
+``/mission/outputs``, so `uavtool view` (reading a recording) and `uavtool fly --rerun`
+(logging while flying) go through this one class. Outputs carry no vehicle time: they are
+logged at the time of the latest observation, the one that produced them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import rerun as rr
+
+from uavtool.camera import CameraPose, Intrinsics
+from uavtool.geo import GeoPoint
+from uavtool.view import entities as ent
+from uavtool.view.paths import Paths
+from uavtool.view.telemetry import Sample, TelemetryLog, log_series_styles, set_times
+from uavtool.world import Scene
+
+_EVENT_LEVELS = {"info": "INFO", "warning": "WARN", "error": "ERROR"}
+_COMMANDS = ("SetMode", "Arm", "Takeoff", "GoTo", "SetGimbal", "TakePhoto", "Land", "Rtl")
+_MODEL_GAP_M = 4.0  # space between the true building and the model shown beside it
+_POI_ABOVE_M = 2.0  # points of interest float this far above the tallest building
+
+
+@dataclass(frozen=True, slots=True)
+class LogCounts:
+    """What a logger has logged so far."""
+
+    frames: int
+    shapes: int
+    telemetry: int
+    route_points: int
+    pois: int
+    recognitions: int
+    models: int
+    texts: int
+
+
+def statustext_level(severity: int) -> str:
+    """Rerun's text-log level for a MAVLink ``MAV_SEVERITY`` (0 emergency … 7 debug)."""
+    if severity <= 2:
+        return "CRITICAL"
+    return {3: "ERROR", 4: "WARN", 5: "INFO", 6: "INFO"}.get(severity, "DEBUG")
+
+
+class MissionLogger:
+    """Logs one mission into ``rec`` under ``prefix``; ``batch`` telemetry samples per send
+    (small when live, so the viewer keeps up; large when converting a file)."""
+
+    def __init__(self, rec: rr.RecordingStream, *, prefix: str = "", batch: int = 10) -> None:
+        self.rec = rec
+        self.paths = Paths(prefix)
+        self.batch = batch
+        self.telemetry = TelemetryLog(rec, self.paths)
+        self.threshold: float | None = None
+        self._vehicle_ns: int | None = None
+        self._frame = -2  # frame index of the photo shown now (−1 is the target picture)
+        self._shapes: dict[int, list[Mapping[str, Any]]] = {}
+        self._photo_pos: list[tuple[float, float, float]] = []
+        self._photo_tags: list[str] = []
+        self._pois: list[Mapping[str, Any]] = []
+        self._scores: dict[int, float] = {}
+        self._matched: int | None = None
+        self._poi_height_m = 10.0
+        self._mode: tuple[str, bool] | None = None
+        self._n = {"frames": 0, "shapes": 0, "recognitions": 0, "models": 0, "texts": 0}
+        ent.log_world(rec, self.paths)
+        log_series_styles(rec, self.paths)
+
+    # --- set-up --------------------------------------------------------------------------------
+
+    def scene(self, scene: Scene) -> None:
+        """The ground truth: buildings (static meshes) and the height to draw POIs at."""
+        ent.log_scene(self.rec, self.paths, scene=scene)
+        tops = [blk.top_m for b in scene.buildings for blk in b.blocks]
+        self._poi_height_m = max(tops, default=8.0) + _POI_ABOVE_M
+
+    def home(self, home: GeoPoint) -> None:
+        """The vehicle's home: from now on positions also go on the map."""
+        self.telemetry.home = home
+
+    def params(self, params: Mapping[str, Any]) -> None:
+        """The mission parameters (as recorded): the recognition threshold is plotted."""
+        value = params.get("recognize", {}).get("threshold")
+        self.threshold = float(value) if isinstance(value, int | float) else None
+
+    def target(self, png: bytes) -> None:
+        ent.log_target(self.rec, self.paths, png=png)
+
+    # --- the mission's stream --------------------------------------------------------------------
+
+    def observation(
+        self,
+        step: int,
+        obs: Mapping[str, Any],
+        image_png: bytes | None = None,
+        *,
+        log_time_ns: int | None = None,
+    ) -> None:
+        """One observation as recorded (``Telemetry``, ``Photo`` with its PNG, …)."""
+        del step  # kept in the signature: the same call as the recorder's
+        ms = obs.get("time_boot_ms")
+        if isinstance(ms, int) and ms > 0:
+            self._vehicle_ns = ms * 1_000_000
+        kind = obs.get("type")
+        if kind == "Telemetry":
+            self._telemetry(obs, log_time_ns)
+            return
+        set_times(self.rec, vehicle_ns=self._vehicle_ns, log_ns=log_time_ns)
+        if kind == "Photo":
+            self._photo(obs, image_png)
+        elif kind == "CommandResult" and not obs.get("accepted", True):
+            self._text(
+                "commands", f"action {obs.get('action_id')}: {obs.get('detail', 'refused')}", "WARN"
+            )
+        elif kind == "LinkLost":
+            self._text("runner", "link lost", "WARN")
+        elif kind == "LinkRestored":
+            self._text("runner", "link restored", "INFO")
+
+    def output(self, n: int, out: Mapping[str, Any], *, log_time_ns: int | None = None) -> None:
+        """One output as recorded (commands, ``Event``, ``Shapes``, ``Plan`` …)."""
+        del n
+        set_times(self.rec, vehicle_ns=self._vehicle_ns, log_ns=log_time_ns)
+        kind = str(out.get("type"))
+        handler = _OUTPUT_HANDLERS.get(kind)
+        if handler is not None:
+            handler(self, out)
+        elif kind in _COMMANDS:
+            self._text("commands", _command_text(out), "DEBUG")
+
+    def statustext(self, severity: int, text: str, *, log_time_ns: int | None = None) -> None:
+        """A MAVLink STATUSTEXT from the vehicle."""
+        set_times(self.rec, vehicle_ns=self._vehicle_ns, log_ns=log_time_ns)
+        self._text("vehicle", text, statustext_level(severity))
+
+    def note(
+        self, level: str, text: str, *, source: str = "runner", log_time_ns: int | None = None
+    ) -> None:
+        """A line from the runner (``level`` info/warning/error)."""
+        set_times(self.rec, vehicle_ns=self._vehicle_ns, log_ns=log_time_ns)
+        self._text(source, text, _EVENT_LEVELS.get(level, "INFO"))
+
+    def flush(self) -> None:
+        """Send buffered telemetry."""
+        self.telemetry.flush()
+
+    @property
+    def counts(self) -> LogCounts:
+        return LogCounts(
+            frames=self._n["frames"],
+            shapes=self._n["shapes"],
+            telemetry=self.telemetry.samples,
+            route_points=self.telemetry.route_points,
+            pois=len(self._pois),
+            recognitions=self._n["recognitions"],
+            models=self._n["models"],
+            texts=self._n["texts"],
+        )
+
+    # --- observations ----------------------------------------------------------------------------
+
+    def _telemetry(self, obs: Mapping[str, Any], log_time_ns: int | None) -> None:
+        if self._vehicle_ns is None:
+            return  # no vehicle time yet: nothing to put it on
+        self.telemetry.add(
+            Sample(
+                vehicle_ns=self._vehicle_ns,
+                log_ns=log_time_ns,
+                pos_enu_m=_vec3(obs.get("pos_enu_m")),
+                vel_enu_m_s=_vec3(obs.get("vel_enu_m_s")),
+                heading_deg=float(obs.get("heading_deg") or 0.0),
+                gimbal_pitch_deg=float(obs.get("gimbal_pitch_deg") or 0.0),
+                battery_pct=float(obs.get("battery_pct") or 0.0),
+            )
+        )
+        mode = (str(obs.get("mode")), bool(obs.get("armed")))
+        if mode != self._mode:
+            set_times(self.rec, vehicle_ns=self._vehicle_ns, log_ns=log_time_ns)
+            self._text("vehicle", f"mode {mode[0]}, {'armed' if mode[1] else 'disarmed'}", "INFO")
+            self._mode = mode
+        if self.telemetry.pending >= self.batch:
+            self.telemetry.flush()
+
+    def _photo(self, obs: Mapping[str, Any], png: bytes | None) -> None:
+        pose_d, intr_d = obs.get("pose") or {}, obs.get("intrinsics") or {}
+        pose = CameraPose(
+            _vec3(pose_d.get("pos_enu_m")), float(pose_d["heading_deg"]), float(pose_d["pitch_deg"])
+        )
+        intrinsics = Intrinsics(
+            int(intr_d["width_px"]),
+            int(intr_d["height_px"]),
+            float(intr_d["fx_px"]),
+            float(intr_d["fy_px"]),
+            float(intr_d["cx_px"]),
+            float(intr_d["cy_px"]),
+        )
+        ent.log_photo(self.rec, self.paths, pose=pose, intrinsics=intrinsics, png=png)
+        self._frame = int(obs.get("frame_index", self._n["frames"]))
+        self._n["frames"] += 1
+        self._photo_pos.append(pose.pos_enu_m)
+        self._photo_tags.append(str(obs.get("tag", "")))
+        ent.log_photo_positions(
+            self.rec, self.paths, positions_enu_m=self._photo_pos, tags=self._photo_tags
+        )
+
+    # --- outputs ---------------------------------------------------------------------------------
+
+    def _event(self, out: Mapping[str, Any]) -> None:
+        self._text(
+            "mission", str(out.get("text", "")), _EVENT_LEVELS.get(str(out.get("level")), "INFO")
+        )
+
+    def _shapes_out(self, out: Mapping[str, Any]) -> None:
+        frame = int(out.get("frame_index", -1))
+        shapes = list(out.get("shapes") or [])
+        self._shapes[frame] = shapes
+        self._n["shapes"] += len(shapes)
+        if frame == -1:  # the target picture: static, like the picture itself
+            ent.log_shapes(self.rec, self.paths.target_shapes, shapes=shapes, static=True)
+        elif frame == self._frame:
+            ent.log_shapes(self.rec, self.paths.shapes, shapes=shapes)
+
+    def _plan(self, out: Mapping[str, Any]) -> None:
+        self._pois = list(out.get("pois") or [])
+        self._log_pois()
+        frame = int(out.get("frame_index", -1))
+        shapes = self._shapes.get(frame, [])
+        if frame != self._frame:
+            return
+        marks = [
+            (p, shapes[int(p["shape_index"])])
+            for p in self._pois
+            if 0 <= int(p["shape_index"]) < len(shapes)
+        ]
+        ent.log_image_pois(
+            self.rec,
+            self.paths,
+            centroids_px=[s["centroid_px"] for _, s in marks],
+            labels=[f"poi {p['index']}" for p, _ in marks],
+        )
+
+    def _recognition(self, out: Mapping[str, Any]) -> None:
+        poi, score, matched = (
+            int(out.get("poi", -1)),
+            float(out.get("score", 0.0)),
+            bool(out.get("matched")),
+        )
+        self._n["recognitions"] += 1
+        self._scores[poi] = score
+        if matched:
+            self._matched = poi
+        ent.log_scalar(self.rec, self.paths.recognition_poi(poi), value=score)
+        if self.threshold is not None:
+            ent.log_scalar(self.rec, self.paths.threshold, value=self.threshold)
+        self._log_pois()
+        frame, candidate = int(out.get("frame_index", -1)), out.get("candidate")
+        shapes = self._shapes.get(frame, [])
+        if frame == self._frame and isinstance(candidate, int) and 0 <= candidate < len(shapes):
+            label = f"{'MATCH' if matched else 'best'} {score:.2f}"
+            ent.log_match(
+                self.rec, self.paths, shape=shapes[candidate], label=label, matched=matched
+            )
+
+    def _viewpoints(self, out: Mapping[str, Any]) -> None:
+        views = [out[k] for k in ("top", "front", "right") if isinstance(out.get(k), Mapping)]
+        ent.log_viewpoints(
+            self.rec, self.paths, footprint_en_m=out.get("footprint_en_m") or [], viewpoints=views
+        )
+        for v in views:
+            if "pos_enu_m" not in v:
+                self._text(
+                    "mission", f"viewpoint {v.get('name')}: {v.get('reason', 'failed')}", "WARN"
+                )
+
+    def _model(self, out: Mapping[str, Any]) -> None:
+        verts: Sequence[Sequence[float]] = out.get("vertices_m") or []
+        xs = [float(v[0]) for v in verts]
+        offset = ((max(xs) - min(xs) + _MODEL_GAP_M) if xs else 0.0, 0.0, 0.0)
+        height_m, volume_m3 = float(out.get("height_m", 0.0)), float(out.get("volume_m3", 0.0))
+        label = f"model: {height_m:.1f} m high, {volume_m3:.0f} m³"
+        ent.log_model(
+            self.rec,
+            self.paths,
+            vertices_m=verts,
+            faces=out.get("faces") or [],
+            offset_enu_m=offset,
+            label=label,
+        )
+        self._n["models"] += 1
+
+    def _outcome(self, out: Mapping[str, Any]) -> None:
+        level = "INFO" if out.get("status") in ("completed", "no-match") else "ERROR"
+        self._text("mission", f"outcome: {out.get('status')}: {out.get('reason')}", level)
+
+    # --- helpers ---------------------------------------------------------------------------------
+
+    def _log_pois(self) -> None:
+        if not self._pois:
+            return
+        labels = []
+        for p in self._pois:
+            i = int(p["index"])
+            label = f"{i}"
+            if i in self._scores:
+                label += f": {'MATCH ' if i == self._matched else ''}{self._scores[i]:.2f}"
+            labels.append(label)
+        ent.log_pois(
+            self.rec,
+            self.paths,
+            positions_en_m=[p["pos_en_m"] for p in self._pois],
+            labels=labels,
+            colours_rgb=[p.get("colour_rgb") or (200, 200, 200) for p in self._pois],
+            matched=[int(p["index"]) == self._matched for p in self._pois],
+            height_m=self._poi_height_m,
+        )
+
+    def _text(self, source: str, text: str, level: str) -> None:
+        ent.log_text(self.rec, self.paths.log_source(source), text=text, level=level)
+        self._n["texts"] += 1
+
+
+_OUTPUT_HANDLERS = {
+    "Event": MissionLogger._event,
+    "Shapes": MissionLogger._shapes_out,
+    "Plan": MissionLogger._plan,
+    "Recognition": MissionLogger._recognition,
+    "Viewpoints": MissionLogger._viewpoints,
+    "ModelBuilt": MissionLogger._model,
+    "Outcome": MissionLogger._outcome,
+}
+
+
+def _vec3(value: object) -> tuple[float, float, float]:
+    if isinstance(value, Sequence) and len(value) >= 3:
+        return (float(value[0]), float(value[1]), float(value[2]))
+    return (0.0, 0.0, 0.0)
+
+
+def _command_text(out: Mapping[str, Any]) -> str:
+    fields = ", ".join(f"{k}={v}" for k, v in out.items() if k not in ("type", "n", "step"))
+    return f"{out.get('type')} {fields}"

@@ -1,0 +1,97 @@
+"""Feed a recording into a `MissionLogger`, in the order it was written.
+
+The mission's own streams (``/mission/observations``, ``/mission/outputs``) drive the
+logger exactly as the live runner does; the frames come from ``/camera/image`` (the k-th
+image is frame k, written just before its ``Photo``), vehicle text from STATUSTEXT, the
+home from HOME_POSITION, and the ground truth from the ``scene`` metadata.
+"""
+
+from __future__ import annotations
+
+import json
+from collections import deque
+from pathlib import Path
+
+from uavtool.geo import GeoPoint
+from uavtool.recording import CompressedImage, JsonDocument, LogEntry, RecordingReader
+from uavtool.view.errors import ViewError
+from uavtool.view.logger import MissionLogger
+from uavtool.world import SceneError, scene_from_dict
+
+OBSERVATIONS = "/mission/observations"
+OUTPUTS = "/mission/outputs"
+IMAGE = "/camera/image"
+TARGET = "/mission/target"
+EVENTS = "/mission/events"
+STATUSTEXT = "/mavlink/in/STATUSTEXT"
+HOME_POSITION = "/mavlink/in/HOME_POSITION"
+_LEVEL_NAMES = {1: "debug", 2: "info", 3: "warning", 4: "error", 5: "error"}
+
+
+def log_recording(path: str | Path, logger: MissionLogger) -> None:
+    """Log everything ``path`` holds through ``logger``. Raises `NotMcapError` if it is not
+    a recording, `ViewError` if it holds no mission."""
+    with RecordingReader(path) as reader:
+        present = set(reader.topics())
+        if OBSERVATIONS not in present:
+            raise ViewError(f"{path}: no {OBSERVATIONS} topic: not a mission recording")
+        metadata = dict(reader.metadata)
+        _setup(path, reader, metadata, logger)
+        wanted = [t for t in (OBSERVATIONS, OUTPUTS, IMAGE, EVENTS, STATUSTEXT) if t in present]
+        images: deque[bytes] = deque()
+        for entry in reader.entries(wanted):
+            value, t_ns = entry.value, entry.log_time_ns
+            if entry.topic == IMAGE and isinstance(value, CompressedImage):
+                images.append(value.data)
+            elif isinstance(value, JsonDocument) and entry.topic == OBSERVATIONS:
+                obs = value.payload
+                png = images.popleft() if obs.get("type") == "Photo" and images else None
+                logger.observation(int(obs.get("step", 0)), obs, png, log_time_ns=t_ns)
+            elif isinstance(value, JsonDocument) and entry.topic == OUTPUTS:
+                out = value.payload
+                logger.output(int(out.get("n", 0)), out, log_time_ns=t_ns)
+            elif isinstance(value, JsonDocument) and entry.topic == STATUSTEXT:
+                msg = value.payload
+                logger.statustext(
+                    int(msg.get("severity", 6)), str(msg.get("text", "")), log_time_ns=t_ns
+                )
+            elif isinstance(value, LogEntry) and value.name == "runner":
+                # The mission's own events come from /mission/outputs and the vehicle's
+                # from STATUSTEXT; this topic repeats both, so only the runner's are new.
+                level = _LEVEL_NAMES.get(int(value.level), "info")
+                logger.note(level, value.message, source="runner", log_time_ns=t_ns)
+    logger.flush()
+
+
+def _setup(
+    path: str | Path,
+    reader: RecordingReader,
+    metadata: dict[str, dict[str, str]],
+    logger: MissionLogger,
+) -> None:
+    scene_json = metadata.get("scene", {}).get("json")
+    if scene_json:
+        try:
+            logger.scene(scene_from_dict(json.loads(scene_json), source=f"{path}: scene metadata"))
+        except (ValueError, SceneError) as exc:
+            raise ViewError(f"{path}: scene metadata unreadable: {exc}") from None
+    params_json = metadata.get("mission", {}).get("params")
+    if params_json:
+        try:
+            logger.params(json.loads(params_json))
+        except ValueError:
+            raise ViewError(f"{path}: mission metadata: params are not JSON") from None
+    topics = set(reader.topics())
+    if TARGET in topics:
+        for entry in reader.entries([TARGET]):
+            if isinstance(entry.value, CompressedImage):
+                logger.target(entry.value.data)
+            break
+    if HOME_POSITION in topics:
+        for entry in reader.entries([HOME_POSITION]):
+            if isinstance(entry.value, JsonDocument):
+                msg = entry.value.payload
+                logger.home(
+                    GeoPoint(msg["latitude"] / 1e7, msg["longitude"] / 1e7, msg["altitude"] / 1e3)
+                )
+            break
