@@ -5,7 +5,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from uavtool.vision.rdp import rdp, rdp_indices, rdp_ring, rdp_ring_indices
+from uavtool.vision.rdp import rdp, rdp_indices, rdp_ring, rdp_ring_indices, rdp_rings_indices
 
 coords = st.floats(min_value=-500, max_value=500, allow_nan=False, allow_infinity=False)
 
@@ -54,6 +54,23 @@ def test_rdp_ring_keeps_a_subset_within_epsilon(pts: np.ndarray, eps: float) -> 
         span = range(i, j + 1) if j > i else [*range(i, len(pts)), *range(j + 1)]
         for q in span:
             assert _dist_to_segment(pts[q], pts[i], pts[j]) <= eps + 1e-9
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    rings=st.lists(
+        arrays(np.float64, st.tuples(st.integers(1, 40), st.just(2)), elements=coords),
+        max_size=6,
+    ),
+    eps=st.floats(0.0, 20.0),
+)
+def test_rings_simplified_together_are_simplified_as_alone(
+    rings: list[np.ndarray], eps: float
+) -> None:
+    together = rdp_rings_indices(rings, eps)
+    assert len(together) == len(rings)
+    for ring, kept in zip(rings, together, strict=True):
+        assert np.array_equal(kept, rdp_ring_indices(ring, eps))
 
 
 def test_rdp_ring_reduces_a_dense_square_to_its_corners() -> None:

@@ -4,7 +4,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from uavtool.vision import RecognizeParams, Shape, match, match_shapes, vectorize
+from uavtool.vision import RecognizeParams, Shape, best_match, match, match_shapes, vectorize
 
 from .synth import FAMILIES, draw, family_shape, place
 
@@ -105,3 +105,21 @@ def test_scores_are_bit_identical_across_runs() -> None:
     a = family_shape("T", 0.7, 0.35)
     b = place(family_shape("T", 0.75, 0.4), angle_deg=33.0, size_px=2.0, centre=(1, 2))
     assert match(a, b).score == match(a.copy(), b.copy()).score
+
+
+def test_a_shape_cut_by_the_border_is_not_judged() -> None:
+    rect = family_shape("rect", 0.6, 0.3)
+    reference = _vectorized(place(rect, angle_deg=0, size_px=200, centre=(250, 250)), 500)
+    # The same rectangle pushed past the left border (its outline is mostly still there),
+    # and an L, complete, at the other side of the frame.
+    cut = place(rect, angle_deg=0, size_px=200, centre=(95, 240))
+    ell = place(family_shape("L", 0.8, 0.4), angle_deg=20, size_px=200, centre=(460, 240))
+    shapes = vectorize(draw([(cut, RED), (ell, (40, 60, 210))]))
+    assert sorted(s.cut_by_border for s in shapes) == [False, True]
+    c = next(i for i, s in enumerate(shapes) if s.cut_by_border)
+    best, matches = best_match(reference, shapes)
+    assert not matches[c].judgeable
+    assert matches[1 - c].judgeable
+    assert matches[c].score > matches[1 - c].score  # scored, but a cut outline proves nothing
+    assert best == 1 - c
+    assert best_match(reference, shapes[c : c + 1]) == (-1, matches[c : c + 1])

@@ -65,6 +65,21 @@ def test_flags_shapes_cut_by_the_border_and_drops_tiny_blobs() -> None:
     assert shapes[0].cut_by_border
 
 
+@pytest.mark.parametrize(("family", "corners"), [("L", 6), ("T", 8), ("U", 8)])
+def test_edges_a_few_degrees_off_the_pixel_grid_give_no_extra_corners(
+    family: str, corners: int
+) -> None:
+    # A slanted edge rasterises as long straight runs; RDP may keep a vertex where one run
+    # ends near a corner, leaving a short edge a few degrees off the real one.
+    for angle in (2.3, 2.9, 3.2, 3.5, 3.8, 4.1):
+        for size in (260, 330):
+            poly = place(
+                family_shape(family, 0.7, 0.35), angle_deg=angle, size_px=size, centre=(320, 240)
+            )
+            shapes = vectorize(draw([(poly, BLUE)], shade=False))
+            assert [len(s.polygon_px) for s in shapes] == [corners], (angle, size)
+
+
 def test_palette_extracts_only_the_listed_colour() -> None:
     shapes = vectorize(_scene(noise=5.0), VectorizeParams(palette_rgb=(RED,)))
     assert len(shapes) == 1
@@ -82,3 +97,5 @@ def test_bad_input_raises_one_line_errors() -> None:
         VectorizeParams(rdp_epsilon_px=-1.0)
     with pytest.raises(VisionParamError, match="denoise_px"):
         VectorizeParams(denoise_px=4)
+    with pytest.raises(VisionParamError, match="straight_tolerance_px"):
+        VectorizeParams(straight_tolerance_px=-0.5)

@@ -44,6 +44,8 @@ class Match:
     ``pairs`` lists matched corner groups: reference corner indices with the candidate
     corner indices they stand for. ``rotation_deg`` turns the reference into the candidate
     (clockwise on screen, y down); ``scale`` is candidate perimeter over reference perimeter.
+    ``judgeable`` is False when either outline is cut by its image border: part of the
+    shape is missing, so the score says nothing either way (it is still computed).
     """
 
     score: float
@@ -52,6 +54,7 @@ class Match:
     rotation_deg: float
     scale: float
     mirrored: bool
+    judgeable: bool = True
 
 
 NO_MATCH = Match(0.0, math.inf, (), 0.0, 0.0, False)

@@ -18,13 +18,20 @@ from uavtool.vision.shapes import FloatArray
 
 # Consecutive lines closer to parallel than this (sine of the angle) do not make a corner.
 _MIN_SINE = 0.05
+# Lines further apart than this (sine, ~15°) always make a corner.
+_MAX_MERGE_SINE = 0.25
 
 Line = tuple[float, float, float, float]  # centre x, y and unit direction x, y
 Span = tuple[int, int]  # first and last dense index of an edge (cyclic)
 
 
 def refine_corners(
-    dense_px: FloatArray, kept: list[int], *, min_edge_px: float, max_shift_px: float
+    dense_px: FloatArray,
+    kept: list[int],
+    *,
+    min_edge_px: float,
+    max_shift_px: float,
+    straight_tolerance_px: float = 0.0,
 ) -> FloatArray:
     """Corners ``(m, 2)`` of a ring whose RDP vertices are ``dense_px[kept]``.
 
@@ -33,11 +40,22 @@ def refine_corners(
     refined corner further than ``max_shift_px`` from the RDP vertex it replaces (nearly
     parallel edges) falls back to that vertex.
     """
-    return refine_rings([dense_px], [kept], min_edge_px=min_edge_px, max_shift_px=max_shift_px)[0]
+    return refine_rings(
+        [dense_px],
+        [kept],
+        min_edge_px=min_edge_px,
+        max_shift_px=max_shift_px,
+        straight_tolerance_px=straight_tolerance_px,
+    )[0]
 
 
 def refine_rings(
-    dense_px: list[FloatArray], kept: list[list[int]], *, min_edge_px: float, max_shift_px: float
+    dense_px: list[FloatArray],
+    kept: list[list[int]],
+    *,
+    min_edge_px: float,
+    max_shift_px: float,
+    straight_tolerance_px: float = 0.0,
 ) -> list[FloatArray]:
     """:func:`refine_corners` of several rings at once (the line fits share array calls)."""
     # The RDP vertices as Python floats, by dense index: every span starts and ends at one.
@@ -53,7 +71,9 @@ def refine_rings(
     for r, dense in enumerate(dense_px):
         corners = None
         if len(kept[r]) >= 3:
-            corners = _corners(dense, vertices[r], spans[r], lines[r], max_shift_px)
+            corners = _corners(
+                dense, vertices[r], spans[r], lines[r], max_shift_px, straight_tolerance_px
+            )
         out.append(dense[kept[r]].copy() if corners is None else corners)
     return out
 
@@ -80,6 +100,7 @@ def _corners(
     spans: list[Span],
     lines: list[Line],
     max_shift_px: float,
+    tol_px: float,
 ) -> FloatArray | None:
     """Intersections of consecutive fitted lines (None: too few lines for a polygon)."""
     # Merge neighbouring edges that are one straight line (a vertex RDP kept for a rounded
@@ -87,10 +108,10 @@ def _corners(
     k = 0
     while len(lines) > 3 and k < len(lines):
         j = (k + 1) % len(lines)
-        (_, _, dx1, dy1), (_, _, dx2, dy2) = lines[k], lines[j]
-        if abs(dx1 * dy2 - dy1 * dx2) < _MIN_SINE and dx1 * dx2 + dy1 * dy2 > 0.0:
+        merged = _one_line(dense, vertices, (spans[k][0], spans[j][1]), lines[k], lines[j], tol_px)
+        if merged is not None:
             spans[k] = (spans[k][0], spans[j][1])
-            lines[k] = _fit_span(dense, spans[k], vertices)
+            lines[k] = merged
             del spans[j], lines[j]
             k = max(k - 1, 0) if j > k else k - 1
             continue
@@ -172,14 +193,54 @@ def _fit_spans(
     return out
 
 
-def _fit_span(dense: FloatArray, span: Span, vertices: dict[int, list[float]]) -> Line:
-    """:func:`_fit_spans` of one span (the same arithmetic, without the batching)."""
+def _one_line(
+    dense: FloatArray,
+    vertices: dict[int, list[float]],
+    span: Span,
+    line1: Line,
+    line2: Line,
+    tol_px: float,
+) -> Line | None:
+    """The line of two neighbouring edges that are one straight edge, else None.
+
+    They are when their directions are within ~3° — or, up to ~15° apart, when every point
+    of the two lies within ``tol_px`` of one line fitted to both: a short edge's direction
+    is only known to about a pixel over its length, so a stretch of a slanted edge that
+    rasterised as one straight run can look a few degrees off.
+    """
+    _, _, dx1, dy1 = line1
+    _, _, dx2, dy2 = line2
+    sine = abs(dx1 * dy2 - dy1 * dx2)
+    if dx1 * dx2 + dy1 * dy2 <= 0.0 or sine >= _MAX_MERGE_SINE:
+        return None
+    if sine < _MIN_SINE:
+        return _fit_span(dense, span, vertices)
+    if tol_px <= 0.0:
+        return None
+    line = _fit_span(dense, span, vertices)
+    cx, cy, ux, uy = line
+    pts = _span_points(dense, span)
+    off = np.abs((pts[:, 0] - cx) * uy - (pts[:, 1] - cy) * ux)
+    return line if float(off.max()) <= tol_px else None
+
+
+def _span_points(dense: FloatArray, span: Span) -> FloatArray:
+    """The dense points a line is fitted to: the span without its end points when long."""
     n = len(dense)
     first, last = span
     count = (last - first) % n + 1
     trim = 1 if count >= 6 else 0
     i0, k = first + trim, count - 2 * trim
-    pts = dense[i0 : i0 + k] if i0 + k <= n else np.concatenate([dense[i0:], dense[: i0 + k - n]])
+    if i0 + k <= n:
+        return dense[i0 : i0 + k]
+    return np.concatenate([dense[i0:], dense[: i0 + k - n]])
+
+
+def _fit_span(dense: FloatArray, span: Span, vertices: dict[int, list[float]]) -> Line:
+    """:func:`_fit_spans` of one span (the same arithmetic, without the batching)."""
+    first, last = span
+    pts = _span_points(dense, span)
+    k = len(pts)
     px, py = pts[:, 0], pts[:, 1]
     cx, cy = math.fsum(px.tolist()) / k, math.fsum(py.tolist()) / k
     dx, dy = px - cx, py - cy

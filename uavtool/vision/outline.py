@@ -34,6 +34,7 @@ def simplify_rings(contours_px: list[npt.NDArray[Any]], p: VectorizeParams) -> l
         [k.tolist() for k in kept],
         min_edge_px=p.min_edge_px,
         max_shift_px=p.min_edge_px + p.point_spacing_px + p.rdp_epsilon_px,
+        straight_tolerance_px=p.straight_tolerance_px,
     )
 
 

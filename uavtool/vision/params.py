@@ -51,6 +51,10 @@ class VectorizeParams:
     min_edge_px: float = 8.0
     """With ``refine_corners``, edges shorter than this are the stub of a split or rounded
     corner: they are dropped and the corner put where the neighbouring edges meet."""
+    straight_tolerance_px: float = 1.0
+    """With ``refine_corners``, two neighbouring edges up to ~15° apart whose points all lie
+    within this of one fitted line are one edge (a straight edge rasterises as runs whose
+    short pieces look a few degrees off); 0 = only edges within ~3° are joined."""
     min_area_px: float = 60.0
     """Regions (and hue clusters) smaller than this many pixels are dropped as noise."""
     min_hole_area_px: float = 30.0
@@ -61,7 +65,9 @@ class VectorizeParams:
 
     def __post_init__(self) -> None:
         _check_positive(self, "point_spacing_px", "min_area_px", "min_edge_px")
-        _check_non_negative(self, "rdp_epsilon_px", "min_hole_area_px", "edge_offset_px")
+        _check_non_negative(
+            self, "rdp_epsilon_px", "min_hole_area_px", "edge_offset_px", "straight_tolerance_px"
+        )
         if not 0.0 < self.hue_tolerance_deg <= 90.0:
             raise VisionParamError(
                 f"vision.hue_tolerance_deg must be in (0, 90], got {self.hue_tolerance_deg}"

@@ -14,6 +14,7 @@ The alignment itself is in :mod:`uavtool.vision.align`.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -43,7 +44,8 @@ def symbols(ring_px: FloatArray) -> Symbols:
 def match_shapes(
     reference: Shape, candidate: Shape, params: RecognizeParams | None = None
 ) -> Match:
-    """Match two shapes' outer outlines; differing hole counts lower the score."""
+    """Match two shapes' outer outlines; differing hole counts lower the score. The match
+    is not ``judgeable`` when either shape is cut by its image border."""
     p = params if params is not None else RecognizeParams()
     return _match_shapes(reference, symbols(reference.polygon_px), candidate, p)
 
@@ -59,26 +61,27 @@ def match(
 def best_match(
     reference: Shape, candidates: tuple[Shape, ...], params: RecognizeParams | None = None
 ) -> tuple[int, tuple[Match, ...]]:
-    """Every candidate's match against the reference and the index of the best (−1 if none)."""
+    """Every candidate's match against the reference, and the index of the best judgeable one
+    (−1 if none): a shape cut by the image border is never the best, whatever its score."""
     p = params if params is not None else RecognizeParams()
     ref = symbols(reference.polygon_px)
     matches = tuple(_match_shapes(reference, ref, c, p) for c in candidates)
-    if not matches:
+    judged = [i for i, m in enumerate(matches) if m.judgeable]
+    if not judged:
         return -1, matches
-    scores = [m.score for m in matches]
-    best = max(range(len(scores)), key=lambda i: (scores[i], -i))
-    return best, matches
+    return max(judged, key=lambda i: (matches[i].score, -i)), matches
 
 
 def _match_shapes(reference: Shape, ref: Symbols, candidate: Shape, p: RecognizeParams) -> Match:
     result = _match(ref, candidate.polygon_px, p)
     holes = abs(len(reference.holes_px) - len(candidate.holes_px))
-    if holes == 0 or result.score == 0.0:
+    score = result.score
+    if holes != 0 and score != 0.0:
+        score = max(0.0, score - p.hole_penalty * holes)
+    judgeable = not (reference.cut_by_border or candidate.cut_by_border)
+    if score == result.score and judgeable:
         return result
-    score = max(0.0, result.score - p.hole_penalty * holes)
-    return Match(
-        score, result.cost, result.pairs, result.rotation_deg, result.scale, result.mirrored
-    )
+    return replace(result, score=score, judgeable=judgeable)
 
 
 def _match(ref: Symbols, candidate_px: FloatArray, p: RecognizeParams) -> Match:
