@@ -8,7 +8,7 @@ logged at the time of the latest observation, the one that produced them.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -17,13 +17,13 @@ import rerun as rr
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.geo import GeoPoint
 from uavtool.view import entities as ent
+from uavtool.view.findings import Findings
 from uavtool.view.paths import Paths
 from uavtool.view.telemetry import Sample, TelemetryLog, log_series_styles, set_times
 from uavtool.world import Scene
 
 _EVENT_LEVELS = {"info": "INFO", "warning": "WARN", "error": "ERROR"}
 _COMMANDS = ("SetMode", "Arm", "Takeoff", "GoTo", "SetGimbal", "TakePhoto", "Land", "Rtl")
-_MODEL_GAP_M = 4.0  # space between the true building and the model shown beside it
 _POI_ABOVE_M = 2.0  # points of interest float this far above the tallest building
 
 
@@ -57,18 +57,12 @@ class MissionLogger:
         self.paths = Paths(prefix)
         self.batch = batch
         self.telemetry = TelemetryLog(rec, self.paths)
-        self.threshold: float | None = None
+        self.findings = Findings(rec, self.paths)
         self._vehicle_ns: int | None = None
-        self._frame = -2  # frame index of the photo shown now (−1 is the target picture)
-        self._shapes: dict[int, list[Mapping[str, Any]]] = {}
         self._photo_pos: list[tuple[float, float, float]] = []
         self._photo_tags: list[str] = []
-        self._pois: list[Mapping[str, Any]] = []
-        self._scores: dict[int, float] = {}
-        self._matched: int | None = None
-        self._poi_height_m = 10.0
         self._mode: tuple[str, bool] | None = None
-        self._n = {"frames": 0, "shapes": 0, "recognitions": 0, "models": 0, "texts": 0}
+        self._texts = 0
         ent.log_world(rec, self.paths)
         log_series_styles(rec, self.paths)
 
@@ -78,7 +72,7 @@ class MissionLogger:
         """The ground truth: buildings (static meshes) and the height to draw POIs at."""
         ent.log_scene(self.rec, self.paths, scene=scene)
         tops = [blk.top_m for b in scene.buildings for blk in b.blocks]
-        self._poi_height_m = max(tops, default=8.0) + _POI_ABOVE_M
+        self.findings.poi_height_m = max(tops, default=8.0) + _POI_ABOVE_M
 
     def home(self, home: GeoPoint) -> None:
         """The vehicle's home: from now on positions also go on the map."""
@@ -87,7 +81,7 @@ class MissionLogger:
     def params(self, params: Mapping[str, Any]) -> None:
         """The mission parameters (as recorded): the recognition threshold is plotted."""
         value = params.get("recognize", {}).get("threshold")
-        self.threshold = float(value) if isinstance(value, int | float) else None
+        self.findings.threshold = float(value) if isinstance(value, int | float) else None
 
     def target(self, png: bytes) -> None:
         ent.log_target(self.rec, self.paths, png=png)
@@ -152,15 +146,16 @@ class MissionLogger:
 
     @property
     def counts(self) -> LogCounts:
+        f = self.findings
         return LogCounts(
-            frames=self._n["frames"],
-            shapes=self._n["shapes"],
+            frames=len(self._photo_tags),
+            shapes=f.shape_count,
             telemetry=self.telemetry.samples,
             route_points=self.telemetry.route_points,
-            pois=len(self._pois),
-            recognitions=self._n["recognitions"],
-            models=self._n["models"],
-            texts=self._n["texts"],
+            pois=len(f.pois),
+            recognitions=f.recognitions,
+            models=f.models,
+            texts=self._texts,
         )
 
     # --- observations ----------------------------------------------------------------------------
@@ -201,8 +196,7 @@ class MissionLogger:
             float(intr_d["cy_px"]),
         )
         ent.log_photo(self.rec, self.paths, pose=pose, intrinsics=intrinsics, png=png)
-        self._frame = int(obs.get("frame_index", self._n["frames"]))
-        self._n["frames"] += 1
+        self.findings.frame = int(obs.get("frame_index", len(self._photo_tags)))
         self._photo_pos.append(pose.pos_enu_m)
         self._photo_tags.append(str(obs.get("tag", "")))
         ent.log_photo_positions(
@@ -212,87 +206,12 @@ class MissionLogger:
     # --- outputs ---------------------------------------------------------------------------------
 
     def _event(self, out: Mapping[str, Any]) -> None:
-        self._text(
-            "mission", str(out.get("text", "")), _EVENT_LEVELS.get(str(out.get("level")), "INFO")
-        )
-
-    def _shapes_out(self, out: Mapping[str, Any]) -> None:
-        frame = int(out.get("frame_index", -1))
-        shapes = list(out.get("shapes") or [])
-        self._shapes[frame] = shapes
-        self._n["shapes"] += len(shapes)
-        if frame == -1:  # the target picture: static, like the picture itself
-            ent.log_shapes(self.rec, self.paths.target_shapes, shapes=shapes, static=True)
-        elif frame == self._frame:
-            ent.log_shapes(self.rec, self.paths.shapes, shapes=shapes)
-
-    def _plan(self, out: Mapping[str, Any]) -> None:
-        self._pois = list(out.get("pois") or [])
-        self._log_pois()
-        frame = int(out.get("frame_index", -1))
-        shapes = self._shapes.get(frame, [])
-        if frame != self._frame:
-            return
-        marks = [
-            (p, shapes[int(p["shape_index"])])
-            for p in self._pois
-            if 0 <= int(p["shape_index"]) < len(shapes)
-        ]
-        ent.log_image_pois(
-            self.rec,
-            self.paths,
-            centroids_px=[s["centroid_px"] for _, s in marks],
-            labels=[f"poi {p['index']}" for p, _ in marks],
-        )
-
-    def _recognition(self, out: Mapping[str, Any]) -> None:
-        poi, score, matched = (
-            int(out.get("poi", -1)),
-            float(out.get("score", 0.0)),
-            bool(out.get("matched")),
-        )
-        self._n["recognitions"] += 1
-        self._scores[poi] = score
-        if matched:
-            self._matched = poi
-        ent.log_scalar(self.rec, self.paths.recognition_poi(poi), value=score)
-        if self.threshold is not None:
-            ent.log_scalar(self.rec, self.paths.threshold, value=self.threshold)
-        self._log_pois()
-        frame, candidate = int(out.get("frame_index", -1)), out.get("candidate")
-        shapes = self._shapes.get(frame, [])
-        if frame == self._frame and isinstance(candidate, int) and 0 <= candidate < len(shapes):
-            label = f"{'MATCH' if matched else 'best'} {score:.2f}"
-            ent.log_match(
-                self.rec, self.paths, shape=shapes[candidate], label=label, matched=matched
-            )
+        level = _EVENT_LEVELS.get(str(out.get("level")), "INFO")
+        self._text("mission", str(out.get("text", "")), level)
 
     def _viewpoints(self, out: Mapping[str, Any]) -> None:
-        views = [out[k] for k in ("top", "front", "right") if isinstance(out.get(k), Mapping)]
-        ent.log_viewpoints(
-            self.rec, self.paths, footprint_en_m=out.get("footprint_en_m") or [], viewpoints=views
-        )
-        for v in views:
-            if "pos_enu_m" not in v:
-                self._text(
-                    "mission", f"viewpoint {v.get('name')}: {v.get('reason', 'failed')}", "WARN"
-                )
-
-    def _model(self, out: Mapping[str, Any]) -> None:
-        verts: Sequence[Sequence[float]] = out.get("vertices_m") or []
-        xs = [float(v[0]) for v in verts]
-        offset = ((max(xs) - min(xs) + _MODEL_GAP_M) if xs else 0.0, 0.0, 0.0)
-        height_m, volume_m3 = float(out.get("height_m", 0.0)), float(out.get("volume_m3", 0.0))
-        label = f"model: {height_m:.1f} m high, {volume_m3:.0f} m³"
-        ent.log_model(
-            self.rec,
-            self.paths,
-            vertices_m=verts,
-            faces=out.get("faces") or [],
-            offset_enu_m=offset,
-            label=label,
-        )
-        self._n["models"] += 1
+        for problem in self.findings.viewpoints(out):
+            self._text("mission", problem, "WARN")
 
     def _outcome(self, out: Mapping[str, Any]) -> None:
         level = "INFO" if out.get("status") in ("completed", "no-match") else "ERROR"
@@ -300,38 +219,18 @@ class MissionLogger:
 
     # --- helpers ---------------------------------------------------------------------------------
 
-    def _log_pois(self) -> None:
-        if not self._pois:
-            return
-        labels = []
-        for p in self._pois:
-            i = int(p["index"])
-            label = f"{i}"
-            if i in self._scores:
-                label += f": {'MATCH ' if i == self._matched else ''}{self._scores[i]:.2f}"
-            labels.append(label)
-        ent.log_pois(
-            self.rec,
-            self.paths,
-            positions_en_m=[p["pos_en_m"] for p in self._pois],
-            labels=labels,
-            colours_rgb=[p.get("colour_rgb") or (200, 200, 200) for p in self._pois],
-            matched=[int(p["index"]) == self._matched for p in self._pois],
-            height_m=self._poi_height_m,
-        )
-
     def _text(self, source: str, text: str, level: str) -> None:
         ent.log_text(self.rec, self.paths.log_source(source), text=text, level=level)
-        self._n["texts"] += 1
+        self._texts += 1
 
 
-_OUTPUT_HANDLERS = {
+_OUTPUT_HANDLERS: dict[str, Callable[[MissionLogger, Mapping[str, Any]], None]] = {
     "Event": MissionLogger._event,
-    "Shapes": MissionLogger._shapes_out,
-    "Plan": MissionLogger._plan,
-    "Recognition": MissionLogger._recognition,
+    "Shapes": lambda self, out: self.findings.shapes(out),
+    "Plan": lambda self, out: self.findings.plan(out),
+    "Recognition": lambda self, out: self.findings.recognition(out),
     "Viewpoints": MissionLogger._viewpoints,
-    "ModelBuilt": MissionLogger._model,
+    "ModelBuilt": lambda self, out: self.findings.model(out),
     "Outcome": MissionLogger._outcome,
 }
 
