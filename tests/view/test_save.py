@@ -182,3 +182,6 @@ def test_compare_shows_a_second_recording_beside(
     spatial = {(kind, origin) for kind, _, origin in views(blueprint) if kind in ("2D", "3D")}
     assert {("3D", "world"), ("3D", "compare/world")} <= spatial
     assert {("2D", "world/camera/image"), ("2D", "compare/world/camera/image")} <= spatial
+    # both missions' telemetry on the same axes, told apart in the legend
+    (legend,) = data.column("compare/plots/telemetry/altitude_m", "SeriesLines:names")
+    assert legend == ["altitude above home (m) [compare]"]

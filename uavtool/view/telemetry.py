@@ -43,8 +43,13 @@ def set_times(rec: rr.RecordingStream, *, vehicle_ns: int | None, log_ns: int | 
 
 
 def log_series_styles(rec: rr.RecordingStream, paths: Paths) -> None:
-    """Names and colours of the telemetry plots; static."""
-    for name, (rgb, legend) in SERIES.items():
+    """Names and colours of the telemetry plots; static. A compared mission's series are
+    paler and say so in the legend, as both are drawn on the same axes."""
+    for name, (base_rgb, base_legend) in SERIES.items():
+        rgb, legend = base_rgb, base_legend
+        if paths.prefix:
+            rgb = (rgb[0] // 2 + 64, rgb[1] // 2 + 64, rgb[2] // 2 + 64)
+            legend = f"{legend} [{paths.prefix}]"
         rec.log(paths.telemetry(name), rr.SeriesLines(colors=[rgb], names=[legend]), static=True)
 
 
