@@ -4,8 +4,9 @@ Evenly spaced points rarely fall exactly on a corner, so RDP keeps a point next 
 two, one on each side (a split corner). Here every edge of the simplified ring that spans
 enough of the dense points gets a least-squares line through them; a corner becomes the
 intersection of two consecutive such lines, and edges too short to fit (the stub between
-the two halves of a split corner) disappear. Sums use ``math.fsum`` and scalars ``math``
-(numpy only for element-wise products), so the result is the same on every machine.
+the two halves of a split corner) disappear, and neighbouring edges that are one straight
+line are joined. Sums use ``math.fsum`` and scalars ``math`` (numpy only for element-wise
+products and exact maxima), so the result is the same on every machine.
 """
 
 from __future__ import annotations

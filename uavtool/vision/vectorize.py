@@ -19,7 +19,7 @@ import numpy.typing as npt
 
 from uavtool.vision.colour import brightest_shade, hue_distance_deg, hue_lut, hue_of
 from uavtool.vision.errors import ImageError
-from uavtool.vision.outline import offset_ring, resample_ring, simplify_rings
+from uavtool.vision.outline import offset_ring, simplify_rings
 from uavtool.vision.params import VectorizeParams
 from uavtool.vision.shapes import FloatArray, Shape, orient
 
@@ -27,15 +27,8 @@ U8Array = npt.NDArray[np.uint8]
 # What OpenCV returns (its stubs type every array loosely).
 CvArray = npt.NDArray[Any]
 
-__all__ = [
-    "CvArray",
-    "U8Array",
-    "hue_distance_deg",
-    "hue_of",
-    "offset_ring",
-    "resample_ring",
-    "vectorize",
-]
+# hue_of and hue_distance_deg live in uavtool.vision.colour; importable from here too.
+__all__ = ["CvArray", "U8Array", "hue_distance_deg", "hue_of", "vectorize"]
 
 
 def vectorize(frame_rgb: U8Array, params: VectorizeParams | None = None) -> tuple[Shape, ...]:
