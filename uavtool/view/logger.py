@@ -23,7 +23,6 @@ from uavtool.view.telemetry import Sample, TelemetryLog, log_series_styles, set_
 from uavtool.world import Scene
 
 _EVENT_LEVELS = {"info": "INFO", "warning": "WARN", "error": "ERROR"}
-_COMMANDS = ("SetMode", "Arm", "Takeoff", "GoTo", "SetGimbal", "TakePhoto", "Land", "Rtl")
 _POI_ABOVE_M = 2.0  # points of interest float this far above the tallest building
 
 
@@ -125,7 +124,7 @@ class MissionLogger:
         handler = _OUTPUT_HANDLERS.get(kind)
         if handler is not None:
             handler(self, out)
-        elif kind in _COMMANDS:
+        else:  # a command to the vehicle (GoTo, TakePhoto …): one line each
             self._text("commands", _command_text(out), "DEBUG")
 
     def statustext(self, severity: int, text: str, *, log_time_ns: int | None = None) -> None:
