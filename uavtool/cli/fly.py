@@ -86,6 +86,13 @@ def _pairs(values: tuple[str, ...], option: str) -> dict[str, str]:
     type=float,
     help="Seconds to wait for the vehicle to connect and report its home.",
 )
+@click.option(
+    "--rerun",
+    "rerun_target",
+    default=None,
+    metavar="spawn|web|FILE.rrd",
+    help="Stream the flight live to Rerun: the native viewer, the web viewer, or a file.",
+)
 @click.option("-q", "--quiet", is_flag=True, help="Print only the summary.")
 def fly(
     connect: str | None,
@@ -103,6 +110,7 @@ def fly(
     wind: str | None,
     outages: tuple[str, ...],
     timeout: float,
+    rerun_target: str | None,
     quiet: bool,
 ) -> None:
     """Search the scene for the target building, photograph it from three sides and build
@@ -150,6 +158,7 @@ def fly(
         link_outages_s=tuple(parse_outage(o) for o in outages),
         command_line=tuple(sys.argv),
         connect_timeout_s=timeout,
+        rerun=rerun_target,
     )
 
     def echo(text: str) -> None:

@@ -25,6 +25,7 @@ from uavtool.mission.params import to_dict
 from uavtool.recording import RecordingWriter
 from uavtool.runner.camera import open_camera
 from uavtool.runner.evaluate import Evaluation, evaluate
+from uavtool.runner.live import LiveView
 from uavtool.runner.params import set_vehicle_params
 from uavtool.runner.record import MissionRecorder
 from uavtool.runner.runner import Progress, Runner, RunnerConfig
@@ -55,6 +56,8 @@ class FlyConfig:
     size_px: tuple[int, int] = (640, 480)
     connect_timeout_s: float = 30.0
     command_line: tuple[str, ...] = ()
+    rerun: str | None = None
+    """Stream live to Rerun: ``"spawn"`` (native viewer), ``"web"`` or a ``.rrd`` path."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -121,6 +124,17 @@ def fly(
             )
             recorder = MissionRecorder(writer)
             recorder.target(target_png)
+        live = None
+        if config.rerun is not None:
+            live = LiveView(
+                config.rerun,
+                scene=scene if config.camera == "sim" else None,
+                params=to_dict(config.params),
+                target_png=target_png,
+            )
+            stack.callback(live.close)
+            if live.url:
+                say(f"Rerun web viewer at {live.url}")
         link = VehicleLink(
             open_transport(connect, timeout_s=config.connect_timeout_s),
             tap=recorder.mavlink if recorder else None,
@@ -133,6 +147,8 @@ def fly(
             f"vehicle {link.target_system} on {link.name}, "
             f"home {home.lat_deg:.6f},{home.lon_deg:.6f}"
         )
+        if live is not None:
+            live.home(home)
         if recorder is not None:
             recorder.home = home
             recorder.note(Level.INFO, f"connected to sysid {link.target_system} on {link.name}")
@@ -144,6 +160,7 @@ def fly(
             camera,
             mission,
             recorder=recorder,
+            live=live,
             scene_origin=scene.home if config.camera == "sim" else None,
             config=RunnerConfig(time_scale=time_scale),
             progress=progress,

@@ -131,18 +131,43 @@ class MissionRecorder:
         payload = {"step": step, **encode_observation(obs)}
         self.writer.write_json(OBSERVATIONS, payload, log_time_ns=t, publish_time_ns=vehicle_ns)
 
-    def outputs(self, step: int, outputs: list[Output], *, log_time_ns: int | None = None) -> None:
+    def outputs(
+        self,
+        step: int,
+        outputs: list[Output],
+        *,
+        log_time_ns: int | None = None,
+        vehicle_time_ms: int | None = None,
+    ) -> None:
+        """Write outputs; ``vehicle_time_ms`` (the mission's time when it produced them) goes to
+        ``publish_time``."""
         t = now_ns() if log_time_ns is None else log_time_ns
+        pub = vehicle_time_ms * 1_000_000 if vehicle_time_ms else None
         for out in outputs:
             self._outputs += 1
-            self.output_json(self._outputs, step, encode_output(out), log_time_ns=t)
+            self.output_json(
+                self._outputs, step, encode_output(out), log_time_ns=t, publish_time_ns=pub
+            )
             if isinstance(out, Event):
                 self.writer.write(EVENTS, LogEntry(_LEVELS[out.level], out.text), log_time_ns=t)
             elif isinstance(out, ModelBuilt):
                 self.writer.write(MODEL, Model3D(out.glb), log_time_ns=t)
 
-    def output_json(self, n: int, step: int, data: dict[str, Any], *, log_time_ns: int) -> None:
-        self.writer.write_json(OUTPUTS, {"n": n, "step": step, **data}, log_time_ns=log_time_ns)
+    def output_json(
+        self,
+        n: int,
+        step: int,
+        data: dict[str, Any],
+        *,
+        log_time_ns: int,
+        publish_time_ns: int | None = None,
+    ) -> None:
+        self.writer.write_json(
+            OUTPUTS,
+            {"n": n, "step": step, **data},
+            log_time_ns=log_time_ns,
+            publish_time_ns=publish_time_ns,
+        )
 
     @staticmethod
     def level(level: Level) -> LogLevel:

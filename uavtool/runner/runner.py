@@ -33,6 +33,7 @@ from uavtool.mission import (
     Telemetry,
 )
 from uavtool.runner.camera import CameraSource
+from uavtool.runner.live import LiveView
 from uavtool.runner.record import MissionRecorder
 from uavtool.runner.vehicle import RESULT_NAMES, camera_pose, send_command, telemetry
 
@@ -63,6 +64,7 @@ class Runner:
         mission: Mission,
         *,
         recorder: MissionRecorder | None,
+        live: LiveView | None = None,
         scene_origin: GeoPoint | None = None,
         config: RunnerConfig = RunnerConfig(),
         progress: Progress | None = None,
@@ -71,6 +73,7 @@ class Runner:
         self.camera = camera
         self.mission = mission
         self.recorder = recorder
+        self.live = live
         self.config = config
         self.progress = progress or (lambda _text, _t: None)
         self.scene_origin = scene_origin
@@ -126,12 +129,19 @@ class Runner:
             self.step += 1
             if self.recorder is not None:
                 self.recorder.observation(self.step, obs)
+            if self.live is not None:
+                self.live.observation(self.step, obs)
             outputs = self.mission.step(obs)
             self._handle(outputs)
 
     def _handle(self, outputs: list[Output]) -> None:
         if self.recorder is not None:
-            self.recorder.outputs(self.step, outputs)
+            last = self.mission.last
+            self.recorder.outputs(
+                self.step, outputs, vehicle_time_ms=last.time_boot_ms if last else None
+            )
+        if self.live is not None:
+            self.live.outputs(self.step, outputs)
         for out in outputs:
             if isinstance(out, TakePhoto):
                 self._queue.append(self._photo(out))
