@@ -234,7 +234,7 @@ def test_message_interval_and_legacy_data_stream(client: Client) -> None:
     n0 = sum(1 for m in client.received if m.get_type() == "ATTITUDE")
     client.wait_until(lambda c: c.latest["SYSTEM_TIME"].time_boot_ms >= t0 + 5000, what="5 s")
     n = sum(1 for m in client.received if m.get_type() == "ATTITUDE") - n0
-    assert 230 <= n <= 270  # 50 Hz for 5 s
+    assert 225 <= n <= 275  # 50 Hz for 5 s (± the window's edges, which telemetry order blurs)
     assert (
         client.command(M.MAV_CMD_SET_MESSAGE_INTERVAL, M.MAVLINK_MSG_ID_ATTITUDE, -1).result
         == ACCEPTED
