@@ -44,6 +44,8 @@ class Judgement:
     candidate: int
     score: float
     matched: bool
+    judgeable: bool = True
+    """False when the candidate's outline is cut by the image border (then never a match)."""
 
 
 def judge(
@@ -56,8 +58,9 @@ def judge(
     _, matches = best_match(target, shapes, params.recognize)
     scores = tuple(match.score for match in matches)
     score = scores[candidate]
-    matched = score >= params.recognize.threshold
+    judgeable = matches[candidate].judgeable
+    matched = judgeable and score >= params.recognize.threshold
     hue_limit = params.mission.match_hue_tolerance_deg
     if matched and hue_limit > 0:
         matched = hue_distance_deg(centre.colour_rgb, target.colour_rgb) <= hue_limit
-    return Judgement(scores, candidate, score, matched)
+    return Judgement(scores, candidate, score, matched, judgeable)

@@ -132,7 +132,9 @@ def _search(
         m.emit(Recognition(photo.frame_index, k, j.scores, j.candidate, score, matched))
         m.event(
             Level.INFO,
-            f"point of interest {k}: {'MATCH' if matched else 'no match'} (score {score:.3f})",
+            f"point of interest {k}: {'MATCH' if matched else 'no match'} (score {score:.3f}"
+            + ("" if j.judgeable else "; outline cut by the image border, not judged")
+            + ")",
         )
         if score > best_score:
             best_score, best_poi = score, k
