@@ -25,6 +25,7 @@ import numpy.typing as npt
 from uavtool.errors import InputError
 
 FloatArray = npt.NDArray[np.float64]
+Vec3 = tuple[float, float, float]
 
 
 @dataclass(frozen=True, slots=True)
@@ -90,8 +91,9 @@ class CameraPose:
         """The pose of a stabilised gimbal camera on a vehicle."""
         return cls(pos_enu_m, vehicle_heading_deg + gimbal_yaw_deg, gimbal_pitch_deg)
 
-    def world_from_camera(self) -> FloatArray:
-        """3×3 rotation whose columns are the camera's x (right), y (down), z (forward) in ENU."""
+    def axes(self) -> tuple[Vec3, Vec3, Vec3]:
+        """The camera's x (right), y (down), z (forward) unit axes in ENU, from ``math``
+        scalars only (decision math in nav uses these, never numpy)."""
         h = math.radians(self.heading_deg)
         p = math.radians(self.pitch_deg)
         sh, ch, sp, cp = math.sin(h), math.cos(h), math.sin(p), math.cos(p)
@@ -103,13 +105,11 @@ class CameraPose:
             forward[2] * right[0] - forward[0] * right[2],
             forward[0] * right[1] - forward[1] * right[0],
         )
-        return np.array(
-            [
-                [right[0], down[0], forward[0]],
-                [right[1], down[1], forward[1]],
-                [right[2], down[2], forward[2]],
-            ]
-        )
+        return right, down, forward
+
+    def world_from_camera(self) -> FloatArray:
+        """3×3 rotation whose columns are the camera's x (right), y (down), z (forward) in ENU."""
+        return np.array(self.axes()).T.copy()
 
     def camera_from_world(self) -> FloatArray:
         """The inverse rotation (its transpose)."""

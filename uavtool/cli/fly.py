@@ -10,16 +10,6 @@ import click
 from uavtool.errors import InputError
 
 
-def _pairs(values: tuple[str, ...], option: str) -> dict[str, str]:
-    out: dict[str, str] = {}
-    for text in values:
-        key, sep, value = text.partition("=")
-        if not sep:
-            raise InputError(f"{option} {text!r}: expected KEY=VALUE")
-        out[key.strip()] = value.strip()
-    return out
-
-
 @click.command()
 @click.option(
     "--connect",
@@ -122,7 +112,7 @@ def fly(
       uavtool fly --visit-all --scene blocked-front
       uavtool fly --connect tcp:127.0.0.1:5760     # ArduPilot SITL (sim_vehicle.py)
     """
-    from uavtool.mission.params import Params, with_overrides
+    from uavtool.mission.params import Params, parse_settings, with_overrides
     from uavtool.runner.fly import FlyConfig
     from uavtool.runner.fly import fly as fly_mission
     from uavtool.runner.params import parse_param
@@ -131,7 +121,7 @@ def fly(
 
     if record is not None and no_record:
         raise click.UsageError("--record and --no-record exclude each other")
-    overrides = _pairs(settings, "--set")
+    overrides = parse_settings(settings)
     if visit_all:
         overrides["mission.visit_all"] = "true"
     params = with_overrides(Params(), overrides)

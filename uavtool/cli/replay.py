@@ -64,7 +64,7 @@ def replay(
       uavtool replay recordings/golden/paper.mcap --set recognize.threshold=0.9
       uavtool replay flight.mcap --set vectorize.rdp_epsilon_px=3 --out replayed.mcap
     """
-    from uavtool.mission.params import with_overrides
+    from uavtool.mission.params import parse_settings, with_overrides
     from uavtool.replay import load_flight, reanalyse_frames
     from uavtool.replay import replay as run_replay
     from uavtool.replay.write import write_replay
@@ -82,12 +82,8 @@ def replay(
     overrides: dict[str, object] = {}
     if params_file is not None:
         overrides.update(_params_file(params_file))
-    for text in settings:
-        key, sep, value = text.partition("=")
-        if not sep:
-            raise InputError(f"--set {text!r}: expected KEY=VALUE")
-        overrides[key.strip()] = value.strip()
-    params = with_overrides(flight.params, overrides)  # type: ignore[arg-type]
+    overrides.update(parse_settings(settings))
+    params = with_overrides(flight.params, overrides)
     changed = bool(overrides)
     if flight.truncated and check:
         raise InputError(
@@ -157,14 +153,4 @@ def _params_file(path: Path) -> dict[str, object]:
         raise InputError(f"--params {path}: not JSON: {exc}") from None
     if not isinstance(data, dict):
         raise InputError(f"--params {path}: expected a JSON object")
-    flat: dict[str, object] = {}
-
-    def walk(prefix: str, value: object) -> None:
-        if isinstance(value, dict):
-            for k, v in value.items():
-                walk(f"{prefix}{k}.", v)
-        else:
-            flat[prefix.rstrip(".")] = value
-
-    walk("", data)
-    return flat
+    return data

@@ -6,6 +6,7 @@ SET_MESSAGE_INTERVAL, HOME_POSITION and the gimbal/mount status messages."""
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -145,8 +146,6 @@ class VehicleLink:
 
     def wait_vehicle(self, timeout_s: float, *, on_wait: Callable[[], None] | None = None) -> None:
         """Block until a vehicle's heartbeat and home position are known; LinkError if not."""
-        import time  # noqa: PLC0415 - the runner, not the mission, waits in wall time
-
         deadline = time.monotonic() + timeout_s
         last_request = 0.0
         while self.state.home is None or self.state.position is None or last_request == 0.0:

@@ -101,7 +101,7 @@ class Mission:
         if self._started:
             raise MissionStateError("the mission was already started")
         self._started = True
-        self._emit(Shapes(-1, "target", self.target_shapes))
+        self.emit(Shapes(-1, "target", self.target_shapes))
         next(self._gen)
         return self._take()
 
@@ -123,11 +123,12 @@ class Mission:
         out, self._out = self._out, []
         return out
 
-    def _emit(self, output: Output) -> None:
+    def emit(self, output: Output) -> None:
+        """Add an output to those the current step returns (the scenario's steps use this)."""
         self._out.append(output)
 
-    def _event(self, level: Level, text: str) -> None:
-        self._emit(Event(level, text))
+    def event(self, level: Level, text: str) -> None:
+        self.emit(Event(level, text))
 
     def _new_id(self) -> int:
         self._next_id += 1
@@ -144,14 +145,14 @@ class Mission:
             end = _End(Status.COMPLETED, reason)
         except _End as exc:
             end = exc
-        self._event(
+        self.event(
             Level.INFO if end.status is Status.COMPLETED else Level.WARNING,
             f"mission ends: {end.status.value}: {end.reason}",
         )
         try:
             yield from self._finish(end.status)
         except _End as exc:
-            self._event(Level.ERROR, f"while finishing: {exc.reason}")
+            self.event(Level.ERROR, f"while finishing: {exc.reason}")
         self.outcome = Outcome(
             end.status,
             end.reason,
@@ -160,7 +161,7 @@ class Mission:
             self.match_score,
             self.model_built,
         )
-        self._emit(self.outcome)
+        self.emit(self.outcome)
 
     def _finish(self, status: Status) -> Wait[None]:
         """Bring the vehicle home (or watch someone else do it) until it has landed."""
@@ -169,15 +170,15 @@ class Mission:
         landed = self._landed_and_disarmed
         if status is Status.TAKEOVER:
             self._expected_modes = frozenset()
-            self._event(Level.INFO, "no more commands; watching until the vehicle lands")
+            self.event(Level.INFO, "no more commands; watching until the vehicle lands")
         elif not landed(self.last):
-            self._event(Level.INFO, "returning home (RTL)")
+            self.event(Level.INFO, "returning home (RTL)")
             yield from self.set_mode("RTL", also=("LAND",))
         ok = yield from self.wait_until(landed, self.params.mission.land_timeout_s)
         if ok:
-            self._event(Level.INFO, "landed and disarmed")
+            self.event(Level.INFO, "landed and disarmed")
         else:
-            self._event(Level.WARNING, "still flying when the mission stopped watching")
+            self.event(Level.WARNING, "still flying when the mission stopped watching")
 
     @staticmethod
     def _landed_and_disarmed(t: Telemetry) -> bool:
@@ -204,7 +205,7 @@ class Mission:
 
     def _wait_for_link(self, lost: LinkLost) -> Wait[None]:
         self._link_was_lost = True
-        self._event(
+        self.event(
             Level.WARNING,
             f"link lost ({lost.silent_s:.1f} s of silence): waiting; the vehicle's failsafe "
             "is in charge",
@@ -212,7 +213,7 @@ class Mission:
         while True:
             obs = yield
             if isinstance(obs, LinkRestored):
-                self._event(Level.INFO, f"link restored after {obs.silent_s:.1f} s")
+                self.event(Level.INFO, f"link restored after {obs.silent_s:.1f} s")
                 return
             if isinstance(obs, LinkLost):
                 if obs.silent_s > self.params.mission.link_lost_abort_s:
@@ -257,12 +258,12 @@ class Mission:
         detail = ""
         for attempt in range(1, attempts + 1):
             cmd = make(self._new_id())
-            self._emit(cmd)
+            self.emit(cmd)
             result = yield from self._result(cmd.id)
             if result.accepted:
                 return
             detail = result.detail
-            self._event(Level.WARNING, f"{what}: {detail} (attempt {attempt} of {attempts})")
+            self.event(Level.WARNING, f"{what}: {detail} (attempt {attempt} of {attempts})")
             if attempt < attempts:
                 yield from self.pause(self.params.mission.retry_wait_s)
         raise _End(Status.ABORTED, f"{what} failed {attempts} times: {detail}")
@@ -295,7 +296,7 @@ class Mission:
             )
             if arrived:
                 return
-            self._event(
+            self.event(
                 Level.WARNING, f"{what}: not reached in {timeout_s:.0f} s (attempt {attempt})"
             )
         raise _End(Status.ABORTED, f"{what}: position never reached")
@@ -319,21 +320,15 @@ class Mission:
                 p.move_slack_s,
             )
             if not ok:
-                self._event(Level.WARNING, f"gimbal did not report {pitch_deg:g}°; photo anyway")
+                self.event(Level.WARNING, f"gimbal did not report {pitch_deg:g}°; photo anyway")
         cmd = TakePhoto(self._new_id(), tag)
-        self._emit(cmd)
+        self.emit(cmd)
         while True:
             obs = yield from self.observe()
             if isinstance(obs, Photo) and obs.action_id == cmd.id:
                 return obs
             if isinstance(obs, CommandResult) and obs.action_id == cmd.id and not obs.accepted:
                 raise _End(Status.ABORTED, f"photo {tag!r}: {obs.detail}")
-
-    def event(self, level: Level, text: str) -> None:
-        self._event(level, text)
-
-    def emit(self, output: Output) -> None:
-        self._emit(output)
 
     def end(self, status: Status, reason: str) -> _End:
         """The exception that ends the flight (``raise mission.end(...)``)."""
@@ -347,12 +342,12 @@ class Mission:
         refused = 0
         while True:
             cmd = Arm(self._new_id())
-            self._emit(cmd)
+            self.emit(cmd)
             result = yield from self._result(cmd.id)
             if result.accepted:
                 break
             if not refused:
-                self._event(Level.WARNING, f"arming refused: {result.detail}; retrying")
+                self.event(Level.WARNING, f"arming refused: {result.detail}; retrying")
             refused += 1
             if self.now_ms() - start_ms > p.arm_wait_s * 1000.0:
                 raise _End(

@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import typing
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -104,9 +105,21 @@ def from_dict(data: dict[str, Any], *, source: str = "parameters") -> Params:
     return _apply(Params(), _flatten(data), source=source)
 
 
-def with_overrides(params: Params, pairs: dict[str, str], *, source: str = "--set") -> Params:
-    """``params`` with dotted keys set from strings (``{"mission.detail_alt_m": "25"}``)."""
-    return _apply(params, pairs, source=source)
+def with_overrides(params: Params, pairs: dict[str, Any], *, source: str = "--set") -> Params:
+    """``params`` with keys set: dotted (``{"mission.detail_alt_m": "25"}``, values as strings
+    or JSON types) or nested (``{"mission": {"detail_alt_m": 25}}``, as a params file holds)."""
+    return _apply(params, _flatten(pairs), source=source)
+
+
+def parse_settings(texts: Iterable[str], *, option: str = "--set") -> dict[str, str]:
+    """``["mission.detail_alt_m=25", …]`` → ``{"mission.detail_alt_m": "25", …}``."""
+    out: dict[str, str] = {}
+    for text in texts:
+        key, sep, value = text.partition("=")
+        if not sep:
+            raise InputError(f"{option} {text!r}: expected KEY=VALUE")
+        out[key.strip()] = value.strip()
+    return out
 
 
 def valid_keys() -> tuple[str, ...]:

@@ -1,7 +1,7 @@
 """Pixels to ground: where a camera pixel's ray meets a horizontal plane.
 
-The rotation is :meth:`uavtool.camera.CameraPose.world_from_camera` rebuilt from ``math``
-scalars, so the decision math never goes through numpy (see DESIGN, determinism).
+The rotation comes from :meth:`uavtool.camera.CameraPose.axes` (``math`` scalars), so the
+decision math never goes through numpy (see DESIGN, determinism).
 """
 
 from __future__ import annotations
@@ -16,21 +16,6 @@ from uavtool.camera import CameraPose, Intrinsics
 from uavtool.nav.errors import NavError
 
 Vec3 = tuple[float, float, float]
-
-
-def camera_axes(heading_deg: float, pitch_deg: float) -> tuple[Vec3, Vec3, Vec3]:
-    """The camera's x (right), y (down), z (forward) unit axes in ENU, as in ``CameraPose``."""
-    h = math.radians(heading_deg)
-    p = math.radians(pitch_deg)
-    sh, ch, sp, cp = math.sin(h), math.cos(h), math.sin(p), math.cos(p)
-    forward = (sh * cp, ch * cp, sp)
-    right = (ch, -sh, 0.0)
-    down = (
-        forward[1] * right[2] - forward[2] * right[1],
-        forward[2] * right[0] - forward[0] * right[2],
-        forward[0] * right[1] - forward[1] * right[0],
-    )
-    return right, down, forward
 
 
 def ground_point(
@@ -50,7 +35,7 @@ def ground_point(
     u, v = float(u_px), float(v_px)
     if not (math.isfinite(u) and math.isfinite(v)):
         raise NavError(f"pixel ({u_px}, {v_px}) is not finite")
-    right, down, forward = camera_axes(pose.heading_deg, pose.pitch_deg)
+    right, down, forward = pose.axes()
     x = (u - intrinsics.cx_px) / intrinsics.fx_px
     y = (v - intrinsics.cy_px) / intrinsics.fy_px
     d = tuple(right[i] * x + down[i] * y + forward[i] for i in range(3))

@@ -6,13 +6,12 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from uavtool.mission import Level, Params
+from uavtool.mission import Params
 from uavtool.mission.params import to_dict
 from uavtool.recording import (
     JsonDocument,
     LogEntry,
     MavlinkFrame,
-    Model3D,
     RecordingReader,
     RecordingWriter,
 )
@@ -20,7 +19,6 @@ from uavtool.recording.topics import EVENTS, MODEL, OBSERVATIONS, OUTPUTS
 from uavtool.replay.load import RecordedOutput
 from uavtool.runner.record import MissionRecorder
 
-_LEVELS = {"info": Level.INFO, "warning": Level.WARNING, "error": Level.ERROR}
 _REGENERATED = {OUTPUTS, MODEL}
 
 
@@ -89,13 +87,5 @@ def _flush(
 ) -> list[RecordedOutput]:
     while pending and pending[0].step <= up_to_step:
         out = pending.pop(0)
-        recorder.output_json(out.n, out.step, out.data, log_time_ns=t)
-        kind = out.data.get("type")
-        if kind == "Event":
-            level = _LEVELS.get(str(out.data.get("level")), Level.INFO)
-            recorder.writer.write(
-                EVENTS, LogEntry(recorder.level(level), str(out.data["text"])), log_time_ns=t
-            )
-        elif kind == "ModelBuilt" and out.n in glbs:
-            recorder.writer.write(MODEL, Model3D(glbs[out.n]), log_time_ns=t)
+        recorder.write_output(out.n, out.step, out.data, glb=glbs.get(out.n), log_time_ns=t)
     return pending

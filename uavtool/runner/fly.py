@@ -20,7 +20,9 @@ from uavtool.camera import CameraPose, Intrinsics
 from uavtool.errors import InputError, LinkError
 from uavtool.images import png_decode, png_encode
 from uavtool.link import VehicleLink, open_transport
-from uavtool.mission import Level, Mission, Outcome, Params, Status, Telemetry
+from uavtool.mavlink.dialect import COPTER_MODES
+from uavtool.mavlink.dialect import mavlink as M
+from uavtool.mission import Level, Mission, Outcome, Params
 from uavtool.mission.params import to_dict
 from uavtool.recording import RecordingWriter
 from uavtool.runner.camera import open_camera
@@ -255,9 +257,6 @@ def _metadata(config: FlyConfig, scene: Scene, connect: str) -> dict[str, dict[s
 
 
 def _abort(link: VehicleLink, recorder: MissionRecorder | None, why: str) -> None:
-    from uavtool.mavlink.dialect import COPTER_MODES  # noqa: PLC0415
-    from uavtool.mavlink.dialect import mavlink as M  # noqa: PLC0415
-
     with contextlib.suppress(LinkError):  # best effort: the link may be what failed
         link.command_long(
             M.MAV_CMD_DO_SET_MODE, M.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, COPTER_MODES["RTL"]
@@ -276,14 +275,3 @@ def _route_length(route: list[tuple[int, tuple[float, float, float]]]) -> float:
 
 def _flight_time(route: list[tuple[int, tuple[float, float, float]]]) -> float:
     return (route[-1][0] - route[0][0]) / 1000.0 if len(route) > 1 else 0.0
-
-
-__all__ = [
-    "FlightSummary",
-    "FlyConfig",
-    "Status",
-    "Telemetry",
-    "default_recording_path",
-    "fly",
-    "target_picture",
-]

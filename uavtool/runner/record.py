@@ -15,7 +15,7 @@ from typing import Any
 
 from uavtool.geo import GeoPoint, geo_from_enu
 from uavtool.images import png_encode
-from uavtool.mission import Event, Level, ModelBuilt, Observation, Output, Photo, Telemetry
+from uavtool.mission import Level, ModelBuilt, Observation, Output, Photo, Telemetry
 from uavtool.mission.codec import encode_observation, encode_output
 from uavtool.recording import (
     CameraCalibration,
@@ -145,33 +145,34 @@ class MissionRecorder:
         pub = vehicle_time_ms * 1_000_000 if vehicle_time_ms else None
         for out in outputs:
             self._outputs += 1
-            self.output_json(
-                self._outputs, step, encode_output(out), log_time_ns=t, publish_time_ns=pub
+            glb = out.glb if isinstance(out, ModelBuilt) else None
+            self.write_output(
+                self._outputs, step, encode_output(out), glb=glb, log_time_ns=t, publish_time_ns=pub
             )
-            if isinstance(out, Event):
-                self.writer.write(EVENTS, LogEntry(_LEVELS[out.level], out.text), log_time_ns=t)
-            elif isinstance(out, ModelBuilt):
-                self.writer.write(MODEL, Model3D(out.glb), log_time_ns=t)
 
-    def output_json(
+    def write_output(
         self,
         n: int,
         step: int,
         data: dict[str, Any],
         *,
+        glb: bytes | None = None,
         log_time_ns: int,
         publish_time_ns: int | None = None,
     ) -> None:
+        """One output in its JSON form (``n``, ``step``, ``encode_output``), plus its Foxglove
+        view: an event as a log line, a model's ``glb`` as a 3D model."""
         self.writer.write_json(
             OUTPUTS,
             {"n": n, "step": step, **data},
             log_time_ns=log_time_ns,
             publish_time_ns=publish_time_ns,
         )
-
-    @staticmethod
-    def level(level: Level) -> LogLevel:
-        return _LEVELS[level]
+        if data.get("type") == "Event":
+            entry = LogEntry(_LEVELS[Level(data["level"])], str(data["text"]))
+            self.writer.write(EVENTS, entry, log_time_ns=log_time_ns)
+        elif glb is not None:
+            self.writer.write(MODEL, Model3D(glb), log_time_ns=log_time_ns)
 
     def note(self, level: Level, text: str, *, name: str = "runner") -> None:
         """A runner event (connection, vehicle STATUSTEXT …) on the events topic only."""
