@@ -7,7 +7,9 @@ from hypothesis.extra.numpy import arrays
 
 from uavtool.vision.rdp import rdp, rdp_indices, rdp_ring, rdp_ring_indices, rdp_rings_indices
 
-coords = st.floats(min_value=-500, max_value=500, allow_nan=False, allow_infinity=False)
+# Pixel coordinates to a millionth of a pixel: two points are equal or at least 1e-6 apart
+# (points a subnormal distance apart are not pixels, and their squared distance underflows).
+coords = st.floats(min_value=-500, max_value=500).map(lambda v: round(v, 6))
 
 
 def _dist_to_segment(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:

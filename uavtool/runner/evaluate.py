@@ -48,7 +48,7 @@ def evaluate(runner: Runner, scene: Scene | None) -> Evaluation:
 
 
 def nearest_building(scene: Scene, point_en: tuple[float, float]) -> str:
-    import shapely  # type: ignore[import-untyped]  # noqa: PLC0415
+    import shapely  # noqa: PLC0415
 
     p = shapely.Point(point_en)
     return min(scene.buildings, key=lambda b: building_footprint(b).distance(p)).name

@@ -5,7 +5,7 @@ than a gap are merged into one outline (a morphological closing of the polygons)
 from __future__ import annotations
 
 import numpy as np
-import shapely  # type: ignore[import-untyped]
+import shapely
 
 from uavtool.vision.shapes import Shape
 

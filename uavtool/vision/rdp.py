@@ -3,12 +3,12 @@
 The output is a subset of the input points, in order, and every input point lies within
 ``epsilon_px`` of the simplified line (distance to the segment, not to its infinite line).
 
-The recursion is run breadth first: every segment still to split, of every ring, is
-handled by one set of array operations per level, so a frame's outlines cost a handful of
-numpy calls per level instead of a few per segment. Each point's distance is computed with
-the same IEEE operations in the same order as a plain per-segment loop, and the split point
-is the first farthest one, so the result is that of the textbook recursion and the same on
-every machine.
+GEOS runs the recursion (``shapely.simplify`` without topology preservation is the textbook
+algorithm: distance to the segment, split at the first farthest point); every chain of
+every ring of a frame goes to it in one call. A point's index rides along as its z
+coordinate, which GEOS copies but does not measure, so the result is a set of indices.
+What is decided here — where a ring is cut, which cut point to drop — uses exact float
+arithmetic in a fixed order, so the result is the same on every machine with the same GEOS.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ import math
 
 import numpy as np
 import numpy.typing as npt
+import shapely
 
 FloatArray = npt.NDArray[np.float64]
 IndexArray = npt.NDArray[np.intp]
@@ -28,10 +29,8 @@ def rdp_indices(points_px: FloatArray, epsilon_px: float) -> IndexArray:
     n = len(pts)
     if n <= 2:
         return np.arange(n, dtype=np.intp)
-    keep = _rdp_keep(
-        pts[:, 0].copy(), pts[:, 1].copy(), np.array([0]), np.array([n - 1]), epsilon_px
-    )
-    return np.flatnonzero(keep)
+    kept, _ = _simplify(pts[:, 0].copy(), pts[:, 1].copy(), np.arange(n), np.array([n]), epsilon_px)
+    return np.sort(kept)
 
 
 def rdp(points_px: FloatArray, epsilon_px: float) -> FloatArray:
@@ -51,8 +50,10 @@ def rdp_ring_indices(ring_px: FloatArray, epsilon_px: float) -> IndexArray:
     """Indices (in cyclic order) of the points a closed ring ``(n, 2)`` keeps.
 
     The ring is cut at two extreme points — the one farthest from the vertex mean and the
-    one farthest from that — which are corners of any polygon, so no vertex is kept only
-    because the cut happened there.
+    one farthest from that — which are corners of any polygon, and each half simplified as
+    an open line. A cut point is then dropped if RDP would not need it (every point between
+    its two neighbours within epsilon of the segment joining them), so no vertex is kept
+    only because the cut happened there.
     """
     return rdp_rings_indices([np.asarray(ring_px, dtype=np.float64)], epsilon_px)[0]
 
@@ -63,43 +64,59 @@ def rdp_rings_indices(rings_px: list[FloatArray], epsilon_px: float) -> list[Ind
     todo = [k for k, r in enumerate(rings_px) if len(r) > 3]
     if not todo:
         return out
-    cuts = _cut_points([rings_px[k] for k in todo])
-    # Each ring doubled, so the chain from the second cut point back round to the first is
-    # a plain slice; all rings side by side in one array.
-    ext = np.concatenate([np.concatenate([rings_px[k], rings_px[k]]) for k in todo])
-    xs, ys = ext[:, 0].copy(), ext[:, 1].copy()
-    base = 0
-    firsts: list[int] = []
-    lasts: list[int] = []
-    chains: dict[int, tuple[int, int, int]] = {}  # ring -> (offset in ext, a, b)
-    for k, (a, b) in zip(todo, cuts, strict=True):
-        n = len(rings_px[k])
-        if a == b:
-            out[k] = np.array([a], dtype=np.intp)
-        else:
-            i, j = min(a, b), max(a, b)
-            firsts += [base + i, base + j]
-            lasts += [base + j, base + i + n]
-            chains[k] = (base, a, b)
-        base += 2 * n
-    if not chains:
+    pts = np.concatenate([rings_px[k] for k in todo])
+    xs, ys = pts[:, 0].copy(), pts[:, 1].copy()
+    ns = np.array([len(rings_px[k]) for k in todo])
+    bases = np.cumsum(ns) - ns
+    # Cut each ring at the point farthest from its vertex mean and at the point farthest
+    # from that one: both are corners of any polygon.
+    xl, yl = xs.tolist(), ys.tolist()
+    bounds = list(zip(bases.tolist(), (bases + ns).tolist(), strict=True))
+    cx = np.repeat(np.array([math.fsum(xl[s:e]) / (e - s) for s, e in bounds]), ns)
+    cy = np.repeat(np.array([math.fsum(yl[s:e]) / (e - s) for s, e in bounds]), ns)
+    a = _first_max(xs - cx, ys - cy, bases, ns)
+    b = _first_max(xs - np.repeat(xs[a], ns), ys - np.repeat(ys[a], ns), bases, ns)
+    a, b = a - bases, b - bases
+    cut = a != b  # else every point of the ring is the same point
+    for k, at in zip(np.asarray(todo)[~cut].tolist(), a[~cut].tolist(), strict=True):
+        out[k] = np.array([at], dtype=np.intp)
+    if not cut.any():
         return out
-    keep = _rdp_keep(xs, ys, np.array(firsts), np.array(lasts), epsilon_px)
+    # Two chains per ring, i…j and j…i+n (cyclic) for the cut points i < j.
+    a, b, n = a[cut], b[cut], ns[cut]
+    i, j = np.minimum(a, b), np.maximum(a, b)
+    count = np.stack([j - i + 1, n - j + i + 1], axis=1).ravel()
+    first = np.stack([i, j], axis=1).ravel()
+    idx = _cyclic_runs(np.repeat(bases[cut], 2), first, count, np.repeat(n, 2))
+    keep = np.zeros(len(xs), dtype=bool)
+    keep[_simplify(xs, ys, idx, count, epsilon_px)[0]] = True
+    rings = [
+        (k, s, m, (i, j))
+        for k, s, m, i, j in zip(
+            np.asarray(todo)[cut].tolist(),
+            bases[cut].tolist(),
+            n.tolist(),
+            a.tolist(),
+            b.tolist(),
+            strict=True,
+        )
+    ]
+    # Each ring's kept points in cyclic order from its first cut point.
     kept: dict[int, list[int]] = {}
-    for k, (off, a, b) in chains.items():
-        n = len(rings_px[k])
-        i = min(a, b)
-        kept[k] = [(i + q) % n for q in np.flatnonzero(keep[off + i : off + i + n]).tolist()]
-    # The cut points are kept unconditionally; drop either one that RDP would not need
-    # (on a rasterised outline the farthest point is often next to the corner, not on it).
-    # Both checks go in one batch when the second cannot depend on the first (the two
-    # anchors are not neighbours, and dropping one still leaves more than three points).
-    eps2 = epsilon_px * epsilon_px
-    pending = {k: [a, b] for k, (_, a, b) in chains.items()}
+    for k, s, m, (p, q) in rings:
+        at = np.flatnonzero(keep[s : s + m]).tolist()
+        first_cut = at.index(min(p, q))
+        kept[k] = at[first_cut:] + at[:first_cut]
+    # Drop a cut point RDP would not need (on a rasterised outline the farthest point is
+    # often next to the corner, not on it). Both checks go in one batch when the second
+    # cannot depend on the first: the two are not neighbours, and dropping one still
+    # leaves more than three points.
+    pending = {k: list(ab) for k, _, _, ab in rings}
+    where = {k: (s, m) for k, s, m, _ in rings}
     while pending:
-        check: list[tuple[int, int]] = []  # (ring, anchor)
-        f: list[int] = []
-        last: list[int] = []
+        check: list[tuple[int, int]] = []  # (ring, cut point)
+        prevs: list[int] = []
+        nexts: list[int] = []
         for k, anchors in pending.items():
             ring_kept = kept[k]
             m = len(ring_kept)
@@ -110,38 +127,76 @@ def rdp_rings_indices(rings_px: list[FloatArray], epsilon_px: float) -> list[Ind
                     take = anchors
             for anchor in take:
                 pos = ring_kept.index(anchor)
-                prev, nxt = ring_kept[pos - 1], ring_kept[(pos + 1) % m]
-                off = chains[k][0]
                 check.append((k, anchor))
-                f.append(off + prev)
-                last.append(off + (nxt if nxt > prev else nxt + len(rings_px[k])))
+                prevs.append(ring_kept[pos - 1])
+                nexts.append(ring_kept[(pos + 1) % m])
             pending[k] = anchors[len(take) :] if take else []
         pending = {k: anchors for k, anchors in pending.items() if anchors}
         if not check:
             break
-        worst, _ = _farthest(xs, ys, np.array(f), np.array(last))
-        for (k, anchor), d2 in zip(check, worst.tolist(), strict=True):
-            if d2 <= eps2:
+        s_arr = np.array([where[k][0] for k, _ in check])
+        m_arr = np.array([where[k][1] for k, _ in check])
+        prev, nxt = np.array(prevs), np.array(nexts)
+        between = _cyclic_runs(s_arr, prev + 1, (nxt - prev) % m_arr - 1, m_arr)
+        ok = _within(
+            xs, ys, between, (nxt - prev) % m_arr - 1, s_arr + prev, s_arr + nxt, epsilon_px
+        )
+        for (k, anchor), drop in zip(check, ok, strict=True):
+            if drop:
                 kept[k].remove(anchor)
     for k, ring_kept in kept.items():
         out[k] = np.array(ring_kept, dtype=np.intp)
     return out
 
 
-def _cut_points(rings: list[FloatArray]) -> list[tuple[int, int]]:
-    """For each ring: the point farthest from its vertex mean, and the point farthest from
-    that one (first of equals, as ``argmax``)."""
-    ns = np.array([len(r) for r in rings])
-    starts = np.cumsum(ns) - ns
-    xs = np.concatenate([r[:, 0] for r in rings])
-    ys = np.concatenate([r[:, 1] for r in rings])
-    xl, yl = xs.tolist(), ys.tolist()
-    bounds = list(zip(starts.tolist(), (starts + ns).tolist(), strict=True))
-    cx = np.repeat(np.array([math.fsum(xl[s:e]) / (e - s) for s, e in bounds]), ns)
-    cy = np.repeat(np.array([math.fsum(yl[s:e]) / (e - s) for s, e in bounds]), ns)
-    a = _first_max(xs - cx, ys - cy, starts, ns)
-    b = _first_max(xs - np.repeat(xs[a], ns), ys - np.repeat(ys[a], ns), starts, ns)
-    return [(int(i) - s, int(j) - s) for i, j, s in zip(a, b, starts.tolist(), strict=True)]
+def _cyclic_runs(
+    bases: IndexArray, firsts: IndexArray, counts: IndexArray, ns: IndexArray
+) -> IndexArray:
+    """Indices of runs of points: ``counts[c]`` points from ``firsts[c]`` on, cyclic in a
+    ring of ``ns[c]`` points that starts at ``bases[c]``; all runs one after the other."""
+    offsets = np.cumsum(counts) - counts
+    step = np.arange(int(offsets[-1] + counts[-1])) - np.repeat(offsets, counts)
+    return np.repeat(bases, counts) + (np.repeat(firsts, counts) + step) % np.repeat(ns, counts)
+
+
+def _simplify(
+    xs: FloatArray, ys: FloatArray, idx: IndexArray, counts: IndexArray, epsilon_px: float
+) -> tuple[IndexArray, IndexArray]:
+    """RDP of the open chains of points ``idx`` (``counts[c]`` for chain ``c``, one after the
+    other) of ``(xs, ys)``: for every point kept, its index into ``xs`` and its chain."""
+    coords = np.stack([xs[idx], ys[idx], idx.astype(np.float64)], axis=1)
+    lines = shapely.linestrings(coords, indices=np.repeat(np.arange(len(counts)), counts))
+    # Coordinates a subnormal distance apart make GEOS's squared segment length underflow
+    # to 0 and divide by it; pixel coordinates never come that close without being equal.
+    with np.errstate(divide="ignore", invalid="ignore"):
+        simple = shapely.simplify(lines, epsilon_px, preserve_topology=False)
+    kept, chain = shapely.get_coordinates(simple, include_z=True, return_index=True)
+    return kept[:, 2].astype(np.intp), chain
+
+
+def _within(
+    xs: FloatArray,
+    ys: FloatArray,
+    idx: IndexArray,
+    counts: IndexArray,
+    a: IndexArray,
+    b: IndexArray,
+    epsilon_px: float,
+) -> list[bool]:
+    """For each group of ``counts[c]`` points ``idx`` (one after the other; ``counts[c] ≥
+    1``): do all lie within ``epsilon_px`` of the segment from point ``a[c]`` to ``b[c]``?"""
+    seg = np.repeat(np.arange(len(counts)), counts)
+    ax, ay = xs[a], ys[a]
+    abx, aby = xs[b] - ax, ys[b] - ay
+    len2 = abx * abx + aby * aby
+    apx, apy = xs[idx] - ax[seg], ys[idx] - ay[seg]
+    abx, aby, len2 = abx[seg], aby[seg], len2[seg]
+    t = np.divide(apx * abx + apy * aby, len2, out=np.zeros(len(idx)), where=len2 > 0.0)
+    np.clip(t, 0.0, 1.0, out=t)
+    dx, dy = apx - t * abx, apy - t * aby
+    worst = np.maximum.reduceat(dx * dx + dy * dy, np.cumsum(counts) - counts)
+    ok: list[bool] = (worst <= epsilon_px * epsilon_px).tolist()
+    return ok
 
 
 def _first_max(dx: FloatArray, dy: FloatArray, starts: IndexArray, ns: IndexArray) -> IndexArray:
@@ -150,56 +205,3 @@ def _first_max(dx: FloatArray, dy: FloatArray, starts: IndexArray, ns: IndexArra
     worst = np.repeat(np.maximum.reduceat(d2, starts), ns)
     at = np.where(d2 == worst, np.arange(len(d2)), len(d2))
     return np.minimum.reduceat(at, starts)
-
-
-def _rdp_keep(
-    xs: FloatArray, ys: FloatArray, firsts: IndexArray, lasts: IndexArray, epsilon_px: float
-) -> npt.NDArray[np.bool_]:
-    """Which of the points ``(xs, ys)`` RDP keeps on the segments ``firsts[s]…lasts[s]``."""
-    eps2 = epsilon_px * epsilon_px
-    keep = np.zeros(len(xs), dtype=bool)
-    keep[firsts] = True
-    keep[lasts] = True
-    f, last = firsts, lasts
-    while True:
-        long = last - f >= 2
-        f, last = f[long], last[long]
-        if len(f) == 0:
-            return keep
-        worst, at = _farthest(xs, ys, f, last)
-        split = worst > eps2
-        k = at[split]
-        keep[k] = True
-        f, last = np.concatenate([f[split], k]), np.concatenate([k, last[split]])
-
-
-def _farthest(
-    xs: FloatArray, ys: FloatArray, f: IndexArray, last: IndexArray
-) -> tuple[FloatArray, IndexArray]:
-    """For each segment ``f[s]``–``last[s]`` of the points ``(xs, ys)`` (``last[s] ≥ f[s] +
-    2``): the largest squared distance to the segment of the points strictly between, and
-    the index of the first point at that distance."""
-    count = last - f - 1
-    seg = np.repeat(np.arange(len(f)), count)
-    starts = np.cumsum(count) - count
-    idx = np.arange(len(seg)) + (f + 1 - starts)[seg]
-    ax, ay = xs[f], ys[f]
-    abx, aby = xs[last] - ax, ys[last] - ay
-    len2 = abx * abx + aby * aby
-    apx, apy = xs[idx] - ax[seg], ys[idx] - ay[seg]
-    abx, aby, len2 = abx[seg], aby[seg], len2[seg]
-    degenerate = len2 == 0.0
-    if degenerate.any():
-        len2[degenerate] = 1.0
-    t = (apx * abx + apy * aby) / len2
-    np.maximum(t, 0.0, out=t)
-    np.minimum(t, 1.0, out=t)
-    dx = apx - t * abx
-    dy = apy - t * aby
-    d2 = dx * dx + dy * dy
-    if degenerate.any():
-        d2[degenerate] = (apx * apx + apy * apy)[degenerate]
-    worst = np.maximum.reduceat(d2, starts)
-    # The first point at the maximum (what a per-segment argmax would pick).
-    at_max = np.where(d2 == worst[seg], idx, len(xs))
-    return worst, np.minimum.reduceat(at_max, starts)

@@ -10,7 +10,7 @@ from uavtool.world.polygon import triangulate
 from uavtool.world.scene import Block, Building
 
 if TYPE_CHECKING:
-    import shapely  # type: ignore[import-untyped]
+    import shapely
     import trimesh
 
 

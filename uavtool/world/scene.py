@@ -32,7 +32,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, NoReturn
 
-import shapely  # type: ignore[import-untyped]
+import shapely
 import yaml
 
 from uavtool.geo import GeoPoint
