@@ -1,7 +1,8 @@
 """Vision speed on the paper scene, each next to its baseline, medians in one run.
 
-Each figure is the median wall time; in brackets the median CPU time of this thread, which
-other processes on a busy machine inflate much less.
+Each figure is the median wall time, the functions compared taking turns in every round;
+in brackets the median CPU time of this thread, which other processes on a busy machine
+inflate much less.
 
 * vectorize the 640×480 overview frame (45 m above home, noise seed 1) vs OpenCV's own
   path per colour (HSV, ``inRange``, ``findContours``, ``approxPolyDP``);
@@ -38,15 +39,28 @@ class Timing(float):
 
 
 def median_ms(fn: Callable[[], object], repeat: int) -> Timing:
-    fn()
-    wall, cpu = [], []
-    for _ in range(repeat):
-        t, c = time.perf_counter(), time.thread_time()
+    return side_by_side([fn], repeat)[0]
+
+
+def side_by_side(fns: list[Callable[[], object]], repeat: int) -> list[Timing]:
+    """Median times of ``fns``, run in turn in every round, so a machine that changes speed
+    during the run (shared cores, frequency scaling) slows them all alike and their ratio
+    stays fair."""
+    for fn in fns:
         fn()
-        wall.append(time.perf_counter() - t)
-        cpu.append(time.thread_time() - c)
-    out = Timing(1e3 * statistics.median(wall))
-    out.cpu_ms = 1e3 * statistics.median(cpu)
+    wall: list[list[float]] = [[] for _ in fns]
+    cpu: list[list[float]] = [[] for _ in fns]
+    for _ in range(repeat):
+        for k, fn in enumerate(fns):
+            t, c = time.perf_counter(), time.thread_time()
+            fn()
+            wall[k].append(time.perf_counter() - t)
+            cpu[k].append(time.thread_time() - c)
+    out = []
+    for w, c in zip(wall, cpu, strict=True):
+        timing = Timing(1e3 * statistics.median(w))
+        timing.cpu_ms = 1e3 * statistics.median(c)
+        out.append(timing)
     return out
 
 
@@ -75,9 +89,15 @@ def run(repeat: int) -> None:
             )[0, 0, 0]
         )
         colours.append(((max(h - 9, 0), 70, 30), (min(h + 9, 255), 255, 255)))
-    ours = median_ms(lambda: vectorize(frame), repeat)
-    roof = median_ms(lambda: vectorize(frame, VectorizeParams(roof_only=True)), repeat)
-    base = median_ms(lambda: opencv_baseline(frame, colours), repeat)
+    roof_only = VectorizeParams(roof_only=True)
+    ours, roof, base = side_by_side(
+        [
+            lambda: vectorize(frame),
+            lambda: vectorize(frame, roof_only),
+            lambda: opencv_baseline(frame, colours),
+        ],
+        repeat,
+    )
     per_colour = base / len(colours)
     print(
         f"vectorize paper overview ({len(shapes)} shapes, {len(colours)} colours): "
@@ -95,16 +115,18 @@ def run(repeat: int) -> None:
         hue_tolerance_deg=10,
     )[0]
     cand = same_colour(shapes, red, hue_tolerance_deg=10)[0]
-    hu = median_ms(
-        lambda: cv2.matchShapes(
-            target.polygon_px.astype("float32"),
-            cand.polygon_px.astype("float32"),
-            cv2.CONTOURS_MATCH_I1,
-            0.0,
-        ),
+    hu, ms = side_by_side(
+        [
+            lambda: cv2.matchShapes(
+                target.polygon_px.astype("float32"),
+                cand.polygon_px.astype("float32"),
+                cv2.CONTOURS_MATCH_I1,
+                0.0,
+            ),
+            lambda: match_shapes(target, cand),
+        ],
         repeat,
     )
-    ms = median_ms(lambda: match_shapes(target, cand), repeat)
     print(
         f"match two shapes ({len(target.polygon_px)} vs {len(cand.polygon_px)} corners): "
         f"{ms} median; cv2.matchShapes {hu}"
