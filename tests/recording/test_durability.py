@@ -4,6 +4,7 @@ threads sharing a writer lose or reorder nothing while chunks are synced behind 
 from __future__ import annotations
 
 import errno
+import gc
 import json
 import os
 import re
@@ -198,3 +199,22 @@ def test_background_fsync_does_not_change_the_bytes(tmp_path: Path) -> None:
     write_sample(tmp_path / "a.mcap", seconds=1.0, fsync=True)
     write_sample(tmp_path / "b.mcap", seconds=1.0, fsync=False)
     assert (tmp_path / "a.mcap").read_bytes() == (tmp_path / "b.mcap").read_bytes()
+
+
+# Python rightly warns about the file the dropped writer leaves unclosed.
+@pytest.mark.filterwarnings("ignore::ResourceWarning")
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_a_writer_dropped_without_close_ends_its_sync_thread(tmp_path: Path) -> None:
+    def sync_threads() -> list[threading.Thread]:
+        return [t for t in threading.enumerate() if t.name == "fsync dropped.mcap"]
+
+    writer = _writer(tmp_path / "dropped.mcap")
+    _write(writer, 0)
+    _write(writer, 1)  # closes a chunk: a sync request
+    writer.flush()  # served: the thread now waits for the next request
+    threads = sync_threads()
+    assert len(threads) == 1 and threads[0].is_alive()
+    del writer
+    gc.collect()
+    threads[0].join(timeout=5.0)
+    assert not threads[0].is_alive()

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import weakref
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import NoReturn
@@ -59,6 +60,9 @@ class RecordingSink:
             raise RecordingError(path, f"cannot write: {exc.strerror or exc}") from exc
         if fsync:
             self._syncer = Syncer(self._file.fileno(), path.name)
+            # A sink dropped without close() still ends its thread (the file is still open
+            # when this runs); close() runs it first, and it runs once.
+            self._stop_syncer = weakref.finalize(self, self._syncer.stop)
 
     def check(self) -> None:
         """Raise `RecordingError` if a write or fsync has failed."""
@@ -126,7 +130,7 @@ class RecordingSink:
             except OSError as exc:
                 self._record("cannot write", exc)
         if self._syncer is not None:
-            self._syncer.stop()
+            self._stop_syncer()
             self._take_sync_failure()
         if self._fsync and self._error is None:
             try:
