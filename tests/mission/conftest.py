@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 
+from tests.mission import scenes
 from tests.mission.driver import Flown, fly
 from uavtool.mission import MissionParams, Params
 from uavtool.world import Scene, load_scene
@@ -23,3 +24,10 @@ def paper_flight(paper: Scene) -> Flown:
 @pytest.fixture(scope="session")
 def visit_all_flight(paper: Scene) -> Flown:
     return fly(paper, Params(mission=MissionParams(visit_all=True)))
+
+
+@pytest.fixture(scope="session")
+def turned_flight() -> Flown:
+    """``paper`` flown facing east: the red roof's first photo scores just below the
+    threshold, so does the second, and the third (from higher still) matches."""
+    return fly(scenes.turned(90.0))

@@ -66,3 +66,12 @@ def out_of_view() -> Scene:
         block["footprint"] = [[x + 150.0, y] for x, y in block["footprint"]]
     data.update(name="out-of-view", buildings=[red])
     return scene_from_dict(data, source="out-of-view")
+
+
+def turned(heading_deg: float, name: str = "paper") -> Scene:
+    """A built-in scene whose vehicle starts facing ``heading_deg`` (it keeps that heading
+    over the points of interest, so their photos see the roofs rotated)."""
+    data = scene_to_dict(load_scene(name))
+    data["origin"]["heading_deg"] = heading_deg
+    data.update(name=f"{name}-heading-{heading_deg:g}")
+    return scene_from_dict(data, source="turned")

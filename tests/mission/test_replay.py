@@ -70,7 +70,9 @@ def _encoded(outputs: list[Output]) -> list[dict[str, Any]]:
     return [encode_output(o) for o in outputs]
 
 
-@pytest.mark.parametrize("flight_name", ["paper_flight", "visit_all_flight", "troubled_flight"])
+@pytest.mark.parametrize(
+    "flight_name", ["paper_flight", "visit_all_flight", "troubled_flight", "turned_flight"]
+)
 def test_replaying_the_observations_reproduces_every_output(
     flight_name: str, request: pytest.FixtureRequest
 ) -> None:

@@ -34,11 +34,29 @@ class MissionParams:
     roof_gap_px: float = 6.0
     """Same-coloured roofs closer than this (pixels) in a nadir photo are one building: blocks
     of different heights show as separate roofs split by a strip of wall."""
+    roof_colour_tolerance_dn: float = 10.0
+    """Roofs count as one colour for that when their colours differ by at most this in every
+    RGB channel (0–255): sensor noise gives one building's roofs slightly different colours
+    (0 = only equal colours)."""
     match_hue_tolerance_deg: float = 20.0
     """A candidate whose colour's hue is further than this from the target's is not a match,
     whatever its shape (0 = judge by shape alone)."""
     min_poi_area_px: float = 150.0
     """Overview shapes smaller than this (square pixels) are not visited."""
+    max_looks: int = 3
+    """Photos taken at most at one point of interest. When the first one is doubtful — the
+    candidate has the target's hue but its outline is cut by the image border, or it scores
+    between ``recheck_min_score`` and the threshold, or it lies off the photo's centre — the
+    vehicle moves over the candidate's roof and looks again; a match in any look counts
+    (1 = never look again)."""
+    recheck_min_score: float = 0.5
+    """Lowest score that makes a candidate worth a second look."""
+    recheck_offcentre: float = 0.25
+    """A candidate whose centroid is further than this fraction of the photo's half-height
+    from the centre is off-centre."""
+    recheck_climb_m: float = 10.0
+    """Each further look is taken this much higher than the one before (the whole roof in
+    view, smaller perspective steps between its heights; never above ``overview_alt_m``)."""
     visit_all: bool = False
     """Visit every point of interest even after a match (then keep the best-scoring match)."""
     arrive_radius_m: float = 0.6
@@ -74,6 +92,8 @@ class MissionParams:
                 raise InputError(f"mission.{name} must be positive, got {getattr(self, name)}")
         if self.detail_alt_m > self.overview_alt_m:
             raise InputError("mission.detail_alt_m must not be above mission.overview_alt_m")
+        if self.max_looks < 1:
+            raise InputError(f"mission.max_looks must be ≥ 1, got {self.max_looks}")
         if self.command_retries < 0:
             raise InputError(f"mission.command_retries must be ≥ 0, got {self.command_retries}")
 

@@ -3,21 +3,18 @@ photos for the model, and the model. Each step is a generator run by :class:`Mis
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from uavtool.mission.analysis import judge, nadir_shapes, side_shapes
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import (
     Level,
     ModelBuilt,
     Plan,
     PointOfInterest,
-    Recognition,
-    Shapes,
     Status,
     Viewpoints,
 )
+from uavtool.mission.search import Found, photo_shapes, search
 from uavtool.nav import (
     Viewpoint,
     ViewpointFailure,
@@ -40,14 +37,6 @@ if TYPE_CHECKING:
 _SIDE_HUE_TOLERANCE_DEG = 15.0
 
 
-@dataclass(frozen=True, slots=True)
-class _Found:
-    poi: PointOfInterest
-    photo: Photo
-    shape: Shape
-    score: float
-
-
 def fly(m: Mission) -> Wait[None]:
     """The whole flight up to (not including) the return home."""
     p = m.params.mission
@@ -64,7 +53,7 @@ def fly(m: Mission) -> Wait[None]:
     yield from m.move((here[0], here[1], p.overview_alt_m), None, "overview position")
 
     overview = yield from m.photo("overview", -90.0)
-    shapes = _vectorize(m, overview)
+    shapes = photo_shapes(m, overview)
     pois = _points_of_interest(m, overview, shapes)
     if not pois:
         raise m.end(Status.NO_MATCH, "the overview photo shows no building")
@@ -75,7 +64,7 @@ def fly(m: Mission) -> Wait[None]:
     m.emit(m.plan)
     m.event(Level.INFO, f"{len(pois)} points of interest; visiting order {list(order)}")
 
-    found = yield from _search(m, pois, order)
+    found = yield from search(m, pois, order)
     if found is None:
         return
     m.matched_poi = found.poi.index
@@ -86,15 +75,6 @@ def fly(m: Mission) -> Wait[None]:
         if i != found.poi.shape_index
     ]
     yield from _model(m, found, obstacles)
-
-
-def _vectorize(m: Mission, photo: Photo, *, nadir: bool = True) -> tuple[Shape, ...]:
-    if nadir:
-        shapes = nadir_shapes(m.params, photo.image_rgb)
-    else:
-        shapes = side_shapes(m.params, photo.image_rgb)
-    m.emit(Shapes(photo.frame_index, photo.tag, shapes))
-    return shapes
 
 
 def _points_of_interest(
@@ -111,48 +91,8 @@ def _points_of_interest(
     return tuple(pois)
 
 
-def _search(
-    m: Mission, pois: tuple[PointOfInterest, ...], order: tuple[int, ...]
-) -> Wait[_Found | None]:
-    """Visit the points of interest in order; the best match (the first one unless
-    ``visit_all``), or None after reporting that nothing matched."""
-    p = m.params.mission
-    best: _Found | None = None
-    best_score, best_poi = 0.0, -1
-    for k in order:
-        poi = pois[k]
-        x, y = poi.pos_en_m
-        yield from m.move((x, y, p.detail_alt_m), None, f"point of interest {k}")
-        photo = yield from m.photo(f"poi-{k}", -90.0)
-        shapes = _vectorize(m, photo)
-        m.visited.append(k)
-        j = judge(m.params, m.target, shapes, photo.intrinsics)
-        centre = shapes[j.candidate] if j.candidate >= 0 else None
-        score, matched = j.score, j.matched
-        m.emit(Recognition(photo.frame_index, k, j.scores, j.candidate, score, matched))
-        m.event(
-            Level.INFO,
-            f"point of interest {k}: {'MATCH' if matched else 'no match'} (score {score:.3f}"
-            + ("" if j.judgeable else "; outline cut by the image border, not judged")
-            + ")",
-        )
-        if score > best_score:
-            best_score, best_poi = score, k
-        if matched and centre is not None and (best is None or score > best.score):
-            best = _Found(poi, photo, centre, score)
-            if not p.visit_all:
-                break
-    if best is None:
-        where = f" at point of interest {best_poi}" if best_poi >= 0 else ""
-        raise m.end(
-            Status.NO_MATCH, f"no building matched the target (best score {best_score:.3f}{where})"
-        )
-    m.event(Level.INFO, f"target is point of interest {best.poi.index} (score {best.score:.3f})")
-    return best
-
-
 def _model(
-    m: Mission, found: _Found, obstacles: list[tuple[tuple[float, float], ...]]
+    m: Mission, found: Found, obstacles: list[tuple[tuple[float, float], ...]]
 ) -> Wait[None]:
     """Top, front and right photos from planned viewpoints, then the model."""
     p = m.params.mission
@@ -167,7 +107,7 @@ def _model(
     top = top_viewpoint(rect, front_heading, alt_m=p.detail_alt_m)
     yield from m.move(top.pos_enu_m, top.heading_deg, "top viewpoint")
     top_photo = yield from m.photo("top", -90.0)
-    top_shapes = _vectorize(m, top_photo)
+    top_shapes = photo_shapes(m, top_photo)
     obj = central_shape(top_shapes, top_photo.intrinsics)
     if obj is None:
         raise m.end(Status.ABORTED, "the top photo shows no building")
@@ -190,7 +130,7 @@ def _model(
         yield from m.move((x, y, p.detail_alt_m), vp.heading_deg, f"above the {vp.name} viewpoint")
         yield from m.move((x, y, z), vp.heading_deg, f"{vp.name} viewpoint")
         photo = yield from m.photo(vp.name, 0.0)
-        shapes = _vectorize(m, photo, nadir=False)
+        shapes = photo_shapes(m, photo, nadir=False)
         silhouette = same_colour(shapes, obj.colour_rgb, hue_tolerance_deg=_SIDE_HUE_TOLERANCE_DEG)
         views[vp.name] = View(silhouette, photo.pose, photo.intrinsics)
         yield from m.move(

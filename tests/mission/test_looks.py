@@ -1,0 +1,159 @@
+"""Recognition that survives an imperfect photo: one building's roofs joined despite sensor
+noise, and a doubtful point of interest looked at again from higher over its roof."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import shapely  # type: ignore[import-untyped]
+
+from tests.mission import scenes
+from tests.mission.driver import Flight, Flown, fly
+from uavtool.camera import CameraPose, Intrinsics
+from uavtool.errors import InputError
+from uavtool.mission import GoTo, Params, Photo, Plan, Recognition, Shapes, Status
+from uavtool.mission.analysis import join_roofs, nadir_shapes
+from uavtool.mission.params import with_overrides
+from uavtool.vision import Shape
+from uavtool.world import Scene, building_footprint, render
+
+K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
+
+
+def _rect(x0: float, y0: float, x1: float, y1: float, colour: tuple[int, int, int]) -> Shape:
+    ring = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=np.float64)
+    return Shape.from_rings(colour_rgb=colour, polygon_px=ring, holes_px=(), cut_by_border=False)
+
+
+def _looks(flight: Flight, poi: int) -> list[tuple[Photo, Recognition]]:
+    """The photos taken at point of interest ``poi`` with their recognitions, in order."""
+    photos = {o.frame_index: o for o in flight.observations if isinstance(o, Photo)}
+    return [(photos[r.frame_index], r) for r in flight.of_type(Recognition) if r.poi == poi]
+
+
+def _red_poi(flight: Flight, scene: Scene) -> int:
+    (plan,) = flight.of_type(Plan)
+    red = building_footprint(scene.building("red"))
+    return next(p.index for p in plan.pois if red.contains(shapely.Point(p.pos_en_m)))
+
+
+# --- roofs joined despite noise ---------------------------------------------------------------
+
+
+@pytest.mark.parametrize("seed", [1, 3])
+def test_noisy_roofs_of_one_building_are_one_shape(paper: Scene, seed: int) -> None:
+    """Over paper's red building its two roofs differ by a few levels in a noisy photo:
+    joined only when colours may differ (equal colours alone left two halves)."""
+    image = render(paper, CameraPose((11.17, -9.05, 20.0), 0.0, -90.0), K, noise_seed=seed)
+    (roof,) = nadir_shapes(Params(), image)
+    exact = nadir_shapes(scenes.with_mission(roof_colour_tolerance_dn=0.0), image)
+    assert len(exact) == 2 and exact[0].colour_rgb != exact[1].colour_rgb
+    assert roof.area_px > sum(s.area_px for s in exact)
+    assert roof.colour_rgb == exact[0].colour_rgb
+
+
+def test_join_roofs_keeps_other_colours_and_far_roofs_apart() -> None:
+    a = _rect(0, 0, 100, 50, (197, 38, 38))
+    b = _rect(103, 0, 150, 50, (199, 36, 41))  # 3 levels off, 3 px away: the same building
+    c = _rect(0, 53, 100, 90, (133, 20, 60))  # crimson, 3 px away: another building
+    d = _rect(300, 0, 350, 50, (196, 38, 38))  # red, far away: another building
+    out = join_roofs((a, b, c, d), gap_px=6.0, colour_tolerance_dn=10.0)
+    assert len(out) == 3
+    assert out[0].colour_rgb == a.colour_rgb and out[0].area_px > a.area_px + b.area_px
+    assert out[1] is c and out[2] is d  # untouched shapes keep their own colours
+    assert join_roofs((a, b, c, d), gap_px=6.0, colour_tolerance_dn=0.0) == (a, b, c, d)
+    assert len(join_roofs((a, b), gap_px=6.0, colour_tolerance_dn=2.0)) == 2
+
+
+# --- looking again ----------------------------------------------------------------------------
+
+
+def test_a_cut_roof_is_looked_at_again_from_higher_over_its_roof() -> None:
+    """Facing north-east the red roof does not fit the first photo from 20 m: the mission
+    climbs 10 m over the roof's centre, looks again and matches; with one look it misses."""
+    scene = scenes.turned(45.0)
+    flown = fly(scene)
+    flight = flown.flight
+    k = _red_poi(flight, scene)
+    (first, r1), (second, r2) = _looks(flight, k)
+    assert not r1.matched and r2.matched
+    assert first.tag == f"poi-{k}" and second.tag == f"poi-{k}-2"
+    assert f"point of interest {k}: outline cut by the image border; looking again" in "\n".join(
+        flight.texts()
+    )
+    (move,) = [g for g in flight.of_type(GoTo) if g.pos_enu_m[2] == 30.0]
+    x, y, _ = move.pos_enu_m
+    assert building_footprint(scene.building("red")).contains(shapely.Point(x, y))
+    assert math.dist(second.pose.pos_enu_m, move.pos_enu_m) < 0.7
+    assert flown.outcome.status is Status.COMPLETED and flown.outcome.matched_poi == k
+    assert flown.outcome.model_built
+
+    once = fly(scene, scenes.with_mission(max_looks=1))
+    assert once.outcome.status is Status.NO_MATCH
+    assert [p.tag for p, _ in _looks(once.flight, k)] == [f"poi-{k}"]
+
+
+def test_looks_climb_until_a_match_and_replay(turned_flight: Flown) -> None:
+    """Facing east the red roof scores just below the threshold from 20 m and 30 m; the third
+    look, from 40 m, matches. Each look is a GoTo over the candidate's roof, a photo with
+    its shapes and a recognition."""
+    flight = turned_flight.flight
+    k = turned_flight.outcome.matched_poi
+    looks = _looks(flight, k)
+    assert [p.tag for p, _ in looks] == [f"poi-{k}", f"poi-{k}-2", f"poi-{k}-3"]
+    assert [r.matched for _, r in looks] == [False, False, True]
+    assert all(0.5 <= r.score < 0.7 for _, r in looks[:2])
+    assert [round(p.pose.pos_enu_m[2]) for p, _ in looks] == [20, 30, 40]
+    shapes_of = {s.frame_index for s in flight.of_type(Shapes)}
+    assert all(p.frame_index in shapes_of for p, _ in looks)
+    again = [t for t in flight.texts() if "looking again" in t]
+    assert len(again) == 2 and all("just below the threshold" in t for t in again)
+    assert turned_flight.outcome.match_score == looks[-1][1].score
+
+
+def test_looks_never_climb_above_the_overview_altitude() -> None:
+    flown = fly(scenes.turned(45.0), scenes.with_mission(recheck_climb_m=40.0))
+    k = flown.outcome.matched_poi
+    heights = [p.pose.pos_enu_m[2] for p, _ in _looks(flown.flight, k)]
+    assert heights[1] == pytest.approx(45.0, abs=0.7)
+    assert [g.pos_enu_m[2] for g in flown.flight.of_type(GoTo)].count(65.0) == 0
+
+
+def test_a_clear_miss_off_centre_is_centred_then_final(paper: Scene) -> None:
+    """Looking for a red cross over paper: the red L scores low but (with a strict centring
+    limit) lies off the photo's centre, so it is looked at once more from above its roof;
+    centred, the low score is final."""
+    params = scenes.with_mission(recheck_offcentre=0.02)
+    flown = fly(paper, params, target_scene=scenes.cross_target())
+    flight = flown.flight
+    k = _red_poi(flight, paper)
+    looks = _looks(flight, k)
+    assert len(looks) == 2 and all(r.score < 0.5 for _, r in looks)
+    shapes = {s.frame_index: s.shapes for s in flight.of_type(Shapes)}
+
+    def off_px(photo: Photo, rec: Recognition) -> float:
+        u, v = shapes[photo.frame_index][rec.candidate].centroid_px
+        return math.hypot(u - K.cx_px, v - K.cy_px)
+
+    assert off_px(*looks[0]) > 0.02 * 240 >= off_px(*looks[1])
+    assert any("candidate off the photo's centre; looking again" in t for t in flight.texts())
+    assert flown.outcome.status is Status.NO_MATCH
+
+
+def test_other_hues_and_matches_get_one_look(paper_flight: Flown) -> None:
+    """On paper facing north nothing is doubtful: the other buildings have other hues and the
+    red one matches at once."""
+    tags = [o.tag for o in paper_flight.flight.observations if isinstance(o, Photo)]
+    assert [t for t in tags if t.startswith("poi-")] == [
+        f"poi-{k}" for k in paper_flight.outcome.visited
+    ]
+    assert not any("looking again" in t for t in paper_flight.flight.texts())
+
+
+def test_look_parameters_are_settable_and_checked() -> None:
+    params = with_overrides(Params(), {"mission.max_looks": "1", "mission.recheck_climb_m": "5"})
+    assert params.mission.max_looks == 1 and params.mission.recheck_climb_m == 5.0
+    with pytest.raises(InputError, match=r"mission\.max_looks must be ≥ 1"):
+        scenes.with_mission(max_looks=0)

@@ -1,0 +1,132 @@
+"""The search: visit the points of interest, photograph each from above and compare it with
+the target. A doubtful photo (the candidate has the target's hue but is cut by the image
+border, scores just below the threshold, or lies off-centre) is not the last word: like a
+pilot, the mission climbs over the candidate's roof and looks again. From higher up the
+whole roof fits the photo and the perspective steps between roofs of different heights
+shrink (on ``paper``, over headings and ±0.5 m: 47 % of photos from 20 m match, 98 % from
+30 m)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from uavtool.mission.analysis import Judgement, judge, nadir_shapes, side_shapes
+from uavtool.mission.observations import Photo
+from uavtool.mission.outputs import Level, PointOfInterest, Recognition, Shapes, Status, Vec3
+from uavtool.nav import ground_point
+from uavtool.vision import Shape
+
+if TYPE_CHECKING:
+    from uavtool.mission.mission import Mission, Wait
+
+
+@dataclass(frozen=True, slots=True)
+class Found:
+    """The matched point of interest, the photo that matched and the matched shape in it."""
+
+    poi: PointOfInterest
+    photo: Photo
+    shape: Shape
+    score: float
+
+
+@dataclass(frozen=True, slots=True)
+class _Look:
+    photo: Photo
+    shapes: tuple[Shape, ...]
+    judgement: Judgement
+    alt_m: float  # the altitude commanded for the photo
+
+
+def photo_shapes(m: Mission, photo: Photo, *, nadir: bool = True) -> tuple[Shape, ...]:
+    """Vectorize a photo (from above, or from the side) and emit its shapes."""
+    if nadir:
+        shapes = nadir_shapes(m.params, photo.image_rgb)
+    else:
+        shapes = side_shapes(m.params, photo.image_rgb)
+    m.emit(Shapes(photo.frame_index, photo.tag, shapes))
+    return shapes
+
+
+def search(
+    m: Mission, pois: tuple[PointOfInterest, ...], order: tuple[int, ...]
+) -> Wait[Found | None]:
+    """Visit the points of interest in order; the best match (the first one unless
+    ``visit_all``); ends the mission with NO_MATCH when nothing matched."""
+    p = m.params.mission
+    best: Found | None = None
+    best_score, best_poi = 0.0, -1
+    for k in order:
+        poi = pois[k]
+        x, y = poi.pos_en_m
+        yield from m.move((x, y, p.detail_alt_m), None, f"point of interest {k}")
+        m.visited.append(k)
+        looks = [(yield from _look(m, k, 1, p.detail_alt_m))]
+        for n in range(2, p.max_looks + 1):
+            again = _look_again(m, looks[-1])
+            if again is None:
+                break
+            pos, why = again
+            m.event(
+                Level.INFO,
+                f"point of interest {k}: {why}; looking again from above its roof at {pos[2]:g} m",
+            )
+            yield from m.move(pos, None, f"point of interest {k}, look {n}")
+            looks.append((yield from _look(m, k, n, pos[2])))
+        top = max(look.judgement.score for look in looks)
+        if top > best_score:
+            best_score, best_poi = top, k
+        look = looks[-1]  # a match ends the looking: the last look is the match if any
+        j = look.judgement
+        if j.matched and (best is None or j.score > best.score):
+            best = Found(poi, look.photo, look.shapes[j.candidate], j.score)
+            if not p.visit_all:
+                break
+    if best is None:
+        where = f" at point of interest {best_poi}" if best_poi >= 0 else ""
+        raise m.end(
+            Status.NO_MATCH, f"no building matched the target (best score {best_score:.3f}{where})"
+        )
+    m.event(Level.INFO, f"target is point of interest {best.poi.index} (score {best.score:.3f})")
+    return best
+
+
+def _look(m: Mission, k: int, n: int, alt_m: float) -> Wait[_Look]:
+    """Look ``n`` at point of interest ``k``: a nadir photo, judged and reported."""
+    photo = yield from m.photo(f"poi-{k}" if n == 1 else f"poi-{k}-{n}", -90.0)
+    shapes = photo_shapes(m, photo)
+    j = judge(m.params, m.target, shapes, photo.intrinsics)
+    m.emit(Recognition(photo.frame_index, k, j.scores, j.candidate, j.score, j.matched))
+    m.event(
+        Level.INFO,
+        f"point of interest {k}{'' if n == 1 else f', look {n}'}: "
+        f"{'MATCH' if j.matched else 'no match'} (score {j.score:.3f}"
+        + ("" if j.judgeable else "; outline cut by the image border, not judged")
+        + ")",
+    )
+    return _Look(photo, shapes, j, alt_m)
+
+
+def _look_again(m: Mission, look: _Look) -> tuple[Vec3, str] | None:
+    """Where to look from again and why, or None when the look was conclusive: a match, no
+    candidate, a candidate of another hue, or a clear miss centred in the photo."""
+    p = m.params.mission
+    j, photo = look.judgement, look.photo
+    if j.matched or j.candidate < 0 or not j.same_hue:
+        return None
+    shape = look.shapes[j.candidate]
+    u, v = shape.centroid_px
+    k = photo.intrinsics
+    off = math.hypot(u - k.cx_px, v - k.cy_px) / (k.height_px / 2.0)
+    if not j.judgeable:
+        why = "outline cut by the image border"
+    elif j.score >= p.recheck_min_score:
+        why = f"score {j.score:.3f} just below the threshold"
+    elif off > p.recheck_offcentre:
+        why = "candidate off the photo's centre"
+    else:
+        return None
+    x, y = ground_point(u, v, photo.pose, photo.intrinsics, plane_z_m=p.roof_plane_z_m)
+    return (x, y, min(look.alt_m + p.recheck_climb_m, p.overview_alt_m)), why
