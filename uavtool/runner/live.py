@@ -40,8 +40,10 @@ class LiveView:
     def home(self, home: GeoPoint) -> None:
         self.logger.home(home)
 
-    def observation(self, step: int, obs: Observation) -> None:
-        png = png_encode(obs.image_rgb) if isinstance(obs, Photo) else None
+    def observation(self, step: int, obs: Observation, png: bytes | None = None) -> None:
+        """Show one observation; a photo's frame as ``png`` if the caller encoded it."""
+        if png is None and isinstance(obs, Photo):
+            png = png_encode(obs.image_rgb)
         self.logger.observation(step, encode_observation(obs), png, log_time_ns=now_ns())
 
     def outputs(self, step: int, outputs: list[Output]) -> None:

@@ -92,13 +92,14 @@ class MissionRecorder:
     def target(self, png: bytes) -> None:
         self.writer.write(TARGET, CompressedImage(png, frame_id="target"), log_time_ns=now_ns())
 
-    def observation(self, step: int, obs: Observation) -> None:
+    def observation(self, step: int, obs: Observation, png: bytes | None = None) -> None:
+        """Record one observation; a photo's frame as ``png`` if the caller encoded it."""
         t = now_ns()
         vehicle_ns = _vehicle_ns(obs)
         if isinstance(obs, Photo):
             self.writer.write(
                 IMAGE,
-                CompressedImage(png_encode(obs.image_rgb)),
+                CompressedImage(png if png is not None else png_encode(obs.image_rgb)),
                 log_time_ns=t,
                 publish_time_ns=vehicle_ns,
             )

@@ -14,6 +14,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from uavtool.geo import GeoPoint, enu_from_geo
+from uavtool.images import png_encode
 from uavtool.link import VehicleLink
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mission import (
@@ -127,10 +128,14 @@ class Runner:
         while self._queue and self.mission.outcome is None:
             obs = self._queue.popleft()
             self.step += 1
+            # A photo is encoded once, for the recording and the live view alike.
+            png = None
+            if isinstance(obs, Photo) and (self.recorder is not None or self.live is not None):
+                png = png_encode(obs.image_rgb)
             if self.recorder is not None:
-                self.recorder.observation(self.step, obs)
+                self.recorder.observation(self.step, obs, png)
             if self.live is not None:
-                self.live.observation(self.step, obs)
+                self.live.observation(self.step, obs, png)
             outputs = self.mission.step(obs)
             self._handle(outputs)
 
