@@ -70,6 +70,7 @@ def test_match_finds_the_target_and_fails_when_absent(tmp_path: Path) -> None:
     result = runner.invoke(cli, ["vision", "match", str(target), str(frame)])
     assert result.exit_code == 0, result.output
     assert "best: shape 1" in result.output
+    assert result.output.count("  judgeable") == 2 and "NOT judgeable" not in result.output
     other = _write(
         tmp_path / "other.png",
         draw(
@@ -85,7 +86,45 @@ def test_match_finds_the_target_and_fails_when_absent(tmp_path: Path) -> None:
     )
     result = runner.invoke(cli, ["vision", "match", str(target), str(other)])
     assert result.exit_code == 1
-    assert "uavtool: error: no shape" in result.output
+    assert f"uavtool: error: {other}: no shape matches the target" in result.output
+    assert "the best, shape 0, scores 0." in result.output
+
+
+def test_match_says_a_target_cut_by_the_border_is_not_judgeable(tmp_path: Path) -> None:
+    """The target's L half outside the frame scores well on what is left of it, but a cut
+    outline is not judged: its row and the error say so, not a score below the threshold."""
+    ell = family_shape("L", 0.6, 0.3)
+    target = _write(
+        tmp_path / "target.png",
+        draw([(place(ell, angle_deg=0, size_px=150, centre=(320, 240)), RED)], shade=False),
+    )
+    frame = _write(
+        tmp_path / "frame.png",
+        draw(
+            [
+                (place(ell, angle_deg=0, size_px=150, centre=(320, 240)), RED),
+                (place(ell, angle_deg=0, size_px=150, centre=(620, 240)), BLUE),
+            ],
+            shade=False,
+        ),
+    )
+    runner = CliRunner()
+    result = runner.invoke(cli, ["vision", "match", str(target), str(frame)])
+    assert result.exit_code == 0, result.output
+    rows = [line for line in result.output.splitlines() if " score " in line]
+    (blue,) = [line for line in rows if "rgb(40, 90, 220)" in line]
+    (red,) = [line for line in rows if "rgb(210, 40, 40)" in line]
+    assert blue.endswith("NOT judgeable (cut by the image border)")
+    assert red.startswith("*") and red.endswith("  judgeable")
+    cut = _write(
+        tmp_path / "cut.png",
+        draw([(place(ell, angle_deg=0, size_px=150, centre=(40, 240)), RED)], shade=False),
+    )
+    result = runner.invoke(cli, ["vision", "match", str(target), str(cut)])
+    assert result.exit_code == 1, result.output
+    assert "NOT judgeable (cut by the image border)" in result.output
+    assert "the best-scoring shape 0 (" in result.output
+    assert "is not judgeable: its outline is cut by the image border" in result.output
 
 
 def test_model_writes_a_glb(tmp_path: Path) -> None:

@@ -78,8 +78,10 @@ def vectorize_cmd(
 def match_cmd(target: Path, frame: Path, threshold: float | None, allow_mirror: bool) -> None:
     """Score every shape of FRAME against the target bitmap TARGET (a picture from above).
 
-    Prints each shape's score (0–1), rotation and scale relative to the target, and the
-    best one. Exits with status 1 when no shape reaches the threshold.
+    Prints each shape's score (0–1), rotation and scale relative to the target and whether
+    it can be judged (a shape cut by the image border cannot: part of its outline is
+    missing), then the best judgeable one. Exits with status 1 when no judgeable shape
+    reaches the threshold, saying so when the best-scoring shape is cut.
 
     \b
     Example:
@@ -96,15 +98,16 @@ def match_cmd(target: Path, frame: Path, threshold: float | None, allow_mirror: 
     report = match_files(target, frame, params=params)
     click.echo(f"target: {len(report.target.polygon_px)} corners, rgb{report.target.colour_rgb}")
     for i, (s, m) in enumerate(zip(report.shapes, report.matches, strict=True)):
-        mark = "*" if i == report.best and m.score >= report.threshold else " "
+        mark = "*" if i == report.best and report.matched else " "
+        judged = "judgeable" if m.judgeable else "NOT judgeable (cut by the image border)"
         click.echo(
             f"{mark}{i:3d}  rgb{s.colour_rgb!s:15s} score {m.score:5.3f}  "
-            f"rotation {m.rotation_deg:7.1f}°  scale {m.scale:5.2f}"
+            f"rotation {m.rotation_deg:7.1f}°  scale {m.scale:5.2f}  {judged}"
             + ("  mirrored" if m.mirrored else "")
         )
-    if report.best < 0 or report.matches[report.best].score < report.threshold:
-        raise FailureError(f"no shape in {frame} matches {target} (threshold {report.threshold})")
-    click.echo(f"best: shape {report.best}, score {report.matches[report.best].score:.3f}")
+    if not report.matched:
+        raise FailureError(f"{frame}: {report.summary()}")
+    click.echo(report.summary())
 
 
 @vision.command("model")

@@ -57,13 +57,42 @@ def vectorize_file(
 
 @dataclass(frozen=True, slots=True)
 class MatchReport:
-    """The target's shape, every shape of the frame with its match, and the best index."""
+    """The target's shape, every shape of the frame with its match, and ``best``: the best
+    judgeable shape's index (−1 if none; a shape cut by the image border is not judged)."""
 
     target: Shape
     shapes: tuple[Shape, ...]
     matches: tuple[Match, ...]
     best: int
     threshold: float
+
+    @property
+    def matched(self) -> bool:
+        """Whether the best judgeable shape reaches the threshold."""
+        return self.best >= 0 and self.matches[self.best].score >= self.threshold
+
+    @property
+    def top(self) -> int:
+        """The highest-scoring shape, judgeable or not (−1 when the frame has none)."""
+        if not self.matches:
+            return -1
+        return max(range(len(self.matches)), key=lambda i: (self.matches[i].score, -i))
+
+    def summary(self) -> str:
+        """One line: the match, or why there is none (no shape, a cut best, a low score)."""
+        if self.matched:
+            return f"best: shape {self.best}, score {self.matches[self.best].score:.3f}"
+        top = self.top
+        if top < 0:
+            why = "the frame has no coloured shape"
+        elif not self.matches[top].judgeable:
+            why = (
+                f"the best-scoring shape {top} ({self.matches[top].score:.3f}) is not "
+                "judgeable: its outline is cut by the image border"
+            )
+        else:
+            why = f"the best, shape {top}, scores {self.matches[top].score:.3f}"
+        return f"no shape matches the target (threshold {self.threshold:g}): {why}"
 
 
 def match_files(
