@@ -49,7 +49,7 @@ class MissionParams:
     between ``recheck_min_score`` and the threshold, or it lies off the photo's centre — the
     vehicle moves over the candidate's roof and looks again; a match in any look counts
     (1 = never look again)."""
-    recheck_min_score: float = 0.5
+    recheck_min_score: float = 0.4
     """Lowest score that makes a candidate worth a second look."""
     recheck_offcentre: float = 0.25
     """A candidate whose centroid is further than this fraction of the photo's half-height
