@@ -44,11 +44,11 @@ class MissionParams:
     min_poi_area_px: float = 150.0
     """Overview shapes smaller than this (square pixels) are not visited."""
     max_looks: int = 3
-    """Photos taken at most at one point of interest. When the first one is doubtful — the
-    candidate has the target's hue but its outline is cut by the image border, or it scores
-    between ``recheck_min_score`` and the threshold, or it lies off the photo's centre — the
-    vehicle moves over the candidate's roof and looks again; a match in any look counts
-    (1 = never look again)."""
+    """Photos taken at most at one point of interest. When a look is doubtful — the candidate
+    has the target's hue but its outline is cut by the image border, or it scores between
+    ``recheck_min_score`` and the threshold, or it lies off the photo's centre — the vehicle
+    climbs ``recheck_climb_m`` over the candidate's roof and looks again; the first match
+    counts (1 = never look again)."""
     recheck_min_score: float = 0.4
     """Lowest score that makes a candidate worth a second look."""
     recheck_offcentre: float = 0.25
