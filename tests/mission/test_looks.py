@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 import pytest
 import shapely  # type: ignore[import-untyped]
 
@@ -14,17 +13,11 @@ from tests.mission.driver import Flight, Flown, fly
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.errors import InputError
 from uavtool.mission import GoTo, Params, Photo, Plan, Recognition, Shapes, Status
-from uavtool.mission.analysis import join_roofs, nadir_shapes
+from uavtool.mission.analysis import nadir_shapes
 from uavtool.mission.params import with_overrides
-from uavtool.vision import Shape
 from uavtool.world import Scene, building_footprint, render
 
 K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
-
-
-def _rect(x0: float, y0: float, x1: float, y1: float, colour: tuple[int, int, int]) -> Shape:
-    ring = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=np.float64)
-    return Shape.from_rings(colour_rgb=colour, polygon_px=ring, holes_px=(), cut_by_border=False)
 
 
 def _looks(flight: Flight, poi: int) -> list[tuple[Photo, Recognition]]:
@@ -52,19 +45,6 @@ def test_noisy_roofs_of_one_building_are_one_shape(paper: Scene, seed: int) -> N
     assert len(exact) == 2 and exact[0].colour_rgb != exact[1].colour_rgb
     assert roof.area_px > sum(s.area_px for s in exact)
     assert roof.colour_rgb == exact[0].colour_rgb
-
-
-def test_join_roofs_keeps_other_colours_and_far_roofs_apart() -> None:
-    a = _rect(0, 0, 100, 50, (197, 38, 38))
-    b = _rect(103, 0, 150, 50, (199, 36, 41))  # 3 levels off, 3 px away: the same building
-    c = _rect(0, 53, 100, 90, (133, 20, 60))  # crimson, 3 px away: another building
-    d = _rect(300, 0, 350, 50, (196, 38, 38))  # red, far away: another building
-    out = join_roofs((a, b, c, d), gap_px=6.0, colour_tolerance_dn=10.0)
-    assert len(out) == 3
-    assert out[0].colour_rgb == a.colour_rgb and out[0].area_px > a.area_px + b.area_px
-    assert out[1] is c and out[2] is d  # untouched shapes keep their own colours
-    assert join_roofs((a, b, c, d), gap_px=6.0, colour_tolerance_dn=0.0) == (a, b, c, d)
-    assert len(join_roofs((a, b), gap_px=6.0, colour_tolerance_dn=2.0)) == 2
 
 
 # --- looking again ----------------------------------------------------------------------------

@@ -3,7 +3,7 @@ does with each frame, and what replay re-runs on every recorded frame."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from uavtool.camera import Intrinsics
 from uavtool.mission.errors import MissionInputError
@@ -19,31 +19,9 @@ def nadir_shapes(params: Params, image_rgb: U8Array) -> tuple[Shape, ...]:
     """Shapes of a photo from above: roofs, with one building's roofs joined."""
     shapes = vectorize(image_rgb, params.vectorize)
     p = params.mission
-    return join_roofs(shapes, gap_px=p.roof_gap_px, colour_tolerance_dn=p.roof_colour_tolerance_dn)
-
-
-def join_roofs(
-    shapes: tuple[Shape, ...], *, gap_px: float, colour_tolerance_dn: float
-) -> tuple[Shape, ...]:
-    """:func:`merge_touching` for roofs whose colours differ by at most ``colour_tolerance_dn``
-    in every RGB channel (0–255): a roof's colour is sampled from a few pixels, so sensor
-    noise gives two roofs of one building slightly different colours. A joined roof takes
-    the colour of the first shape of its colour; the others keep theirs."""
-    if colour_tolerance_dn <= 0.0:
-        return merge_touching(shapes, gap_px=gap_px)
-    # Give each shape the colour of the first earlier shape close enough to its own, so
-    # merge_touching (which joins equal colours) sees one colour per building.
-    keyed: list[Shape] = []
-    for shape in shapes:
-        tol, colour = colour_tolerance_dn, shape.colour_rgb
-        like = next((k for k in keyed if _gap_dn(k.colour_rgb, colour) <= tol), None)
-        keyed.append(shape if like is None else replace(shape, colour_rgb=like.colour_rgb))
-    original = {id(k): s for k, s in zip(keyed, shapes, strict=True)}
-    return tuple(original.get(id(s), s) for s in merge_touching(tuple(keyed), gap_px=gap_px))
-
-
-def _gap_dn(a: tuple[int, int, int], b: tuple[int, int, int]) -> int:
-    return max(abs(a[0] - b[0]), abs(a[1] - b[1]), abs(a[2] - b[2]))
+    return merge_touching(
+        shapes, gap_px=p.roof_gap_px, colour_tolerance_dn=p.roof_colour_tolerance_dn
+    )
 
 
 def side_shapes(params: Params, image_rgb: U8Array) -> tuple[Shape, ...]:

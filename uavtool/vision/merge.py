@@ -1,6 +1,8 @@
 """Joining the roofs of one building: seen from above, a building whose blocks have different
 heights shows one roof per block, split by a thin strip of wall. Same-coloured shapes closer
-than a gap are merged into one outline (a morphological closing of the polygons)."""
+than a gap are merged into one outline (a morphological closing of the polygons). "Same
+colour" may allow a few levels per channel: a shape's colour is sampled from a few pixels,
+so sensor noise gives two roofs of one building slightly different colours."""
 
 from __future__ import annotations
 
@@ -10,10 +12,13 @@ import shapely
 from uavtool.vision.shapes import Shape
 
 
-def merge_touching(shapes: tuple[Shape, ...], *, gap_px: float) -> tuple[Shape, ...]:
+def merge_touching(
+    shapes: tuple[Shape, ...], *, gap_px: float, colour_tolerance_dn: float = 0.0
+) -> tuple[Shape, ...]:
     """Shapes of one colour less than ``gap_px`` apart become one shape (union closed by
     ``gap_px / 2``, mitred so corners stay sharp); others are returned unchanged, in order.
-    The merged shape takes the place of its first member."""
+    Two colours are one when they differ by at most ``colour_tolerance_dn`` in every RGB
+    channel (0–255). The merged shape takes the place and the colour of its first member."""
     if gap_px <= 0.0 or len(shapes) < 2:
         return shapes
     polys = [shapely.Polygon(s.polygon_px, list(s.holes_px)) for s in shapes]
@@ -27,7 +32,7 @@ def merge_touching(shapes: tuple[Shape, ...], *, gap_px: float) -> tuple[Shape, 
     for i in range(len(shapes)):
         for j in range(i + 1, len(shapes)):
             if (
-                shapes[i].colour_rgb == shapes[j].colour_rgb
+                _colour_gap_dn(shapes[i].colour_rgb, shapes[j].colour_rgb) <= colour_tolerance_dn
                 and polys[i].distance(polys[j]) < gap_px
             ):
                 group[root(j)] = root(i)
@@ -57,3 +62,8 @@ def merge_touching(shapes: tuple[Shape, ...], *, gap_px: float) -> tuple[Shape, 
             )
         )
     return tuple(out)
+
+
+def _colour_gap_dn(a: tuple[int, int, int], b: tuple[int, int, int]) -> int:
+    """The largest difference of two RGB colours in one channel."""
+    return max(abs(a[0] - b[0]), abs(a[1] - b[1]), abs(a[2] - b[2]))

@@ -1,0 +1,33 @@
+from __future__ import annotations
+
+import numpy as np
+
+from uavtool.vision import Shape
+from uavtool.vision.merge import merge_touching
+
+
+def _rect(x0: float, y0: float, x1: float, y1: float, colour: tuple[int, int, int]) -> Shape:
+    ring = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=np.float64)
+    return Shape.from_rings(colour_rgb=colour, polygon_px=ring)
+
+
+def test_roofs_of_one_colour_within_the_gap_become_one_shape() -> None:
+    a = _rect(0, 0, 100, 50, (197, 38, 38))
+    b = _rect(103, 0, 150, 50, (197, 38, 38))  # 3 px away: a block of the same building
+    (merged,) = merge_touching((a, b), gap_px=6.0)
+    assert merged.area_px > a.area_px + b.area_px  # the strip of wall between is filled
+    assert merged.polygon_px[:, 0].min() == 0.0 and merged.polygon_px[:, 0].max() == 150.0
+    assert merge_touching((a, b), gap_px=2.0) == (a, b)  # further apart than the gap
+
+
+def test_colour_tolerance_joins_noisy_roofs_and_keeps_other_colours_apart() -> None:
+    a = _rect(0, 0, 100, 50, (197, 38, 38))
+    b = _rect(103, 0, 150, 50, (199, 36, 41))  # 3 levels off, 3 px away: the same building
+    c = _rect(0, 53, 100, 90, (133, 20, 60))  # crimson, 3 px away: another building
+    d = _rect(300, 0, 350, 50, (196, 38, 38))  # red, far away: another building
+    out = merge_touching((a, b, c, d), gap_px=6.0, colour_tolerance_dn=10.0)
+    assert len(out) == 3
+    assert out[0].colour_rgb == a.colour_rgb and out[0].area_px > a.area_px + b.area_px
+    assert out[1] is c and out[2] is d  # untouched shapes keep their own colours
+    assert merge_touching((a, b, c, d), gap_px=6.0) == (a, b, c, d)  # exact colours only
+    assert len(merge_touching((a, b), gap_px=6.0, colour_tolerance_dn=2.0)) == 2
