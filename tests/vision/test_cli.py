@@ -44,13 +44,18 @@ def test_vectorize_writes_shapes_and_overlay(tmp_path: Path) -> None:
     assert cv2.imread(str(overlay)).shape == (960, 1280, 3)
 
 
-def test_match_finds_the_target_and_fails_when_absent(tmp_path: Path) -> None:
-    # Flat roofs (one shade each): `match` compares the brightest shade of each colour.
-    ell = family_shape("L", 0.6, 0.3)
-    target = _write(
+def _l_target(tmp_path: Path, ell: np.ndarray) -> Path:
+    """The target picture: the L in red, flat (one shade), upright in the middle."""
+    return _write(
         tmp_path / "target.png",
         draw([(place(ell, angle_deg=0, size_px=150, centre=(320, 240)), RED)], shade=False),
     )
+
+
+def test_match_finds_the_target_and_fails_when_absent(tmp_path: Path) -> None:
+    # Flat roofs (one shade each): `match` compares the brightest shade of each colour.
+    ell = family_shape("L", 0.6, 0.3)
+    target = _l_target(tmp_path, ell)
     frame = _write(
         tmp_path / "frame.png",
         draw(
@@ -94,10 +99,7 @@ def test_match_says_a_target_cut_by_the_border_is_not_judgeable(tmp_path: Path) 
     """The target's L half outside the frame scores well on what is left of it, but a cut
     outline is not judged: its row and the error say so, not a score below the threshold."""
     ell = family_shape("L", 0.6, 0.3)
-    target = _write(
-        tmp_path / "target.png",
-        draw([(place(ell, angle_deg=0, size_px=150, centre=(320, 240)), RED)], shade=False),
-    )
+    target = _l_target(tmp_path, ell)
     frame = _write(
         tmp_path / "frame.png",
         draw(
