@@ -28,15 +28,12 @@ import argparse
 import json
 import tempfile
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from unittest import mock
 
-import uavtool.runner.fly as fly_module
-from uavtool.mission import Mission, Output, Params, Recognition
+from uavtool.mission import Params
 from uavtool.mission.params import valid_keys, with_overrides
+from uavtool.replay.load import load_flight
 from uavtool.runner.fly import FlightSummary, FlyConfig, fly
 from uavtool.world import load_scene, scene_to_dict
 
@@ -63,10 +60,18 @@ class Condition:
         )
 
 
+@dataclass(frozen=True, slots=True)
+class Seen:
+    """One recognition: the point of interest looked at and its candidate's score."""
+
+    poi: int
+    score: float
+
+
 @dataclass(slots=True)
 class Result:
     summary: FlightSummary
-    recognitions: list[Recognition] = field(default_factory=list)
+    recognitions: list[Seen] = field(default_factory=list)
 
     @property
     def correct(self) -> bool:
@@ -96,20 +101,6 @@ def conditions(
     return out
 
 
-@contextmanager
-def watching(into: list[Recognition]) -> Iterator[None]:
-    """While inside, the mission ``fly`` builds also hands its recognitions to ``into``."""
-
-    class Watched(Mission):
-        def emit(self, output: Output) -> None:
-            if isinstance(output, Recognition):
-                into.append(output)
-            super().emit(output)
-
-    with mock.patch.object(fly_module, "Mission", Watched):
-        yield
-
-
 def scene_arg(cond: Condition, tmp: Path) -> str:
     """The scene's name, or a scene file with the home heading turned."""
     if cond.heading_deg == 0.0:
@@ -122,17 +113,22 @@ def scene_arg(cond: Condition, tmp: Path) -> str:
 
 
 def fly_one(cond: Condition, params: Params, tmp: Path) -> Result:
-    seen: list[Recognition] = []
+    """Fly one condition, recorded; its recognitions are read back from the recording."""
+    record = tmp / "flight.mcap"
     config = FlyConfig(
         scene=scene_arg(cond, tmp),
-        no_record=True,
+        record=record,
         params=params,
         seed=cond.seed,
         noise=cond.noise,
         wind=cond.wind,
     )
-    with watching(seen):
-        summary = fly(config)
+    summary = fly(config)
+    seen = [
+        Seen(out.data["poi"], out.data["score"])
+        for out in load_flight(record).outputs
+        if out.data["type"] == "Recognition"
+    ]
     return Result(summary, seen)
 
 

@@ -7,8 +7,6 @@ from pathlib import Path
 
 import click
 
-from uavtool.errors import InputError
-
 
 @click.command()
 @click.option(
@@ -117,7 +115,7 @@ def fly(
     from uavtool.runner.fly import fly as fly_mission
     from uavtool.runner.params import parse_param
     from uavtool.runner.summary import format_progress, format_summary
-    from uavtool.sitl.config import parse_outage
+    from uavtool.sitl.config import parse_outage, parse_wind
 
     if record is not None and no_record:
         raise click.UsageError("--record and --no-record exclude each other")
@@ -125,13 +123,7 @@ def fly(
     if visit_all:
         overrides["mission.visit_all"] = "true"
     params = with_overrides(Params(), overrides)
-    wind_pair = (0.0, 0.0)
-    if wind is not None:
-        try:
-            speed, direction = (float(v) for v in wind.split(","))
-        except ValueError:
-            raise InputError(f"--wind {wind!r}: expected SPEED,DIR, e.g. 5,270") from None
-        wind_pair = (speed, direction)
+    wind_pair = parse_wind(wind) if wind is not None else (0.0, 0.0)
     config = FlyConfig(
         connect=connect,
         scene=scene,

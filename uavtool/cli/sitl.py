@@ -7,20 +7,9 @@ from pathlib import Path
 
 import click
 
-from uavtool.errors import InputError
-
 
 def _interrupt(_signum: int, _frame: object) -> None:
     raise KeyboardInterrupt
-
-
-def _pair(text: str, what: str) -> tuple[float, float]:
-    parts = text.split(",")
-    try:
-        a, b = (float(p) for p in parts)
-    except ValueError:
-        raise InputError(f"--{what} {text!r}: expected two numbers, e.g. 5,270") from None
-    return a, b
 
 
 @click.command()
@@ -89,14 +78,14 @@ def sitl(
       mavproxy.py --master tcp:127.0.0.1:5760
     """
     from uavtool.sitl import Sitl, SitlConfig, parse_home, parse_signing_key
-    from uavtool.sitl.config import DEFAULT_ENDPOINTS, parse_outage
+    from uavtool.sitl.config import DEFAULT_ENDPOINTS, parse_outage, parse_wind
     from uavtool.sitl.params import load_param_file
 
     kwargs: dict[str, object] = {}
     if home is not None:
         kwargs["home"], kwargs["home_heading_deg"] = parse_home(home)
     if wind is not None:
-        kwargs["wind_speed_ms"], kwargs["wind_dir_deg"] = _pair(wind, "wind")
+        kwargs["wind_speed_ms"], kwargs["wind_dir_deg"] = parse_wind(wind)
     if signing_key is not None:
         kwargs["signing_key"] = parse_signing_key(signing_key)
     if params_file is not None:

@@ -74,6 +74,15 @@ def parse_signing_key(text: str) -> bytes:
     return key
 
 
+def parse_wind(text: str) -> tuple[float, float]:
+    """``SPEED,DIR`` (m/s, blowing from DIR degrees) → (speed, direction)."""
+    try:
+        speed_ms, from_deg = (float(v) for v in text.split(","))
+    except ValueError:
+        raise InputError(f"--wind {text!r}: expected SPEED,DIR, e.g. 5,270") from None
+    return speed_ms, from_deg
+
+
 def parse_outage(text: str) -> tuple[float, float]:
     """``START:DURATION`` (seconds of sim time) → a link outage window."""
     try:

@@ -29,8 +29,9 @@ def rdp_indices(points_px: FloatArray, epsilon_px: float) -> IndexArray:
     n = len(pts)
     if n <= 2:
         return np.arange(n, dtype=np.intp)
-    kept, _ = _simplify(pts[:, 0].copy(), pts[:, 1].copy(), np.arange(n), np.array([n]), epsilon_px)
-    return np.sort(kept)
+    return np.sort(
+        _simplify(pts[:, 0].copy(), pts[:, 1].copy(), np.arange(n), np.array([n]), epsilon_px)
+    )
 
 
 def rdp(points_px: FloatArray, epsilon_px: float) -> FloatArray:
@@ -89,10 +90,10 @@ def rdp_rings_indices(rings_px: list[FloatArray], epsilon_px: float) -> list[Ind
     first = np.stack([i, j], axis=1).ravel()
     idx = _cyclic_runs(np.repeat(bases[cut], 2), first, count, np.repeat(n, 2))
     keep = np.zeros(len(xs), dtype=bool)
-    keep[_simplify(xs, ys, idx, count, epsilon_px)[0]] = True
-    rings = [
-        (k, s, m, (i, j))
-        for k, s, m, i, j in zip(
+    keep[_simplify(xs, ys, idx, count, epsilon_px)] = True
+    rings = [  # (ring, its first index in xs, its length, its two cut points)
+        (k, s, m, (p, q))
+        for k, s, m, p, q in zip(
             np.asarray(todo)[cut].tolist(),
             bases[cut].tolist(),
             n.tolist(),
@@ -137,10 +138,9 @@ def rdp_rings_indices(rings_px: list[FloatArray], epsilon_px: float) -> list[Ind
         s_arr = np.array([where[k][0] for k, _ in check])
         m_arr = np.array([where[k][1] for k, _ in check])
         prev, nxt = np.array(prevs), np.array(nexts)
-        between = _cyclic_runs(s_arr, prev + 1, (nxt - prev) % m_arr - 1, m_arr)
-        ok = _within(
-            xs, ys, between, (nxt - prev) % m_arr - 1, s_arr + prev, s_arr + nxt, epsilon_px
-        )
+        inner = (nxt - prev) % m_arr - 1  # the points between the neighbours, cut point included
+        between = _cyclic_runs(s_arr, prev + 1, inner, m_arr)
+        ok = _within(xs, ys, between, inner, s_arr + prev, s_arr + nxt, epsilon_px)
         for (k, anchor), drop in zip(check, ok, strict=True):
             if drop:
                 kept[k].remove(anchor)
@@ -161,17 +161,17 @@ def _cyclic_runs(
 
 def _simplify(
     xs: FloatArray, ys: FloatArray, idx: IndexArray, counts: IndexArray, epsilon_px: float
-) -> tuple[IndexArray, IndexArray]:
+) -> IndexArray:
     """RDP of the open chains of points ``idx`` (``counts[c]`` for chain ``c``, one after the
-    other) of ``(xs, ys)``: for every point kept, its index into ``xs`` and its chain."""
+    other) of ``(xs, ys)``: the indices into ``xs`` of the points kept."""
     coords = np.stack([xs[idx], ys[idx], idx.astype(np.float64)], axis=1)
     lines = shapely.linestrings(coords, indices=np.repeat(np.arange(len(counts)), counts))
     # Coordinates a subnormal distance apart make GEOS's squared segment length underflow
     # to 0 and divide by it; pixel coordinates never come that close without being equal.
     with np.errstate(divide="ignore", invalid="ignore"):
         simple = shapely.simplify(lines, epsilon_px, preserve_topology=False)
-    kept, chain = shapely.get_coordinates(simple, include_z=True, return_index=True)
-    return kept[:, 2].astype(np.intp), chain
+    kept: IndexArray = shapely.get_coordinates(simple, include_z=True)[:, 2].astype(np.intp)
+    return kept
 
 
 def _within(
