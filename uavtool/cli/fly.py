@@ -29,7 +29,11 @@ import click
     "--camera", default="sim", show_default=True, help="sim, opencv:N (device) or a stream URL."
 )
 @click.option(
-    "--speedup", default=30.0, show_default=True, type=float, help="Built-in SITL speed-up."
+    "--speedup",
+    default=None,
+    metavar="N|max",
+    help="Cap on the built-in vehicle's pace, vehicle seconds per wall second. It never changes "
+    "the flight (lockstep). Default: max (as fast as the CPU allows); 1 with --rerun.",
 )
 @click.option(
     "--record",
@@ -72,7 +76,8 @@ import click
     default=30.0,
     show_default=True,
     type=float,
-    help="Seconds to wait for the vehicle to connect and report its home.",
+    help="Seconds to wait for the vehicle to connect and report its home (vehicle seconds for "
+    "the built-in one).",
 )
 @click.option(
     "--rerun",
@@ -87,7 +92,7 @@ def fly(
     scene: str,
     target: Path | None,
     camera: str,
-    speedup: float,
+    speedup: str | None,
     record: Path | None,
     no_record: bool,
     visit_all: bool,
@@ -129,7 +134,7 @@ def fly(
         scene=scene,
         target=target,
         camera=camera,
-        speedup=speedup,
+        speedup=_speedup(speedup, live=rerun_target is not None),
         record=record,
         no_record=no_record,
         params=params,
@@ -138,7 +143,6 @@ def fly(
         noise=noise,
         wind=wind_pair,
         link_outages_s=tuple(parse_outage(o) for o in outages),
-        command_line=tuple(sys.argv),
         connect_timeout_s=timeout,
         rerun=rerun_target,
     )
@@ -155,3 +159,20 @@ def fly(
     click.echo(format_summary(summary))
     if summary.outcome.status.value not in ("completed", "no-match"):
         sys.exit(1)
+
+
+def _speedup(text: str | None, *, live: bool) -> float | None:
+    """``max`` → None (no cap); a positive number → that cap. Watching live defaults to 1."""
+    if text is None:
+        return 1.0 if live else None
+    if text.strip().lower() == "max":
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not value > 0 or value == float("inf"):
+        raise click.BadParameter(
+            f"{text!r}: expected a positive number or 'max'", param_hint="--speedup"
+        )
+    return value

@@ -50,12 +50,21 @@ class VehicleState:
     statustext: list[tuple[int, str]] = field(default_factory=list)
 
 
+Clock = Callable[[], float]
+"""Seconds on the link's clock: the wall clock (``time.monotonic``) for a vehicle that flies
+in real time, the vehicle's own clock for one stepped in lockstep."""
+
+
 class VehicleLink:
     """A connection to one vehicle. ``poll`` reads what arrived and returns the messages from
-    the vehicle; ``send`` packs and sends. Not thread-safe (the runner owns it)."""
+    the vehicle; ``send`` packs and sends. ``clock`` is what every wait on this link is timed
+    by. Not thread-safe (the runner owns it)."""
 
-    def __init__(self, transport: Transport, *, tap: Tap | None = None) -> None:
+    def __init__(
+        self, transport: Transport, *, tap: Tap | None = None, clock: Clock = time.monotonic
+    ) -> None:
         self.transport = transport
+        self.clock = clock
         self.name = transport.name
         self.tap = tap
         self._parser = FrameParser()
@@ -145,15 +154,16 @@ class VehicleLink:
         self.command_long(M.MAV_CMD_REQUEST_MESSAGE, M.MAVLINK_MSG_ID_HOME_POSITION)
 
     def wait_vehicle(self, timeout_s: float, *, on_wait: Callable[[], None] | None = None) -> None:
-        """Block until a vehicle's heartbeat and home position are known; LinkError if not."""
-        deadline = time.monotonic() + timeout_s
-        last_request = 0.0
-        while self.state.home is None or self.state.position is None or last_request == 0.0:
-            now = time.monotonic()
+        """Block until a vehicle's heartbeat and home position are known (``timeout_s`` on the
+        link's clock); LinkError if not."""
+        deadline = self.clock() + timeout_s
+        last_request: float | None = None
+        while self.state.home is None or self.state.position is None or last_request is None:
+            now = self.clock()
             if now > deadline:
                 what = "heartbeat" if self.target_system == 0 else "home position"
                 raise LinkError(f"{self.name}: no {what} from a vehicle in {timeout_s:g} s")
-            if self.target_system and now - last_request > 2.0:
+            if self.target_system and (last_request is None or now - last_request > 2.0):
                 self.heartbeat()
                 self.request_streams()
                 last_request = now

@@ -1,5 +1,10 @@
 """``uavtool fly`` as a library call: connect (or start the built-in SITL), fly the mission,
-record it, and summarise the flight."""
+record it, and summarise the flight.
+
+The built-in vehicle always flies in lockstep with the runner (:mod:`uavtool.sitl.lockstep`):
+the flight, and its recording byte for byte, depend only on the :class:`FlyConfig`, never on
+the speed-up or the machine. Any other vehicle flies on the wall clock.
+"""
 
 from __future__ import annotations
 
@@ -14,12 +19,13 @@ from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from uavtool import __version__
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.errors import InputError, LinkError
 from uavtool.images import png_decode, png_encode
-from uavtool.link import VehicleLink, open_transport
+from uavtool.link import Clock, Transport, VehicleLink, open_transport
 from uavtool.mavlink.dialect import COPTER_MODES
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mission import Level, Mission, Outcome, Params
@@ -29,9 +35,12 @@ from uavtool.runner.camera import open_camera
 from uavtool.runner.evaluate import Evaluation, evaluate
 from uavtool.runner.live import LiveView
 from uavtool.runner.params import set_vehicle_params
-from uavtool.runner.record import MissionRecorder
-from uavtool.runner.runner import Progress, Runner, RunnerConfig
+from uavtool.runner.record import ClockNs, MissionRecorder
+from uavtool.runner.runner import Progress, Runner
 from uavtool.world import Scene, load_scene, render, scene_to_dict
+
+if TYPE_CHECKING:
+    from uavtool.sitl.lockstep import LockstepTransport
 
 _TARGET_VIEW_M = 30.0  # the default target picture: from this far above its roof
 
@@ -44,7 +53,9 @@ class FlyConfig:
     scene: str = "paper"
     target: Path | None = None
     camera: str = "sim"
-    speedup: float = 30.0
+    speedup: float | None = None
+    """Cap on the built-in vehicle's pace, vehicle seconds per wall second; None: as fast as
+    the CPU allows. It never changes the flight."""
     record: Path | None = None
     """None: ``recordings/<UTC time>.mcap``."""
     no_record: bool = False
@@ -57,7 +68,6 @@ class FlyConfig:
     hfov_deg: float = 60.0
     size_px: tuple[int, int] = (640, 480)
     connect_timeout_s: float = 30.0
-    command_line: tuple[str, ...] = ()
     rerun: str | None = None
     """Stream live to Rerun: ``"spawn"`` (native viewer), ``"web"`` or a ``.rrd`` path."""
 
@@ -72,6 +82,10 @@ class FlightSummary:
     recording: Path | None
     wall_time_s: float
     vehicle: str
+    vehicle_time_s: float
+    """Vehicle time from the first observation to the end of the mission."""
+    flight_wall_s: float
+    """Wall time of the same span (the mission itself, without start-up)."""
 
 
 def default_recording_path(now: datetime | None = None) -> Path:
@@ -113,18 +127,25 @@ def fly(
     )
     with ExitStack() as stack:
         stack.callback(camera.close)
-        connect = config.connect
-        if connect is None:
-            connect = stack.enter_context(_builtin_sitl(config, scene))
-            say(f"built-in SITL at {connect}, speed-up {config.speedup:g}x, scene {scene.name!r}")
+        if config.connect is None:
+            lockstep = stack.enter_context(_builtin_sitl(config, scene))
+            transport: Transport = lockstep
+            clock: Clock = lockstep.clock
+            clock_ns: ClockNs = lockstep.recording_ns
+            pace = "as fast as it can" if config.speedup is None else f"≤ {config.speedup:g}x"
+            say(f"built-in SITL in lockstep ({pace}), scene {scene.name!r}")
+        else:
+            transport = open_transport(config.connect, timeout_s=config.connect_timeout_s)
+            stack.callback(transport.close)
+            clock, clock_ns = time.monotonic, time.time_ns
         path = None if config.no_record else (config.record or default_recording_path())
         recorder = None
         if path is not None:
             path.parent.mkdir(parents=True, exist_ok=True)
             writer = stack.enter_context(
-                RecordingWriter(path, metadata=_metadata(config, scene, connect))
+                RecordingWriter(path, metadata=flight_metadata(config, scene))
             )
-            recorder = MissionRecorder(writer)
+            recorder = MissionRecorder(writer, clock_ns=clock_ns)
             recorder.target(target_png)
         live = None
         if config.rerun is not None:
@@ -133,15 +154,12 @@ def fly(
                 scene=scene if config.camera == "sim" else None,
                 params=to_dict(config.params),
                 target_png=target_png,
+                clock_ns=clock_ns,
             )
             stack.callback(live.close)
             if live.url:
                 say(f"Rerun web viewer at {live.url}")
-        link = VehicleLink(
-            open_transport(connect, timeout_s=config.connect_timeout_s),
-            tap=recorder.mavlink if recorder else None,
-        )
-        stack.callback(link.close)
+        link = VehicleLink(transport, tap=recorder.mavlink if recorder else None, clock=clock)
         link.wait_vehicle(config.connect_timeout_s)
         home = link.state.home
         assert home is not None
@@ -156,7 +174,6 @@ def fly(
             recorder.note(Level.INFO, f"connected to sysid {link.target_system} on {link.name}")
         if config.vehicle_params:
             set_vehicle_params(link, config.vehicle_params)
-        time_scale = config.speedup if config.connect is None else 1.0
         runner = Runner(
             link,
             camera,
@@ -164,14 +181,15 @@ def fly(
             recorder=recorder,
             live=live,
             scene_origin=scene.home if config.camera == "sim" else None,
-            config=RunnerConfig(time_scale=time_scale),
             progress=progress,
         )
+        flight_wall0, vehicle0 = time.perf_counter(), clock()
         try:
             outcome = runner.run()
         except KeyboardInterrupt:
             _abort(link, recorder, "interrupted by the user: RTL sent")
             raise
+        flight_wall_s, vehicle_s = time.perf_counter() - flight_wall0, clock() - vehicle0
         evaluation = evaluate(runner, scene if config.camera == "sim" else None)
         summary = FlightSummary(
             outcome,
@@ -182,6 +200,8 @@ def fly(
             path,
             time.monotonic() - wall0,
             link.name,
+            vehicle_s,
+            flight_wall_s,
         )
         if recorder is not None:
             recorder.outcome(summary_record(summary))
@@ -220,26 +240,33 @@ def _read_target(path: Path) -> bytes:
 
 
 @contextmanager
-def _builtin_sitl(config: FlyConfig, scene: Scene) -> Iterator[str]:
-    from uavtool.sitl import Sitl, SitlConfig  # noqa: PLC0415 - only when flying the built-in one
+def _builtin_sitl(config: FlyConfig, scene: Scene) -> Iterator[LockstepTransport]:
+    # Only when flying the built-in vehicle: a real one needs none of the simulator.
+    from uavtool.sitl import SitlConfig  # noqa: PLC0415
+    from uavtool.sitl.lockstep import SIM_EPOCH_UNIX_S, LockstepTransport  # noqa: PLC0415
 
     sitl_config = SitlConfig(
-        endpoints=("tcpin:127.0.0.1:0",),
+        endpoints=(),
         home=scene.home,
         home_heading_deg=scene.home_heading_deg,
-        speedup=config.speedup,
         seed=config.seed,
         wind_speed_ms=config.wind[0],
         wind_dir_deg=config.wind[1],
         link_outages_s=config.link_outages_s,
+        start_unix_us=SIM_EPOCH_UNIX_S * 1_000_000,
     )
-    with Sitl(sitl_config) as vehicle:
-        yield f"tcp:127.0.0.1:{vehicle.ports[0]}"
-        if vehicle.error is not None:
-            raise LinkError(f"the built-in SITL stopped: {vehicle.error}")
+    transport = LockstepTransport(sitl_config, speedup=config.speedup)
+    try:
+        yield transport
+    finally:
+        transport.close()
 
 
-def _metadata(config: FlyConfig, scene: Scene, connect: str) -> dict[str, dict[str, str]]:
+def flight_metadata(config: FlyConfig, scene: Scene) -> dict[str, dict[str, str]]:
+    """The recording's metadata: a function of the flight's inputs alone (no paths, ports,
+    dates or speed-up), so that the same inputs give the same file; ``flight`` holds what
+    re-flying needs besides the scene, the mission parameters and the target picture."""
+    builtin = config.connect is None
     return {
         "mission": {"params": json.dumps(to_dict(config.params)), "tool_version": __version__},
         "scene": {"name": scene.name, "json": json.dumps(scene_to_dict(scene))},
@@ -248,11 +275,21 @@ def _metadata(config: FlyConfig, scene: Scene, connect: str) -> dict[str, dict[s
             "camera_noise": str(config.seed) if config.noise else "",
         },
         "vehicle": {
-            "connect": connect,
-            "builtin": str(config.connect is None).lower(),
+            "connect": "builtin" if builtin else str(config.connect),
+            "builtin": str(builtin).lower(),
             "camera": config.camera,
+            "clock": "lockstep" if builtin else "wall",
         },
-        "command_line": {"argv": json.dumps(list(config.command_line))},
+        "flight": {
+            "seed": str(config.seed),
+            "noise": json.dumps(config.noise),
+            "wind": json.dumps(list(config.wind)),
+            "link_outages_s": json.dumps([list(o) for o in config.link_outages_s]),
+            "vehicle_params": json.dumps([list(p) for p in config.vehicle_params]),
+            "hfov_deg": json.dumps(config.hfov_deg),
+            "size_px": json.dumps(list(config.size_px)),
+            "target": "file" if config.target else "scene",
+        },
     }
 
 

@@ -10,16 +10,22 @@ from uavtool.geo import GeoPoint
 from uavtool.images import png_encode
 from uavtool.mission import Observation, Output, Photo
 from uavtool.mission.codec import encode_observation, encode_output
-from uavtool.runner.record import now_ns
+from uavtool.runner.record import ClockNs
 from uavtool.world import Scene
 
 
 class LiveView:
     """Sends each observation and output to a Rerun viewer (``rerun`` = ``"spawn"``,
-    ``"web"`` or a ``.rrd`` path)."""
+    ``"web"`` or a ``.rrd`` path), stamped by the recording's clock ``clock_ns``."""
 
     def __init__(
-        self, target: str, *, scene: Scene | None, params: dict[str, Any], target_png: bytes
+        self,
+        target: str,
+        *,
+        scene: Scene | None,
+        params: dict[str, Any],
+        target_png: bytes,
+        clock_ns: ClockNs,
     ) -> None:
         from uavtool.view import open_viewer  # noqa: PLC0415 - rerun is heavy; only with --rerun
 
@@ -36,6 +42,7 @@ class LiveView:
         self.logger.params(params)
         self.logger.target(target_png)
         self._n = 0
+        self.clock_ns = clock_ns
 
     def home(self, home: GeoPoint) -> None:
         self.logger.home(home)
@@ -44,10 +51,10 @@ class LiveView:
         """Show one observation; a photo's frame as ``png`` if the caller encoded it."""
         if png is None and isinstance(obs, Photo):
             png = png_encode(obs.image_rgb)
-        self.logger.observation(step, encode_observation(obs), png, log_time_ns=now_ns())
+        self.logger.observation(step, encode_observation(obs), png, log_time_ns=self.clock_ns())
 
     def outputs(self, step: int, outputs: list[Output]) -> None:
-        t = now_ns()
+        t = self.clock_ns()
         for out in outputs:
             self._n += 1
             self.logger.output(

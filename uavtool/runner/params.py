@@ -3,8 +3,6 @@ parameter protocol: PARAM_SET, confirmed by the PARAM_VALUE echo."""
 
 from __future__ import annotations
 
-import time
-
 from uavtool.errors import ParamError
 from uavtool.link import VehicleLink
 from uavtool.mavlink.dialect import mavlink as M
@@ -36,8 +34,8 @@ def set_vehicle_params(link: VehicleLink, params: tuple[tuple[str, float], ...])
                     M.MAV_PARAM_TYPE_REAL32,
                 )
             )
-            deadline = time.monotonic() + _WAIT_S
-            while time.monotonic() < deadline:
+            deadline = link.clock() + _WAIT_S
+            while link.clock() < deadline:
                 echoed = [
                     m
                     for m in link.poll(0.05)

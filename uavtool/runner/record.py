@@ -5,12 +5,19 @@ mission consumed it, numbered by ``step``) and ``/mission/outputs`` (every outpu
 ``n``, with the ``step`` that produced it): replay reads these. Photos go to ``/camera/*``,
 telemetry also to ``/vehicle/*``, events also to ``/mission/events`` and the model's GLB to
 ``/mission/model`` so Foxglove and Rerun show them natively.
+
+The clock rule: every message's ``log_time`` is when the runner received or produced it on the
+recording's clock — for a simulated flight flown in lockstep, the vehicle's time since boot
+plus a fixed epoch (``uavtool.sitl.lockstep.SIM_EPOCH_NS``); for any other vehicle, the wall
+clock. ``publish_time`` equals ``log_time`` on every channel. The vehicle's own time since
+boot is in the payloads (``time_boot_ms``).
 """
 
 from __future__ import annotations
 
 import json
 import time
+from collections.abc import Callable
 from typing import Any
 
 from uavtool.geo import GeoPoint, geo_from_enu
@@ -67,16 +74,17 @@ _OUT_SCHEMA = {
 _LEVELS = {Level.INFO: LogLevel.INFO, Level.WARNING: LogLevel.WARNING, Level.ERROR: LogLevel.ERROR}
 
 
-def now_ns() -> int:
-    """Receive time for the recording's ``log_time`` (the runner's clock, not the mission's)."""
-    return time.time_ns()
+ClockNs = Callable[[], int]
+"""The recording's clock, integer ns since the Unix epoch (``time.time_ns`` for a real vehicle)."""
 
 
 class MissionRecorder:
-    """Writes a flight into ``writer``. ``home`` is the vehicle's home (for WGS-84 fixes)."""
+    """Writes a flight into ``writer``, each message stamped by ``clock_ns``. ``home`` is the
+    vehicle's home (for WGS-84 fixes)."""
 
-    def __init__(self, writer: RecordingWriter) -> None:
+    def __init__(self, writer: RecordingWriter, *, clock_ns: ClockNs = time.time_ns) -> None:
         self.writer = writer
+        self.clock_ns = clock_ns
         self.home: GeoPoint | None = None
         writer.add_json_topic(OBSERVATIONS, schema_name="uavtool.Observation", schema=_OBS_SCHEMA)
         writer.add_json_topic(OUTPUTS, schema_name="uavtool.Output", schema=_OUT_SCHEMA)
@@ -86,40 +94,36 @@ class MissionRecorder:
         self.writer.write_mavlink(
             frame,
             direction=Direction.IN if direction == "in" else Direction.OUT,
-            log_time_ns=now_ns(),
+            log_time_ns=self.clock_ns(),
         )
 
     def target(self, png: bytes) -> None:
-        self.writer.write(TARGET, CompressedImage(png, frame_id="target"), log_time_ns=now_ns())
+        self.writer.write(
+            TARGET, CompressedImage(png, frame_id="target"), log_time_ns=self.clock_ns()
+        )
 
     def observation(self, step: int, obs: Observation, png: bytes | None = None) -> None:
         """Record one observation; a photo's frame as ``png`` if the caller encoded it."""
-        t = now_ns()
-        vehicle_ns = _vehicle_ns(obs)
+        t = self.clock_ns()
         if isinstance(obs, Photo):
             self.writer.write(
                 IMAGE,
                 CompressedImage(png if png is not None else png_encode(obs.image_rgb)),
                 log_time_ns=t,
-                publish_time_ns=vehicle_ns,
             )
             self.writer.write(
                 CALIBRATION,
                 CameraCalibration.from_intrinsics(obs.intrinsics),
                 log_time_ns=t,
-                publish_time_ns=vehicle_ns,
             )
             self.writer.write(
                 CAMERA_POSE,
                 FrameTransform.from_camera_pose(obs.pose),
                 log_time_ns=t,
-                publish_time_ns=vehicle_ns,
             )
         elif isinstance(obs, Telemetry):
             pose = Pose.from_enu_heading(obs.pos_enu_m, obs.heading_deg)
-            self.writer.write(
-                POSE, PosesInFrame((pose,)), log_time_ns=t, publish_time_ns=vehicle_ns
-            )
+            self.writer.write(POSE, PosesInFrame((pose,)), log_time_ns=t)
             if self.home is not None:
                 x, y, z = obs.pos_enu_m
                 geo = geo_from_enu(self.home, x, y, z)
@@ -127,29 +131,17 @@ class MissionRecorder:
                     FIX,
                     LocationFix(geo.lat_deg, geo.lon_deg, geo.alt_amsl_m),
                     log_time_ns=t,
-                    publish_time_ns=vehicle_ns,
                 )
         payload = {"step": step, **encode_observation(obs)}
-        self.writer.write_json(OBSERVATIONS, payload, log_time_ns=t, publish_time_ns=vehicle_ns)
+        self.writer.write_json(OBSERVATIONS, payload, log_time_ns=t)
 
-    def outputs(
-        self,
-        step: int,
-        outputs: list[Output],
-        *,
-        log_time_ns: int | None = None,
-        vehicle_time_ms: int | None = None,
-    ) -> None:
-        """Write outputs; ``vehicle_time_ms`` (the mission's time when it produced them) goes to
-        ``publish_time``."""
-        t = now_ns() if log_time_ns is None else log_time_ns
-        pub = vehicle_time_ms * 1_000_000 if vehicle_time_ms else None
+    def outputs(self, step: int, outputs: list[Output]) -> None:
+        """Write the outputs of one mission step."""
+        t = self.clock_ns()
         for out in outputs:
             self._outputs += 1
             glb = out.glb if isinstance(out, ModelBuilt) else None
-            self.write_output(
-                self._outputs, step, encode_output(out), glb=glb, log_time_ns=t, publish_time_ns=pub
-            )
+            self.write_output(self._outputs, step, encode_output(out), glb=glb, log_time_ns=t)
 
     def write_output(
         self,
@@ -159,7 +151,6 @@ class MissionRecorder:
         *,
         glb: bytes | None = None,
         log_time_ns: int,
-        publish_time_ns: int | None = None,
     ) -> None:
         """One output in its JSON form (``n``, ``step``, ``encode_output``), plus its Foxglove
         view: an event as a log line, a model's ``glb`` as a 3D model."""
@@ -167,7 +158,6 @@ class MissionRecorder:
             OUTPUTS,
             {"n": n, "step": step, **data},
             log_time_ns=log_time_ns,
-            publish_time_ns=publish_time_ns,
         )
         if data.get("type") == "Event":
             entry = LogEntry(_LEVELS[Level(data["level"])], str(data["text"]))
@@ -177,15 +167,12 @@ class MissionRecorder:
 
     def note(self, level: Level, text: str, *, name: str = "runner") -> None:
         """A runner event (connection, vehicle STATUSTEXT …) on the events topic only."""
-        self.writer.write(EVENTS, LogEntry(_LEVELS[level], text, name=name), log_time_ns=now_ns())
+        self.writer.write(
+            EVENTS, LogEntry(_LEVELS[level], text, name=name), log_time_ns=self.clock_ns()
+        )
 
     def outcome(self, record: dict[str, Any]) -> None:
         self.writer.add_metadata("outcome", {k: _text(v) for k, v in record.items()})
-
-
-def _vehicle_ns(obs: Observation) -> int | None:
-    ms = getattr(obs, "time_boot_ms", None)
-    return ms * 1_000_000 if isinstance(ms, int) and ms > 0 else None
 
 
 def _text(value: Any) -> str:

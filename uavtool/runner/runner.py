@@ -2,13 +2,13 @@
 observations, feeds them to the mission one at a time, executes its commands, takes its
 photos, and records every input and output.
 
-It waits on telemetry, never on fixed sleeps. Its only clocks are the link's silence (wall
-time scaled by the vehicle's speed-up) and, for command acknowledgements, vehicle time.
+It waits on telemetry, never on fixed sleeps. Its clocks are the link's (``VehicleLink.clock``:
+the wall clock for a real vehicle, the vehicle's own clock in lockstep) for silence and its own
+heartbeat, and vehicle time for command acknowledgements.
 """
 
 from __future__ import annotations
 
-import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -44,14 +44,13 @@ Progress = Callable[[str, Telemetry | None], None]
 
 @dataclass(frozen=True, slots=True)
 class RunnerConfig:
-    """``time_scale``: vehicle seconds per wall second (the SITL's speed-up, 1 for a real
-    vehicle). Timeouts are in vehicle seconds."""
+    """Timeouts: ``ack_timeout_s`` in vehicle time, the others on the link's clock."""
 
-    time_scale: float = 1.0
     ack_timeout_s: float = 3.0
     link_timeout_s: float = 3.0
-    min_link_timeout_wall_s: float = 0.5
     link_report_s: float = 1.0
+    heartbeat_s: float = 1.0
+    poll_s: float = 0.02
 
 
 class Runner:
@@ -86,10 +85,9 @@ class Runner:
         self._pending: dict[int, tuple[int, int]] = {}  # MAV_CMD -> (action id, vehicle ms)
         self._gimbal = (0.0, 0.0)
         self._last: Telemetry | None = None
-        self._silent_since: float | None = None
         self._lost_reported = 0.0
         self._link_lost = False
-        self._last_heartbeat = 0.0
+        self._last_heartbeat: float | None = None
         self.scene_offset = (0.0, 0.0)  # vehicle home in the scene's frame (east, north)
 
     # --- the loop ---------------------------------------------------------------------------
@@ -103,13 +101,14 @@ class Runner:
             east, north, _ = enu_from_geo(self.scene_origin, home)
             self.scene_offset = (east, north)
         self._handle(self.mission.start())
-        last_rx = time.monotonic()
+        clock = self.link.clock
+        last_rx = clock()
         while True:
             self._drain()
             if self.mission.done:
                 break
-            msgs = self.link.poll(0.02)
-            now = time.monotonic()
+            msgs = self.link.poll(self.config.poll_s)
+            now = clock()
             if msgs:
                 if self._link_lost:
                     self._link_lost = False
@@ -119,7 +118,7 @@ class Runner:
                     self._on_message(msg)
             else:
                 self._check_silence(now, last_rx)
-            if now - self._last_heartbeat > 1.0:
+            if self._last_heartbeat is None or now - self._last_heartbeat > self.config.heartbeat_s:
                 self._heartbeat(now)
         assert self.mission.outcome is not None
         return self.mission.outcome
@@ -141,10 +140,7 @@ class Runner:
 
     def _handle(self, outputs: list[Output]) -> None:
         if self.recorder is not None:
-            last = self.mission.last
-            self.recorder.outputs(
-                self.step, outputs, vehicle_time_ms=last.time_boot_ms if last else None
-            )
+            self.recorder.outputs(self.step, outputs)
         if self.live is not None:
             self.live.outputs(self.step, outputs)
         for out in outputs:
@@ -178,7 +174,7 @@ class Runner:
         elif kind == "HEARTBEAT":
             # Pace our heartbeat by the vehicle's: at any speed-up the vehicle hears us as
             # often as it speaks, so its ground-station failsafe never fires by accident.
-            self._heartbeat(time.monotonic())
+            self._heartbeat(self.link.clock())
         elif kind == "STATUSTEXT" and self.recorder is not None:
             self.recorder.note(Level.INFO, f"vehicle: {msg.text}", name="vehicle")  # type: ignore[attr-defined]
 
@@ -202,16 +198,15 @@ class Runner:
 
     def _check_silence(self, now: float, last_rx: float) -> None:
         c = self.config
-        wall_limit = max(c.link_timeout_s / c.time_scale, c.min_link_timeout_wall_s)
-        if now - last_rx < wall_limit:
+        if now - last_rx < c.link_timeout_s:
             return
-        if not self._link_lost or now - self._lost_reported >= c.link_report_s / c.time_scale:
+        if not self._link_lost or now - self._lost_reported >= c.link_report_s:
             self._link_lost = True
             self._lost_reported = now
             self._queue.append(LinkLost(self._silent_s(now, last_rx)))
 
     def _silent_s(self, now: float, last_rx: float) -> float:
-        return round((now - last_rx) * self.config.time_scale, 3)
+        return round(now - last_rx, 3)
 
     def _heartbeat(self, now: float) -> None:
         self._last_heartbeat = now

@@ -28,6 +28,9 @@ class SitlConfig:
     seed: int = 0
     signing_key: bytes | None = None
     params: tuple[tuple[str, float], ...] = ()
+    start_unix_us: int | None = None
+    """What the vehicle's clock (SYSTEM_TIME) reads at boot; None: the wall clock at start.
+    Lockstep flights fix it so that the bytes the vehicle sends depend on nothing else."""
     link_outages_s: tuple[tuple[float, float], ...] = ()
     """Fault injection: ``(start, duration)`` windows of sim time (s since start) during which
     every link is cut both ways, as if the radio failed."""

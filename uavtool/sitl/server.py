@@ -71,7 +71,9 @@ class Sitl:
             self.autopilot,
             sysid=self.sysid,
             instance=config.instance,
-            start_unix_us=int(time.time() * 1e6),
+            start_unix_us=(
+                int(time.time() * 1e6) if config.start_unix_us is None else config.start_unix_us
+            ),
         )
         self.sessions: list[GcsSession] = []
         self._selector = selectors.DefaultSelector()
@@ -142,6 +144,23 @@ class Sitl:
             out.append(f"{ep.kind}:{ep.host}:{port}")
         return out
 
+    def attach(self, name: str, send: Callable[[bytes], None]) -> Link:
+        """A link to a peer that is not a socket: the vehicle hands its bytes to ``send``, and
+        the peer's bytes come in through :meth:`deliver` (the lockstep transport uses this)."""
+        return self._make_link(name, send)
+
+    def deliver(self, link: Link, data: bytes) -> None:
+        """Bytes that arrived from ``link``'s peer: parse them and act on every whole frame
+        (lost, as on a radio, while a fault-injected outage lasts)."""
+        self.rx_bytes += len(data)
+        if self.link_down:
+            return
+        for frame in link.receive(data):
+            try:
+                link.session.handle(frame)
+            except Exception:  # a bug must not let one peer take the vehicle down
+                log.exception("error handling %s from %s", frame.msg.get_type(), link.name)
+
     # ------------------------------------------------------------------ parameters
     def set_param(self, name: str, value: float) -> float:
         stored = self.autopilot.params.set(name, value)
@@ -190,14 +209,7 @@ class Sitl:
         for key, _ in self._selector.select(max(timeout_s, 0.0)):
             owner: _Socketed = key.data
             for link, data in owner.on_readable():
-                self.rx_bytes += len(data)
-                if self.link_down:
-                    continue
-                for frame in link.receive(data):
-                    try:
-                        link.session.handle(frame)
-                    except Exception:  # a bug must not let one peer take the vehicle down
-                        log.exception("error handling %s from %s", frame.msg.get_type(), link.name)
+                self.deliver(link, data)
             if isinstance(owner, TcpListener):
                 while owner.accepted:
                     self._register(owner.accepted.pop())
