@@ -52,3 +52,14 @@ def assert_replays_identically(path: str | Path) -> None:
         raise AssertionError(
             f"{path}: diverged at step {result.divergence.step}: {result.divergence.reason}"
         )
+
+
+def assert_reflies_identically(path: str | Path) -> None:
+    """Fly ``path``'s configuration again on the built-in vehicle, in lockstep, and compare the
+    new recording with it; AssertionError with the first difference. Only for recordings
+    made by ``uavtool fly`` on the built-in vehicle."""
+    from uavtool.replay.refly import refly  # noqa: PLC0415 - keep pytest start-up light
+
+    result = refly(path)
+    if result.first_difference is not None:
+        raise AssertionError(f"{path}: re-flown: {result.first_difference}")

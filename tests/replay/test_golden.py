@@ -6,11 +6,17 @@ from pathlib import Path
 
 from uavtool.replay import load_flight
 from uavtool.replay.golden import digest, digest_path
-from uavtool.testing import assert_replays_identically
+from uavtool.testing import assert_reflies_identically, assert_replays_identically
 
 
 def test_golden_replays_identically(uavtool_recording: Path) -> None:
     assert_replays_identically(uavtool_recording)
+
+
+def test_golden_reflies_identically(uavtool_recording: Path) -> None:
+    """Flown again from its metadata, each golden gives the same recording: the vehicle, the
+    link, the renderer and the mission together."""
+    assert_reflies_identically(uavtool_recording)
 
 
 def test_golden_digest_is_current(uavtool_recording: Path) -> None:

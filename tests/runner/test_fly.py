@@ -21,7 +21,7 @@ from uavtool.runner.fly import FlyConfig, fly
 @pytest.fixture(scope="module")
 def paper_flight(tmp_path_factory: pytest.TempPathFactory) -> tuple[object, Path]:
     path = tmp_path_factory.mktemp("fly") / "paper.mcap"
-    summary = fly(FlyConfig(record=path, speedup=30.0))
+    summary = fly(FlyConfig(record=path))
     return summary, path
 
 
@@ -50,9 +50,7 @@ def test_recording_is_whole_and_replays_identically(paper_flight: tuple[object, 
 
 def test_fly_cli_prints_progress_and_summary(tmp_path: Path) -> None:
     rec = tmp_path / "r.mcap"
-    result = CliRunner().invoke(
-        cli, ["fly", "--scene", "blocked-front", "--speedup", "30", "--record", str(rec)]
-    )
+    result = CliRunner().invoke(cli, ["fly", "--scene", "blocked-front", "--record", str(rec)])
     assert result.exit_code == 0, result.output
     out = result.output
     assert "points of interest; visiting order" in out
@@ -68,7 +66,6 @@ def test_link_lost_for_good_ends_the_mission(tmp_path: Path) -> None:
     summary = fly(
         FlyConfig(
             record=tmp_path / "lost.mcap",
-            speedup=30.0,
             params=params,
             link_outages_s=((40.0, 1000.0),),
         )

@@ -14,7 +14,7 @@ from uavtool.cli import cli
 def test_fly_rerun_streams_the_same_entities_as_view(tmp_path: Path) -> None:
     live = tmp_path / "live.rrd"
     result = CliRunner().invoke(
-        cli, ["fly", "-q", "--no-record", "--speedup", "30", "--rerun", str(live)]
+        cli, ["fly", "-q", "--no-record", "--speedup", "max", "--rerun", str(live)]
     )
     assert result.exit_code == 0, result.output
     data, blueprint = read_rrd(live)

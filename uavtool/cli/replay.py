@@ -45,6 +45,13 @@ from uavtool.errors import InputError
     help="Rewrite RECORDING's outputs (and its .outputs.txt digest) with what the mission "
     "produces now. Deliberate: only when behaviour is meant to change.",
 )
+@click.option(
+    "--refly",
+    is_flag=True,
+    help="Fly RECORDING's configuration again on the built-in vehicle, in lockstep, from its "
+    "metadata alone, and compare the new recording with it message by message (exit 1 at the "
+    "first difference). --out keeps the new recording.",
+)
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar.")
 def replay(
     recording: Path,
@@ -54,6 +61,7 @@ def replay(
     out: Path | None,
     vision_only: bool,
     update_golden: bool,
+    refly: bool,
     quiet: bool,
 ) -> None:
     """Feed RECORDING's observations to a fresh mission and compare every output.
@@ -63,12 +71,20 @@ def replay(
       uavtool replay --check recordings/golden/paper.mcap
       uavtool replay recordings/golden/paper.mcap --set recognize.threshold=0.9
       uavtool replay flight.mcap --set vectorize.rdp_epsilon_px=3 --out replayed.mcap
+      uavtool replay --refly recordings/golden/paper.mcap   # vehicle, renderer and mission
     """
     from uavtool.mission.params import parse_settings, with_overrides
     from uavtool.replay import load_flight, reanalyse_frames
     from uavtool.replay import replay as run_replay
     from uavtool.replay.write import write_replay
 
+    if refly:
+        if settings or params_file or vision_only or update_golden or check:
+            raise click.UsageError(
+                "--refly flies the recorded configuration as it is: it takes only --out"
+            )
+        _refly(recording, out)
+        return
     if update_golden:
         from uavtool.replay.golden import update_golden as update
 
@@ -131,6 +147,23 @@ def replay(
                 click.echo(change.describe())
     if check and not vision_only and result.first_difference is not None:
         sys.exit(1)
+
+
+def _refly(recording: Path, out: Path | None) -> None:
+    from uavtool.replay.refly import refly
+
+    result = refly(recording, out=out)
+    s = result.summary
+    click.echo(
+        f"{recording}: flown again in lockstep, {s.vehicle_time_s:.1f} s of vehicle time in "
+        f"{s.flight_wall_s:.1f} s; {result.messages} messages compared"
+        + (f"; new recording {out}" if out is not None else "")
+    )
+    if result.first_difference is None:
+        click.echo("identical: the new recording equals the old one")
+        return
+    click.echo(f"first difference: {result.first_difference}")
+    sys.exit(1)
 
 
 class _NoBar:

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from uavtool.replay.load import RecordedOutput, load_flight
+from uavtool.replay.refly import is_lockstep, refly
 from uavtool.replay.replay import replay
 from uavtool.replay.write import write_replay
 
@@ -50,11 +51,24 @@ def _round(value: Any) -> Any:
 
 
 def update_golden(recording: Path) -> tuple[int, int]:
-    """Replay ``recording`` with its own parameters and rewrite its outputs (and digest) with
-    what the mission produces now. Returns (outputs before, outputs after). The observations
-    are kept: when the mission's decisions change, fly the golden again instead (see
-    ``recordings/README.md``) — this refuses a replay that diverges."""
+    """Bring ``recording`` and its digest up to what the code does now; returns (outputs
+    before, outputs after).
+
+    A lockstep flight of the built-in vehicle is flown again from its own metadata and
+    replaced whole, so that it still re-flies identically. Any other recording keeps its
+    observations and gets the outputs the mission produces from them now; that refuses a
+    replay that diverges."""
     flight = load_flight(recording)
+    if is_lockstep(recording):
+        tmp = recording.with_suffix(".mcap.tmp")
+        try:
+            refly(recording, out=tmp, compare=False)
+            tmp.replace(recording)
+        finally:
+            tmp.unlink(missing_ok=True)
+        outputs = load_flight(recording).outputs
+        digest_path(recording).write_text(digest(outputs))
+        return len(flight.outputs), len(outputs)
     result = replay(flight)
     if result.divergence is not None:
         from uavtool.replay.load import ReplayInputError  # noqa: PLC0415

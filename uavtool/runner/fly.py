@@ -50,7 +50,8 @@ class FlyConfig:
     """What ``uavtool fly`` options set. ``connect`` None starts the built-in SITL."""
 
     connect: str | None = None
-    scene: str = "paper"
+    scene: str | Scene = "paper"
+    """A built-in scene's name, a scene file, or a loaded scene."""
     target: Path | None = None
     camera: str = "sim"
     speedup: float | None = None
@@ -114,7 +115,7 @@ def fly(
     reached. ``progress`` hears each mission event, ``status`` the set-up steps."""
     say = status or (lambda _text: None)
     wall0 = time.monotonic()
-    scene = load_scene(config.scene)
+    scene = config.scene if isinstance(config.scene, Scene) else load_scene(config.scene)
     w, h = config.size_px
     intrinsics = Intrinsics.from_hfov(width_px=w, height_px=h, hfov_deg=config.hfov_deg)
     target_png = _read_target(config.target) if config.target else target_picture(scene, intrinsics)

@@ -1,0 +1,77 @@
+"""Re-fly: a recording's configuration flown again from its metadata, the new recording
+compared with the old one message by message."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from click.testing import CliRunner
+
+from tests.recording.sample import write_sample
+from uavtool.cli import cli
+from uavtool.recording import RecordingWriter
+from uavtool.replay.refly import compare_recordings
+from uavtool.sitl.lockstep import SIM_EPOCH_NS
+
+GOLDEN = Path(__file__).parents[2] / "recordings" / "golden" / "paper.mcap"
+
+
+def test_refly_cli_reports_identical(tmp_path: Path) -> None:
+    out = tmp_path / "again.mcap"
+    result = CliRunner().invoke(cli, ["replay", "--refly", str(GOLDEN), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "identical: the new recording equals the old one" in result.output
+    assert out.exists()
+
+
+def test_refly_refuses_what_lockstep_did_not_fly(tmp_path: Path) -> None:
+    sample = tmp_path / "sample.mcap"
+    write_sample(sample)
+    result = CliRunner().invoke(cli, ["replay", "--refly", str(sample)])
+    assert result.exit_code == 2, result.output
+    assert "not a lockstep flight of the built-in vehicle" in result.output
+    assert "Traceback" not in result.output
+
+
+def test_refly_takes_no_overrides() -> None:
+    result = CliRunner().invoke(cli, ["replay", "--refly", str(GOLDEN), "--set", "a.b=1"])
+    assert result.exit_code == 2
+    assert "--refly" in result.output
+
+
+def _write(path: Path, payloads: list[Mapping[str, Any]]) -> Path:
+    with RecordingWriter(path, metadata={"flight": {"seed": "0"}}) as writer:
+        writer.add_json_topic("/t", schema_name="t", schema={"type": "object"})
+        for i, payload in enumerate(payloads):
+            writer.write_json("/t", payload, log_time_ns=SIM_EPOCH_NS + i * 100_000_000)
+    return path
+
+
+def test_compare_names_the_first_differing_field(tmp_path: Path) -> None:
+    a = _write(tmp_path / "a.mcap", [{"x": 1}, {"x": 2, "p": [0.5, 1.5]}])
+    b = _write(tmp_path / "b.mcap", [{"x": 1}, {"x": 2, "p": [0.5, 1.25]}])
+    count, diff = compare_recordings(a, b)
+    assert count == 1
+    assert diff == "message 1 (/t, vehicle time 0.100 s): p[1]: 1.5 recorded, 1.25 re-flown"
+
+
+def test_compare_notices_a_missing_message(tmp_path: Path) -> None:
+    a = _write(tmp_path / "a.mcap", [{"x": 1}, {"x": 2}])
+    b = _write(tmp_path / "b.mcap", [{"x": 1}])
+    assert compare_recordings(a, b) == (
+        1,
+        "the recorded flight has more messages, from message 1 (/t, vehicle time 0.100 s)",
+    )
+    assert compare_recordings(a, a) == (2, None)
+
+
+def test_compare_ignores_the_software_version_only(tmp_path: Path) -> None:
+    for i, (version, params) in enumerate([("0.1.0", "a"), ("9.9.9", "a"), ("0.1.0", "b")]):
+        meta = {"mission": {"tool_version": version, "params": params}}
+        with RecordingWriter(tmp_path / f"{i}.mcap", metadata=meta):
+            pass
+    assert compare_recordings(tmp_path / "0.mcap", tmp_path / "1.mcap") == (0, None)
+    _, diff = compare_recordings(tmp_path / "0.mcap", tmp_path / "2.mcap")
+    assert diff == 'metadata mission.params: "a" recorded, "b" re-flown'
