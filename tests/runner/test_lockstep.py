@@ -3,6 +3,7 @@ any speed-up, under any load, with every fault injected — and its recording ru
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -12,12 +13,14 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from uavtool.camera import CameraPose
 from uavtool.cli import cli
 from uavtool.mission import Params, Status
 from uavtool.mission.params import with_overrides
 from uavtool.recording import RecordingReader
+from uavtool.runner.camera import SimCamera
 from uavtool.runner.fly import FlyConfig, fly
-from uavtool.sitl.lockstep import SIM_EPOCH_NS
+from uavtool.sitl.lockstep import SIM_EPOCH_NS, LockstepTransport
 
 # The link is cut for good 15 s into the flight; the mission gives up 5 s later: a short
 # flight that still crosses the vehicle, the link, the camera and the mission.
@@ -127,3 +130,38 @@ def test_speedup_must_be_positive_or_max(tmp_path: Path, bad: str) -> None:
     result = CliRunner().invoke(cli, ["fly", "--no-record", "--speedup", bad])
     assert result.exit_code == 2
     assert "--speedup" in result.output and "'max'" in result.output
+
+
+def test_photos_are_rendered_where_the_vehicle_really_is(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With 2 m of GPS noise the telemetry (and so the mission) is wrong about the position;
+    the simulated camera is not: it renders at the vehicle's true pose at that instant."""
+    truths: list[CameraPose] = []
+    rendered: list[CameraPose] = []
+    true_pose = LockstepTransport.camera_pose
+
+    def spy_truth(self: LockstepTransport) -> CameraPose:
+        truths.append(true_pose(self))
+        return truths[-1]
+
+    capture = SimCamera.capture
+
+    def spy_capture(self: SimCamera, pose: CameraPose) -> object:
+        rendered.append(pose)
+        return capture(self, pose)
+
+    monkeypatch.setattr(LockstepTransport, "camera_pose", spy_truth)
+    monkeypatch.setattr(SimCamera, "capture", spy_capture)
+    path = tmp_path / "noisy.mcap"
+    fly(FlyConfig(record=path, vehicle_params=(("SIM_GPS_NOISE", 2.0),), seed=4))
+    assert rendered and rendered == truths  # the paper scene's home is the vehicle's
+    with RecordingReader(path) as reader:
+        told = [
+            e.value.payload["pose"]["pos_enu_m"]
+            for e in reader.entries(["/mission/observations"])
+            if e.value.payload["type"] == "Photo"  # type: ignore[union-attr]
+        ]
+    assert len(told) == len(rendered)
+    errors = [math.dist(t, r.pos_enu_m) for t, r in zip(told, rendered, strict=True)]
+    assert max(errors) > 0.5  # the noise is real: the mission is told another pose

@@ -133,12 +133,13 @@ def fly(
             transport: Transport = lockstep
             clock: Clock = lockstep.clock
             clock_ns: ClockNs = lockstep.recording_ns
+            true_pose: Callable[[], CameraPose] | None = lockstep.camera_pose
             pace = "as fast as it can" if config.speedup is None else f"≤ {config.speedup:g}x"
             say(f"built-in SITL in lockstep ({pace}), scene {scene.name!r}")
         else:
             transport = open_transport(config.connect, timeout_s=config.connect_timeout_s)
             stack.callback(transport.close)
-            clock, clock_ns = time.monotonic, time.time_ns
+            clock, clock_ns, true_pose = time.monotonic, time.time_ns, None
         path = None if config.no_record else (config.record or default_recording_path())
         recorder = None
         if path is not None:
@@ -182,6 +183,7 @@ def fly(
             recorder=recorder,
             live=live,
             scene_origin=scene.home if config.camera == "sim" else None,
+            true_pose=true_pose,
             progress=progress,
         )
         flight_wall0, vehicle0 = time.perf_counter(), clock()

@@ -13,6 +13,7 @@ from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from uavtool.camera import CameraPose
 from uavtool.geo import GeoPoint, enu_from_geo
 from uavtool.images import png_encode
 from uavtool.link import VehicleLink
@@ -55,7 +56,9 @@ class RunnerConfig:
 
 class Runner:
     """Flies ``mission`` on ``link`` with ``camera``; ``scene_origin`` is the geographic
-    origin of the camera's world (the scene's home) when it is simulated."""
+    origin of the camera's world (the scene's home) when it is simulated. ``true_pose``, for
+    a simulated vehicle, says where its camera really is (ENU around its home): photos are
+    rendered there, while the mission is told the pose the telemetry reports."""
 
     def __init__(
         self,
@@ -66,6 +69,7 @@ class Runner:
         recorder: MissionRecorder | None,
         live: LiveView | None = None,
         scene_origin: GeoPoint | None = None,
+        true_pose: Callable[[], CameraPose] | None = None,
         config: RunnerConfig = RunnerConfig(),
         progress: Progress | None = None,
     ) -> None:
@@ -77,6 +81,7 @@ class Runner:
         self.config = config
         self.progress = progress or (lambda _text, _t: None)
         self.scene_origin = scene_origin
+        self.true_pose = true_pose
         self.step = 0
         self.frames = 0
         self.coalesced = 0  # telemetry snapshots superseded before the mission saw them
@@ -228,7 +233,9 @@ class Runner:
         t = self._last
         assert t is not None  # the mission photographs only after telemetry
         pose = camera_pose(t)
-        image = self.camera.capture(camera_pose(t, offset_enu_m=self.scene_offset))
+        at = self.true_pose() if self.true_pose is not None else pose
+        (x, y, z), (dx, dy) = at.pos_enu_m, self.scene_offset
+        image = self.camera.capture(CameraPose((x + dx, y + dy, z), at.heading_deg, at.pitch_deg))
         photo = Photo(
             cmd.id, self.frames, cmd.tag, t.time_boot_ms, pose, self.camera.intrinsics, image
         )

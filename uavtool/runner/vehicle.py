@@ -67,12 +67,10 @@ def _attitude_heading(link: VehicleLink) -> float:
     return math.degrees(att.yaw) % 360.0 if att is not None else 0.0
 
 
-def camera_pose(t: Telemetry, *, offset_enu_m: tuple[float, float] = (0.0, 0.0)) -> CameraPose:
-    """The camera's pose from telemetry; ``offset_enu_m`` shifts it into another frame (the
-    scene's, when the vehicle's home is not the scene's origin)."""
-    x, y, z = t.pos_enu_m
+def camera_pose(t: Telemetry) -> CameraPose:
+    """The camera's pose as the telemetry reports it (ENU around the vehicle's home)."""
     return CameraPose.from_vehicle(
-        pos_enu_m=(x + offset_enu_m[0], y + offset_enu_m[1], z),
+        pos_enu_m=t.pos_enu_m,
         vehicle_heading_deg=t.heading_deg,
         gimbal_pitch_deg=t.gimbal_pitch_deg,
         gimbal_yaw_deg=t.gimbal_yaw_deg,

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import time
 
+from uavtool.camera import CameraPose
 from uavtool.sitl.config import SitlConfig
 from uavtool.sitl.server import Sitl
 
@@ -56,6 +57,16 @@ class LockstepTransport:
     def recording_ns(self) -> int:
         """The recording clock: :data:`SIM_EPOCH_NS` plus vehicle time since boot."""
         return SIM_EPOCH_NS + self.vehicle.now_ns
+
+    def camera_pose(self) -> CameraPose:
+        """Where the vehicle's camera really is at this instant, in ENU metres around its home:
+        a simulated camera photographs the world from here, not from the pose the telemetry
+        last reported (which lags, and carries the GPS noise a real one would)."""
+        ap = self.vehicle.autopilot
+        north, east, down = ap.state.pos_ned_m
+        gimbal = ap.gimbal
+        heading = gimbal.yaw_deg if gimbal.yaw_locked else ap.state.yaw_deg + gimbal.yaw_deg
+        return CameraPose((east, north, -down), heading % 360.0, gimbal.pitch_deg)
 
     # --- Transport -----------------------------------------------------------------------------
 
