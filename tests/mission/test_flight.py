@@ -166,7 +166,8 @@ def test_builtin_scene_matches_its_target(name: str) -> None:
     scene = load_scene(name)
     flown = fly(scene)
     outcome = flown.outcome
-    assert outcome.status is Status.COMPLETED
+    # On 'dense' the front viewpoint has no line of sight: found, but no model.
+    assert outcome.status in (Status.COMPLETED, Status.PARTIAL)
     (plan,) = flown.flight.of_type(Plan)
     target = building_footprint(scene.target_building)
     assert target.contains(shapely.Point(plan.pois[outcome.matched_poi].pos_en_m))
@@ -215,9 +216,10 @@ def test_blocked_viewpoint_is_reported_and_the_flight_completes(
     flown = fly(scenes.walled(sides))
     flight = flown.flight
     outcome = flight.outcome
-    assert outcome.status is Status.COMPLETED
+    assert outcome.status is Status.PARTIAL
     assert outcome.matched_poi >= 0 and not outcome.model_built
-    assert outcome.reason == "target found; model not built"
+    missing = " or ".join(impossible)
+    assert outcome.reason == f"target found; model not built: no {missing} photo"
     (views,) = flight.of_type(Viewpoints)
     photos = _photos(flight)
     for name in ("front", "right"):

@@ -120,3 +120,17 @@ def test_garbage_instead_of_a_vehicle(tmp_path: Path) -> None:
     server.close()
     assert result.exit_code == 2, result.output
     assert f"tcp:127.0.0.1:{port}: no heartbeat from a vehicle in 1 s" in result.output
+
+
+@pytest.mark.parametrize(
+    ("args", "status", "code"),
+    [
+        (["--scene", "dense"], "partial: target found; model not built", 3),
+        (["--set", "recognize.threshold=0.999"], "no-match", 4),
+        (["--link-outage", "15:1e6", "--set", "mission.link_lost_abort_s=5"], "link-lost", 1),
+    ],
+)
+def test_each_outcome_has_its_exit_code(args: list[str], status: str, code: int) -> None:
+    result = CliRunner().invoke(cli, ["fly", "-q", "--no-record", *args])
+    assert result.exit_code == code, result.output
+    assert f"outcome        {status}" in result.output

@@ -7,6 +7,17 @@ from pathlib import Path
 
 import click
 
+EXIT_CODES: dict[str, int] = {
+    "completed": 0,
+    "aborted": 1,
+    "pilot-takeover": 1,
+    "link-lost": 1,
+    "partial": 3,
+    "no-match": 4,
+    "crashed": 5,
+}
+"""``uavtool fly``'s exit code for each mission status (2 is bad input, as for every command)."""
+
 
 @click.command()
 @click.option(
@@ -110,6 +121,10 @@ def fly(
     its 3D model; record everything to one MCAP file.
 
     \b
+    Exit codes: 0 completed (target found, model built), 3 partial (target found, no
+    model), 4 no match, 5 crashed, 1 aborted / pilot takeover / link lost, 2 bad input.
+
+    \b
     Examples:
       uavtool fly                                  # built-in SITL, scene 'paper'
       uavtool fly --visit-all --scene blocked-front
@@ -157,8 +172,7 @@ def fly(
         status=lambda text: echo(f"uavtool fly: {text}"),
     )
     click.echo(format_summary(summary))
-    if summary.outcome.status.value not in ("completed", "no-match"):
-        sys.exit(1)
+    sys.exit(EXIT_CODES[summary.outcome.status.value])
 
 
 def _speedup(text: str | None, *, live: bool) -> float | None:

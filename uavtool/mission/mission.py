@@ -90,6 +90,9 @@ class Mission:
         self._frames_seen = 0
         self._expected_modes: frozenset[str] = frozenset()
         self._link_was_lost = False
+        self._airborne = False  # from take-off until the return: disarming now is a crash
+        self.no_model = "unknown"
+        """Why no model was built (for a PARTIAL outcome)."""
         self._deferred: list[Observation] = []
         self._gen = self._run()
         self._started = False
@@ -141,8 +144,11 @@ class Mission:
 
         try:
             yield from fly(self)
-            reason = "model built" if self.model_built else "target found; model not built"
-            end = _End(Status.COMPLETED, reason)
+            end = (
+                _End(Status.COMPLETED, "model built")
+                if self.model_built
+                else _End(Status.PARTIAL, f"target found; model not built: {self.no_model}")
+            )
         except _End as exc:
             end = exc
         self.event(
@@ -165,7 +171,8 @@ class Mission:
 
     def _finish(self, status: Status) -> Wait[None]:
         """Bring the vehicle home (or watch someone else do it) until it has landed."""
-        if status is Status.LINK_LOST or self.last is None:
+        self._airborne = False
+        if status in (Status.LINK_LOST, Status.CRASHED) or self.last is None:
             return
         landed = self._landed_and_disarmed
         if status is Status.TAKEOVER:
@@ -200,6 +207,12 @@ class Mission:
                 continue
             if isinstance(obs, Telemetry):
                 self.last = obs
+                if self._airborne and not obs.armed:
+                    raise _End(
+                        Status.CRASHED,
+                        f"the vehicle disarmed in the air at {obs.pos_enu_m[2]:.1f} m "
+                        "(its crash check: it hit something)",
+                    )
                 self._check_mode(obs)
             return obs
 
@@ -358,12 +371,17 @@ class Mission:
         if not ok:
             raise _End(Status.ABORTED, "the vehicle accepted arming but never showed armed")
         yield from self.command(lambda i: Takeoff(i, alt_m), f"take-off to {alt_m:g} m")
+        self.airborne()
         climbed = yield from self.wait_until(
             lambda t: t.pos_enu_m[2] >= alt_m - p.arrive_radius_m,
             alt_m / p.climb_speed_m_s + p.move_slack_s,
         )
         if not climbed:
             raise _End(Status.ABORTED, f"take-off: {alt_m:g} m never reached")
+
+    def airborne(self) -> None:
+        """From now until the return home, a vehicle that disarms has crashed."""
+        self._airborne = True
 
 
 def _distance(t: Telemetry | None, pos_enu_m: Vec3) -> float:

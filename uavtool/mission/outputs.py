@@ -153,11 +153,22 @@ class ModelBuilt:
 
 
 class Status(Enum):
+    """How a mission ended (``uavtool fly`` maps each to its exit code)."""
+
     COMPLETED = "completed"
+    """The target was found and its model built."""
+    PARTIAL = "partial"
+    """The target was found but no model was built."""
     NO_MATCH = "no-match"
+    """The search ended without a match."""
     ABORTED = "aborted"
+    """The mission gave up (a command refused, a position never reached …) and sent RTL."""
     TAKEOVER = "pilot-takeover"
+    """Someone else changed the mode; the mission stopped commanding."""
     LINK_LOST = "link-lost"
+    """The link stayed silent for too long."""
+    CRASHED = "crashed"
+    """The vehicle disarmed in the air (its crash check): it hit something."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -46,6 +46,7 @@ def fly(m: Mission) -> Wait[None]:
     if last.armed and not last.landed:
         m.event(Level.INFO, "already flying: taking control in GUIDED")
         yield from m.set_mode("GUIDED")
+        m.airborne()
     else:
         m.event(Level.INFO, f"taking off to {p.overview_alt_m:g} m")
         yield from m.arm_and_take_off(p.overview_alt_m)
@@ -139,7 +140,8 @@ def _model(
 
     missing = [name for name in ("front", "right") if name not in views]
     if missing:
-        m.event(Level.WARNING, f"model not built: no {' or '.join(missing)} photo")
+        m.no_model = f"no {' or '.join(missing)} photo"
+        m.event(Level.WARNING, f"model not built: {m.no_model}")
         return
     try:
         model = build_model(
@@ -149,6 +151,7 @@ def _model(
             m.params.model,
         )
     except VisionError as exc:
+        m.no_model = str(exc)
         m.event(Level.ERROR, f"model not built: {exc}")
         return
     mesh = model.mesh

@@ -213,7 +213,9 @@ class MissionLogger:
             self._text("mission", problem, "WARN")
 
     def _outcome(self, out: Mapping[str, Any]) -> None:
-        level = "INFO" if out.get("status") in ("completed", "no-match") else "ERROR"
+        level = {"completed": "INFO", "partial": "WARN", "no-match": "WARN"}.get(
+            str(out.get("status")), "ERROR"
+        )
         self._text("mission", f"outcome: {out.get('status')}: {out.get('reason')}", level)
 
     # --- helpers ---------------------------------------------------------------------------------
