@@ -9,7 +9,7 @@ from uavtool.camera import Intrinsics
 from uavtool.mission.errors import MissionInputError
 from uavtool.mission.observations import U8Array
 from uavtool.mission.params import Params
-from uavtool.vision import Shape, best_match, vectorize
+from uavtool.vision import Shape, best_match, mirror_score, vectorize
 from uavtool.vision.merge import merge_touching
 from uavtool.vision.model3d import central_shape
 from uavtool.vision.vectorize import hue_distance_deg
@@ -41,7 +41,9 @@ def target_shapes(params: Params, target_rgb: U8Array) -> tuple[tuple[Shape, ...
 class Judgement:
     """A nadir photo at a point of interest compared with the target: ``scores`` per shape,
     ``candidate`` the shape the photo is centred on (−1 none), its ``score``, and whether it
-    is a match (shape score at the threshold and, if asked, a hue close to the target's)."""
+    is a match: judgeable, shape score at the threshold, a hue close to the target's (if
+    asked), and more like the target than like the target's mirror image (the mirror rule,
+    :class:`uavtool.vision.RecognizeParams`)."""
 
     scores: tuple[float, ...]
     candidate: int
@@ -51,6 +53,10 @@ class Judgement:
     """False when the candidate's outline is cut by the image border (then never a match)."""
     same_hue: bool = True
     """Whether the candidate's hue is within the hue gate of the target's (True without one)."""
+    mirror_score: float = 0.0
+    """The candidate's score against the target's mirror image."""
+    not_mirror: bool = True
+    """Whether the mirror rule holds (always for a target that is its own mirror image)."""
 
 
 def judge(
@@ -66,5 +72,9 @@ def judge(
     judgeable = matches[candidate].judgeable
     hue_limit = params.mission.match_hue_tolerance_deg
     same_hue = hue_limit <= 0 or hue_distance_deg(centre.colour_rgb, target.colour_rgb) <= hue_limit
-    matched = judgeable and same_hue and score >= params.recognize.threshold
-    return Judgement(scores, candidate, score, matched, judgeable, same_hue)
+    rp = params.recognize
+    mirrored = mirror_score(target, centre, rp)
+    gap = 1.0 - mirror_score(target, target, rp)  # how unlike its mirror image the target is
+    not_mirror = gap < rp.symmetric_gap or score - mirrored >= rp.mirror_margin * gap
+    matched = judgeable and same_hue and not_mirror and score >= rp.threshold
+    return Judgement(scores, candidate, score, matched, judgeable, same_hue, mirrored, not_mirror)

@@ -119,8 +119,8 @@ class Recognition:
     """Frame ``frame_index`` at point of interest ``poi`` compared with the target.
 
     ``scores`` : one per shape of the frame; ``candidate`` the shape judged (the one the photo
-    is centred on; −1 if none), ``score`` its score, ``matched`` whether it reaches the
-    threshold."""
+    is centred on; −1 if none), ``score`` its score, ``matched`` the decision;
+    ``mirror_score`` the candidate's score against the target's mirror image."""
 
     frame_index: int
     poi: int
@@ -128,6 +128,7 @@ class Recognition:
     candidate: int
     score: float
     matched: bool
+    mirror_score: float = 0.0
 
 
 @dataclass(frozen=True, slots=True)

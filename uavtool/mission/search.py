@@ -98,13 +98,18 @@ def _look(m: Mission, k: int, n: int, alt_m: float) -> Wait[_Look]:
     photo = yield from m.photo(f"poi-{k}" if n == 1 else f"poi-{k}-{n}", -90.0)
     shapes = photo_shapes(m, photo)
     j = judge(m.params, m.target, shapes, photo.intrinsics)
-    m.emit(Recognition(photo.frame_index, k, j.scores, j.candidate, j.score, j.matched))
+    m.emit(
+        Recognition(photo.frame_index, k, j.scores, j.candidate, j.score, j.matched, j.mirror_score)
+    )
+    why = ""
+    if not j.judgeable:
+        why = "; outline cut by the image border, not judged"
+    elif not j.not_mirror:
+        why = f"; as much like the target's mirror image: {j.mirror_score:.3f}"
     m.event(
         Level.INFO,
         f"point of interest {k}{'' if n == 1 else f', look {n}'}: "
-        f"{'MATCH' if j.matched else 'no match'} (score {j.score:.3f}"
-        + ("" if j.judgeable else "; outline cut by the image border, not judged")
-        + ")",
+        f"{'MATCH' if j.matched else 'no match'} (score {j.score:.3f}{why})",
     )
     return _Look(photo, shapes, j, alt_m)
 

@@ -8,7 +8,7 @@ inside each stage (``cv2.setNumThreads(1)`` at the entry points).
 from __future__ import annotations
 
 from uavtool.vision.params import ModelParams, RecognizeParams, VectorizeParams
-from uavtool.vision.recognize import Match, best_match, match, match_shapes
+from uavtool.vision.recognize import Match, best_match, match, match_shapes, mirror_score
 from uavtool.vision.shapes import Shape
 from uavtool.vision.vectorize import vectorize
 
@@ -21,5 +21,6 @@ __all__ = [
     "best_match",
     "match",
     "match_shapes",
+    "mirror_score",
     "vectorize",
 ]

@@ -108,10 +108,19 @@ class RecognizeParams:
     """Scores at or above this are a match."""
     allow_mirror: bool = False
     """Also try the mirror image (a mirrored building is a different building by default)."""
+    mirror_margin: float = 0.25
+    """The mirror rule (used by the mission's decision): a candidate is the reference and not
+    its mirror image only if its score beats its score against the reference's mirror image
+    by this fraction of the reference's chirality gap (1 − the reference's score against its
+    own mirror image). The true building then wins by about the whole gap, its mirror image
+    loses by it."""
+    symmetric_gap: float = 0.05
+    """A reference whose chirality gap is below this is its own mirror image (a rectangle, a
+    T, a U): the mirror rule cannot and need not tell them apart, and does not apply."""
 
     def __post_init__(self) -> None:
         _check_positive(self, "angle_scale_deg", "length_scale")
-        _check_non_negative(self, "merge_cost", "hole_penalty")
+        _check_non_negative(self, "merge_cost", "hole_penalty", "mirror_margin", "symmetric_gap")
         if self.max_merge < 1:
             raise VisionParamError(f"vision.max_merge must be ≥ 1, got {self.max_merge}")
         if not 0.0 <= self.threshold <= 1.0:

@@ -23,7 +23,16 @@ from uavtool.vision.align import NO_MATCH, Match, Symbols, align
 from uavtool.vision.params import RecognizeParams
 from uavtool.vision.shapes import FloatArray, Shape, orient, perimeter
 
-__all__ = ["NO_MATCH", "Match", "Symbols", "best_match", "match", "match_shapes", "symbols"]
+__all__ = [
+    "NO_MATCH",
+    "Match",
+    "Symbols",
+    "best_match",
+    "match",
+    "match_shapes",
+    "mirror_score",
+    "symbols",
+]
 
 
 def symbols(ring_px: FloatArray) -> Symbols:
@@ -70,6 +79,19 @@ def best_match(
     if not judged:
         return -1, matches
     return max(judged, key=lambda i: (matches[i].score, -i)), matches
+
+
+def mirror_score(
+    reference: Shape, candidate: Shape, params: RecognizeParams | None = None
+) -> float:
+    """How well ``candidate`` matches the mirror image of ``reference`` (differing hole counts
+    lower it as in :func:`match_shapes`). ``mirror_score(s, s)`` says how chiral a shape is:
+    1 for a shape that is its own mirror image (a rectangle, a T), lower for an L."""
+    p = params if params is not None else RecognizeParams()
+    flipped = np.asarray(candidate.polygon_px, dtype=np.float64) * np.array([-1.0, 1.0])
+    score = align(symbols(reference.polygon_px), symbols(flipped), p, mirrored=True).score
+    holes = abs(len(reference.holes_px) - len(candidate.holes_px))
+    return max(0.0, score - p.hole_penalty * holes) if holes and score else score
 
 
 def _match_shapes(reference: Shape, ref: Symbols, candidate: Shape, p: RecognizeParams) -> Match:
