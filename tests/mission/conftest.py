@@ -28,6 +28,7 @@ def visit_all_flight(paper: Scene) -> Flown:
 
 @pytest.fixture(scope="session")
 def turned_flight() -> Flown:
-    """``paper`` flown facing east: the red roof's first photo scores just below the
-    threshold, so does the second, and the third (from higher still) matches."""
-    return fly(scenes.turned(90.0))
+    """``paper`` flown facing east, each look from where the roof fills the photo's height
+    (``look_fill`` 1): the red roof's first two photos score below the threshold, the third
+    (20 m higher than the first) matches."""
+    return fly(scenes.turned(90.0), scenes.with_mission(look_fill=1.0))

@@ -23,6 +23,7 @@ from uavtool.mission import (
     Status,
     Viewpoints,
 )
+from uavtool.mission.search import look_altitude_m
 from uavtool.nav import Viewpoint, ViewpointFailure
 from uavtool.runner.evaluate import model_iou
 from uavtool.world import Scene, building_footprint, load_scene
@@ -119,12 +120,15 @@ def test_photos_are_taken_where_planned(paper_flight: Flown) -> None:
     (plan,) = flight.of_type(Plan)
     (views,) = flight.of_type(Viewpoints)
     assert isinstance(views.front, Viewpoint) and isinstance(views.right, Viewpoint)
+    high = p.overview_alt_m + p.overview_climb_m
     expected: dict[str, tuple[tuple[float, float, float], float | None, float]] = {
-        "overview": ((0.0, 0.0, p.overview_alt_m), None, -90.0)
+        "overview": ((0.0, 0.0, p.overview_alt_m), None, -90.0),
+        "overview-2": ((0.0, 0.0, high), None, -90.0),
     }
     for k in flight.outcome.visited:
-        x, y = plan.pois[k].pos_en_m
-        expected[f"poi-{k}"] = ((x, y, p.detail_alt_m), None, -90.0)
+        poi = plan.pois[k]
+        alt = min(look_altitude_m(paper_flight.mission, poi, photos["overview-2"].intrinsics), high)
+        expected[f"poi-{k}"] = ((*poi.pos_en_m, alt), None, -90.0)
     for vp in (views.top, views.front, views.right):
         expected[vp.name] = (vp.pos_enu_m, vp.heading_deg, vp.pitch_deg)
     assert sorted(photos) == sorted(expected)
@@ -188,7 +192,7 @@ def test_builtin_scene_matches_its_target(name: str) -> None:
 
 @pytest.mark.parametrize(
     ("scene_name", "why", "visits"),
-    [("paper", "no building matched the target", 4), ("out-of-view", "shows no building", 0)],
+    [("paper", "no building matched the target", 4), ("out-of-view", "show no building", 0)],
 )
 def test_no_match_reports_and_lands(scene_name: str, why: str, visits: int) -> None:
     if scene_name == "paper":

@@ -33,7 +33,7 @@ def test_check_passes_on_the_paper_golden() -> None:
 
 
 def test_changed_parameter_fails_check_with_first_difference() -> None:
-    code, out = run("replay", "--check", "-q", str(PAPER), "--set", "recognize.threshold=0.9")
+    code, out = run("replay", "--check", "-q", str(PAPER), "--set", "recognize.threshold=0.995")
     assert code == 1
     # The first difference names the step, the output, the field, and both values.
     assert "first difference: step" in out
@@ -60,7 +60,7 @@ def test_unknown_parameter_lists_the_valid_ones() -> None:
 
 def test_params_file(tmp_path: Path) -> None:
     params = tmp_path / "p.json"
-    params.write_text(json.dumps({"recognize": {"threshold": 0.9}}))
+    params.write_text(json.dumps({"recognize": {"threshold": 0.995}}))
     code, out = run("replay", "-q", str(PAPER), "--params", str(params))
     assert code == 0
     assert "diverged" in out

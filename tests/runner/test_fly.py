@@ -37,7 +37,7 @@ def test_paper_mission_finds_the_red_building_and_builds_its_model(
     assert e.visited == ("purple", "yellow", "blue", "red")
     assert o.model_built
     assert e.model_iou is not None and e.model_iou > 0.85
-    assert summary.frames == 8  # type: ignore[attr-defined]
+    assert summary.frames == 9  # type: ignore[attr-defined]  # 2 overviews, 4 looks, 3 sides
 
 
 def test_recording_is_whole_and_replays_identically(paper_flight: tuple[object, Path]) -> None:
@@ -83,7 +83,7 @@ def test_link_lost_for_good_ends_the_mission(tmp_path: Path) -> None:
         (["--connect", "bogus:1:2"], "connection 'bogus:1:2'"),
         (["--connect", "tcp:127.0.0.1:1", "--timeout", "0.5"], "cannot connect"),
         (["--set", "mission.nope=1"], "unknown parameter 'mission.nope'"),
-        (["--set", "mission.detail_alt_m=abc"], "is not a valid float"),
+        (["--set", "mission.look_fill=abc"], "is not a valid float"),
         (["--camera", "webcam"], "--camera 'webcam'"),
         (["--param", "WPNAV_SPEED"], "expected NAME=VALUE"),
     ],

@@ -122,6 +122,7 @@ def test_points_of_interest_and_the_match(saved: Saved, facts: Facts) -> None:
     assert facts.matched_poi is not None
     label = pois["Points3D:labels"][facts.matched_poi]
     assert "MATCH" in label
+    assert all(" m)" in text and "(roof " in text for text in pois["Points3D:labels"])
     assert pois["Points3D:radii"][facts.matched_poi] == max(pois["Points3D:radii"])
     scores = sum(len(data.rows[e]) for e in data.entities("plots/recognition/poi_"))
     assert scores == facts.recognitions

@@ -68,7 +68,7 @@ EXIT_CODES: dict[str, int] = {
     "settings",
     multiple=True,
     metavar="KEY=VALUE",
-    help="Set a mission parameter (e.g. mission.detail_alt_m=25, vectorize.rdp_epsilon_px=2).",
+    help="Set a mission parameter (e.g. mission.look_fill=0.6, vectorize.rdp_epsilon_px=2).",
 )
 @click.option("--seed", default=0, show_default=True, type=int, help="SITL wind/noise seed.")
 @click.option("--noise", is_flag=True, help="Add seeded sensor noise to simulated photos.")

@@ -314,6 +314,22 @@ class Mission:
             )
         raise _End(Status.ABORTED, f"{what}: position never reached")
 
+    def travel(
+        self, pos_enu_m: Vec3, heading_deg: float | None, transit_m: float, what: str
+    ) -> Wait[None]:
+        """Fly to a position over every known roof: straight up to ``transit_m`` (or the
+        destination's altitude, if higher) when below it, across at that altitude, then
+        straight to the destination."""
+        p = self.params.mission
+        x, y, z = pos_enu_m
+        cruise = max(transit_m, z)
+        here = self.last.pos_enu_m if self.last is not None else (x, y, cruise)
+        if math.hypot(here[0] - x, here[1] - y) > p.arrive_radius_m:
+            if here[2] < cruise - p.arrive_radius_m:
+                yield from self.move((here[0], here[1], cruise), None, f"climb to {cruise:.1f} m")
+            yield from self.move((x, y, cruise), None, f"{what}: across at {cruise:.1f} m")
+        yield from self.move(pos_enu_m, heading_deg, what)
+
     def _arrived(self, t: Telemetry, pos_enu_m: Vec3, heading_deg: float | None) -> bool:
         p = self.params.mission
         if _distance(t, pos_enu_m) > p.arrive_radius_m or t.speed_m_s > p.arrive_speed_m_s:

@@ -94,14 +94,19 @@ class Shapes:
 
 @dataclass(frozen=True, slots=True)
 class PointOfInterest:
-    """A building seen in the overview: where it is (ENU, on the roof plane) and its colour.
-    ``shape_index`` is its index in the overview's shapes."""
+    """A building seen in the overview: where it is (ENU, the centre of its roof) and its
+    colour. ``shape_index`` is its index in the overview's shapes; ``roof_m`` its roof height
+    above home, measured from two overview photos (``roof_measured``) or assumed;
+    ``extent_m`` the diagonal of its footprint's smallest rectangle."""
 
     index: int
     shape_index: int
     pos_en_m: tuple[float, float]
     colour_rgb: tuple[int, int, int]
     area_px: float
+    roof_m: float
+    roof_measured: bool
+    extent_m: float
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,7 +1,7 @@
 """The mission's parameters: one typed, documented structure, recorded with every mission.
 
 ``Params`` groups the mission's own settings with those of each vision and navigation stage it
-calls. Keys are dotted paths (``mission.detail_alt_m``, ``vectorize.rdp_epsilon_px``,
+calls. Keys are dotted paths (``mission.look_fill``, ``vectorize.rdp_epsilon_px``,
 ``viewpoints.safety_margin_m``) for ``--set key=value`` on ``fly`` and ``replay``.
 """
 
@@ -25,12 +25,24 @@ class MissionParams:
     of vehicle time (the telemetry's ``time_boot_ms``), angles in degrees."""
 
     overview_alt_m: float = 45.0
-    """Altitude above home of the overview photo (the whole scene in view)."""
-    detail_alt_m: float = 20.0
-    """Altitude of the nadir photo at each point of interest, and of transit between views."""
-    roof_plane_z_m: float = 5.0
-    """Typical roof height: overview shapes are projected onto this plane to place points of
-    interest and obstacles (a roof seen from above sits higher than the ground)."""
+    """Altitude above home of the first overview photo."""
+    overview_climb_m: float = 15.0
+    """The second overview photo is taken this much higher, straight above the first: a
+    roof's size changes between them by how far below the camera it is, which gives every
+    building's roof height (and the higher photo sees further)."""
+    assumed_roof_m: float = 25.0
+    """Roof height assumed for a building whose height the overview photos could not measure
+    (cut by the border, or seen in one photo only): the tallest expected. A look measures it."""
+    roof_match_px: float = 25.0
+    """A roof in the lower overview is the same as one in the higher when it lies within
+    this many pixels of where the climb should have moved it (and has its colour)."""
+    look_fill: float = 0.5
+    """Each nadir look at a point of interest is taken from the altitude at which the
+    building's footprint spans this fraction of the photo's shorter side …"""
+    top_fill: float = 0.6
+    """… and the top photo for the model from the altitude at which it spans this fraction."""
+    min_above_roof_m: float = 6.0
+    """No photo is taken closer than this above the roof it looks at."""
     roof_gap_px: float = 6.0
     """Same-coloured roofs closer than this (pixels) in a nadir photo are one building: blocks
     of different heights show as separate roofs split by a strip of wall."""
@@ -56,7 +68,7 @@ class MissionParams:
     from the centre is off-centre."""
     recheck_climb_m: float = 10.0
     """Each further look is taken this much higher than the one before (the whole roof in
-    view, smaller perspective steps between its heights; never above ``overview_alt_m``)."""
+    view, smaller perspective steps between its heights; never above the second overview)."""
     visit_all: bool = False
     """Visit every point of interest even after a match (then keep the best-scoring match)."""
     arrive_radius_m: float = 0.6
@@ -87,11 +99,24 @@ class MissionParams:
     """Time allowed for the return and landing before the mission stops watching."""
 
     def __post_init__(self) -> None:
-        for name in ("overview_alt_m", "detail_alt_m", "arrive_radius_m", "cruise_speed_m_s"):
+        for name in (
+            "overview_alt_m",
+            "overview_climb_m",
+            "arrive_radius_m",
+            "cruise_speed_m_s",
+            "roof_match_px",
+            "min_above_roof_m",
+        ):
             if not getattr(self, name) > 0:
                 raise InputError(f"mission.{name} must be positive, got {getattr(self, name)}")
-        if self.detail_alt_m > self.overview_alt_m:
-            raise InputError("mission.detail_alt_m must not be above mission.overview_alt_m")
+        for name in ("look_fill", "top_fill"):
+            if not 0.0 < getattr(self, name) <= 1.0:
+                raise InputError(f"mission.{name} must be in (0, 1], got {getattr(self, name)}")
+        if not 0.0 <= self.assumed_roof_m < self.overview_alt_m:
+            raise InputError(
+                "mission.assumed_roof_m must be ≥ 0 and below mission.overview_alt_m, "
+                f"got {self.assumed_roof_m}"
+            )
         if self.max_looks < 1:
             raise InputError(f"mission.max_looks must be ≥ 1, got {self.max_looks}")
         if self.command_retries < 0:
@@ -126,13 +151,13 @@ def from_dict(data: dict[str, Any], *, source: str = "parameters") -> Params:
 
 
 def with_overrides(params: Params, pairs: dict[str, Any], *, source: str = "--set") -> Params:
-    """``params`` with keys set: dotted (``{"mission.detail_alt_m": "25"}``, values as strings
-    or JSON types) or nested (``{"mission": {"detail_alt_m": 25}}``, as a params file holds)."""
+    """``params`` with keys set: dotted (``{"mission.look_fill": "0.6"}``, values as strings
+    or JSON types) or nested (``{"mission": {"look_fill": 0.6}}``, as a params file holds)."""
     return _apply(params, _flatten(pairs), source=source)
 
 
 def parse_settings(texts: Iterable[str], *, option: str = "--set") -> dict[str, str]:
-    """``["mission.detail_alt_m=25", …]`` → ``{"mission.detail_alt_m": "25", …}``."""
+    """``["mission.look_fill=0.6", …]`` → ``{"mission.look_fill": "0.6", …}``."""
     out: dict[str, str] = {}
     for text in texts:
         key, sep, value = text.partition("=")

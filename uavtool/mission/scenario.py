@@ -3,6 +3,8 @@ photos for the model, and the model. Each step is a generator run by :class:`Mis
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from typing import TYPE_CHECKING
 
 from uavtool.mission.observations import Photo
@@ -10,11 +12,11 @@ from uavtool.mission.outputs import (
     Level,
     ModelBuilt,
     Plan,
-    PointOfInterest,
     Status,
     Viewpoints,
 )
 from uavtool.mission.search import Found, photo_shapes, search
+from uavtool.mission.survey import survey
 from uavtool.nav import (
     Viewpoint,
     ViewpointFailure,
@@ -25,8 +27,7 @@ from uavtool.nav import (
     top_viewpoint,
     visit_order,
 )
-from uavtool.nav import ground_point as nav_ground_point
-from uavtool.vision import Shape
+from uavtool.nav.heights import fit_altitude_m
 from uavtool.vision.errors import VisionError
 from uavtool.vision.model3d import View, build_model, central_shape, model_glb, same_colour
 
@@ -53,71 +54,83 @@ def fly(m: Mission) -> Wait[None]:
     here = m.last.pos_enu_m if m.last else (0.0, 0.0, 0.0)
     yield from m.move((here[0], here[1], p.overview_alt_m), None, "overview position")
 
-    overview = yield from m.photo("overview", -90.0)
-    shapes = photo_shapes(m, overview)
-    pois = _points_of_interest(m, overview, shapes)
+    seen = yield from survey(m)
+    pois = seen.pois
     if not pois:
-        raise m.end(Status.NO_MATCH, "the overview photo shows no building")
+        raise m.end(Status.NO_MATCH, "the overview photos show no building")
     start = (m.last.pos_enu_m[0], m.last.pos_enu_m[1]) if m.last else (0.0, 0.0)
     points = [poi.pos_en_m for poi in pois]
     order = visit_order(start, points)
-    m.plan = Plan(overview.frame_index, pois, order, route_length_m(start, points, order))
+    m.plan = Plan(seen.photo.frame_index, pois, order, route_length_m(start, points, order))
     m.emit(m.plan)
     m.event(Level.INFO, f"{len(pois)} points of interest; visiting order {list(order)}")
 
-    found = yield from search(m, pois, order)
+    transit_m = seen.highest_roof_m + m.params.viewpoints.safety_margin_m
+    found = yield from search(
+        m, pois, order, overview=seen.photo, overview_shapes=seen.shapes, transit_m=transit_m
+    )
     if found is None:
         return
     m.matched_poi = found.poi.index
     m.match_score = found.score
-    obstacles = [
-        ground_polygon(s.polygon_px, overview.pose, overview.intrinsics, plane_z_m=p.roof_plane_z_m)
-        for i, s in enumerate(shapes)
-        if i != found.poi.shape_index
-    ]
-    yield from _model(m, found, obstacles)
-
-
-def _points_of_interest(
-    m: Mission, overview: Photo, shapes: tuple[Shape, ...]
-) -> tuple[PointOfInterest, ...]:
-    p = m.params.mission
-    pois: list[PointOfInterest] = []
-    for i, shape in enumerate(shapes):
-        if shape.area_px < p.min_poi_area_px:
-            continue
-        u, v = shape.centroid_px
-        pos = nav_ground_point(u, v, overview.pose, overview.intrinsics, plane_z_m=p.roof_plane_z_m)
-        pois.append(PointOfInterest(len(pois), i, pos, shape.colour_rgb, shape.area_px))
-    return tuple(pois)
+    obstacles = [f for i, f in enumerate(seen.footprints) if i != found.poi.shape_index]
+    yield from _model(m, found, obstacles, transit_m)
 
 
 def _model(
-    m: Mission, found: Found, obstacles: list[tuple[tuple[float, float], ...]]
+    m: Mission,
+    found: Found,
+    obstacles: list[tuple[tuple[float, float], ...]],
+    transit_m: float,
 ) -> Wait[None]:
-    """Top, front and right photos from planned viewpoints, then the model."""
+    """Top, front and right photos from planned viewpoints, then the model. The side photos
+    are taken only once the top photo shows the whole building."""
     p = m.params.mission
+    roof = found.roof_m
+    k = found.photo.intrinsics
+    # Side photos: a horizontal camera halfway up, its view holding the whole height.
+    vp_params = dataclasses.replace(
+        m.params.viewpoints,
+        camera_alt_m=max(m.params.viewpoints.camera_alt_m, roof / 2.0),
+        assumed_height_m=max(m.params.viewpoints.assumed_height_m, roof),
+    )
     footprint = ground_polygon(
-        found.shape.polygon_px, found.photo.pose, found.photo.intrinsics, plane_z_m=p.roof_plane_z_m
+        found.shape.polygon_px, found.photo.pose, k, plane_z_m=min(roof, _below(found.photo))
     )
     rect = min_area_rect(footprint)
-    front, right = plan_viewpoints(rect, obstacles, found.photo.intrinsics, m.params.viewpoints)
+    front, right = plan_viewpoints(rect, obstacles, k, vp_params)
     front_heading = (
         front.heading_deg if isinstance(front, Viewpoint) else (rect.long_axis_deg + 90.0) % 360.0
     )
-    top = top_viewpoint(rect, front_heading, alt_m=p.detail_alt_m)
-    yield from m.move(top.pos_enu_m, top.heading_deg, "top viewpoint")
-    top_photo = yield from m.photo("top", -90.0)
-    top_shapes = photo_shapes(m, top_photo)
-    obj = central_shape(top_shapes, top_photo.intrinsics)
-    if obj is None:
-        raise m.end(Status.ABORTED, "the top photo shows no building")
-    # The top photo is centred on the building: plan the side photos from its footprint.
-    footprint = ground_polygon(
-        obj.polygon_px, top_photo.pose, top_photo.intrinsics, plane_z_m=p.roof_plane_z_m
+    extent = math.hypot(rect.length_m, rect.width_m)
+    alt = max(
+        fit_altitude_m(roof_m=roof, extent_m=extent, intrinsics=k, fill=p.top_fill),
+        roof + p.min_above_roof_m,
     )
+    for attempt in range(1, p.max_looks + 1):
+        top = top_viewpoint(rect, front_heading, alt_m=alt)
+        yield from m.travel(top.pos_enu_m, top.heading_deg, transit_m, "top viewpoint")
+        top_photo = yield from m.photo("top" if attempt == 1 else f"top-{attempt}", -90.0)
+        top_shapes = photo_shapes(m, top_photo)
+        obj = central_shape(top_shapes, top_photo.intrinsics)
+        if obj is None:
+            m.no_model = "the top photo shows no building"
+            raise m.end(Status.PARTIAL, f"target found; model not built: {m.no_model}")
+        if not obj.cut_by_border:
+            break
+        m.event(
+            Level.INFO,
+            f"top photo from {alt:.1f} m: the building touches the image border; "
+            + ("again from higher" if attempt < p.max_looks else "giving up"),
+        )
+        alt = roof + (alt - roof) * 1.5
+    else:
+        m.no_model = f"the top photo never showed the whole building ({p.max_looks} tries)"
+        raise m.end(Status.PARTIAL, f"target found; model not built: {m.no_model}")
+    # The top photo is centred on the building: plan the side photos from its footprint.
+    footprint = ground_polygon(obj.polygon_px, top_photo.pose, top_photo.intrinsics, plane_z_m=roof)
     rect = min_area_rect(footprint)
-    front, right = plan_viewpoints(rect, obstacles, top_photo.intrinsics, m.params.viewpoints)
+    front, right = plan_viewpoints(rect, obstacles, top_photo.intrinsics, vp_params)
     m.emit(Viewpoints(footprint, top, front, right))
 
     views: dict[str, View] = {}
@@ -128,15 +141,15 @@ def _model(
         if vp.fallback:
             m.event(Level.INFO, f"{vp.name} viewpoint: {vp.fallback}")
         x, y, z = vp.pos_enu_m
-        yield from m.move((x, y, p.detail_alt_m), vp.heading_deg, f"above the {vp.name} viewpoint")
+        yield from m.travel(
+            (x, y, transit_m), vp.heading_deg, transit_m, f"above the {vp.name} viewpoint"
+        )
         yield from m.move((x, y, z), vp.heading_deg, f"{vp.name} viewpoint")
         photo = yield from m.photo(vp.name, 0.0)
         shapes = photo_shapes(m, photo, nadir=False)
         silhouette = same_colour(shapes, obj.colour_rgb, hue_tolerance_deg=_SIDE_HUE_TOLERANCE_DEG)
         views[vp.name] = View(silhouette, photo.pose, photo.intrinsics)
-        yield from m.move(
-            (x, y, p.detail_alt_m), vp.heading_deg, f"climb from the {vp.name} viewpoint"
-        )
+        yield from m.move((x, y, transit_m), vp.heading_deg, f"climb from the {vp.name} viewpoint")
 
     missing = [name for name in ("front", "right") if name not in views]
     if missing:
@@ -168,3 +181,8 @@ def _model(
         Level.INFO,
         f"model built: height {model.height_m:.2f} m, volume {float(mesh.volume):.1f} m³",
     )
+
+
+def _below(photo: Photo) -> float:
+    """Just below the camera: the highest plane a nadir photo's pixels can be put on."""
+    return photo.pose.pos_enu_m[2] - 0.5

@@ -12,10 +12,12 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from uavtool.camera import Intrinsics
 from uavtool.mission.analysis import Judgement, judge, nadir_shapes, side_shapes
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest, Recognition, Shapes, Status, Vec3
 from uavtool.nav import ground_point
+from uavtool.nav.heights import fit_altitude_m, roof_from_photos
 from uavtool.vision import Shape
 
 if TYPE_CHECKING:
@@ -30,6 +32,9 @@ class Found:
     photo: Photo
     shape: Shape
     score: float
+    roof_m: float
+    """The roof's height, measured again from the look (closer, so more precise) when it
+    could be, else the point of interest's."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -50,28 +55,48 @@ def photo_shapes(m: Mission, photo: Photo, *, nadir: bool = True) -> tuple[Shape
     return shapes
 
 
+def look_altitude_m(m: Mission, poi: PointOfInterest, intrinsics: Intrinsics) -> float:
+    """Where to look at ``poi`` from: its footprint spans ``look_fill`` of the photo, and the
+    camera is at least ``min_above_roof_m`` over its roof."""
+    p = m.params.mission
+    fit = fit_altitude_m(
+        roof_m=poi.roof_m, extent_m=poi.extent_m, intrinsics=intrinsics, fill=p.look_fill
+    )
+    return max(fit, poi.roof_m + p.min_above_roof_m)
+
+
 def search(
-    m: Mission, pois: tuple[PointOfInterest, ...], order: tuple[int, ...]
+    m: Mission,
+    pois: tuple[PointOfInterest, ...],
+    order: tuple[int, ...],
+    *,
+    overview: Photo,
+    overview_shapes: tuple[Shape, ...],
+    transit_m: float,
 ) -> Wait[Found | None]:
-    """Visit the points of interest in order; the best match (the first one unless
-    ``visit_all``); ends the mission with NO_MATCH when nothing matched."""
+    """Visit the points of interest in order (across at ``transit_m``, over every known
+    roof); the best match (the first one unless ``visit_all``); ends the mission with
+    NO_MATCH when nothing matched."""
     p = m.params.mission
     best: Found | None = None
     best_score, best_poi = 0.0, -1
+    ceiling_m = overview.pose.pos_enu_m[2]
     for k in order:
         poi = pois[k]
         x, y = poi.pos_en_m
-        yield from m.move((x, y, p.detail_alt_m), None, f"point of interest {k}")
+        alt = min(look_altitude_m(m, poi, overview.intrinsics), ceiling_m)
+        yield from m.travel((x, y, alt), None, transit_m, f"point of interest {k}")
         m.visited.append(k)
-        looks = [(yield from _look(m, k, 1, p.detail_alt_m))]
+        looks = [(yield from _look(m, k, 1, alt))]
         for n in range(2, p.max_looks + 1):
-            again = _look_again(m, looks[-1])
+            again = _look_again(m, looks[-1], poi.roof_m, ceiling_m)
             if again is None:
                 break
             pos, why = again
             m.event(
                 Level.INFO,
-                f"point of interest {k}: {why}; looking again from above its roof at {pos[2]:g} m",
+                f"point of interest {k}: {why}; looking again from above its roof at "
+                f"{pos[2]:.1f} m",
             )
             yield from m.move(pos, None, f"point of interest {k}, look {n}")
             looks.append((yield from _look(m, k, n, pos[2])))
@@ -81,7 +106,10 @@ def search(
         look = looks[-1]  # a match ends the looking: the last look is the match if any
         j = look.judgement
         if j.matched and (best is None or j.score > best.score):
-            best = Found(poi, look.photo, look.shapes[j.candidate], j.score)
+            shape = look.shapes[j.candidate]
+            seen = overview_shapes[poi.shape_index]
+            roof = _roof_again(seen, overview, look.photo, shape)
+            best = Found(poi, look.photo, shape, j.score, poi.roof_m if roof is None else roof)
             if not p.visit_all:
                 break
     if best is None:
@@ -89,8 +117,29 @@ def search(
         raise m.end(
             Status.NO_MATCH, f"no building matched the target (best score {best_score:.3f}{where})"
         )
-    m.event(Level.INFO, f"target is point of interest {best.poi.index} (score {best.score:.3f})")
+    m.event(
+        Level.INFO,
+        f"target is point of interest {best.poi.index} (score {best.score:.3f}), "
+        f"roof {best.roof_m:.1f} m above home",
+    )
     return best
+
+
+def _roof_again(seen: Shape, overview: Photo, photo: Photo, shape: Shape) -> float | None:
+    """The roof height from the overview and the look, both whole: the cameras are far
+    apart, so the estimate is closer than the overview pair's."""
+    if shape.cut_by_border or seen.cut_by_border:
+        return None
+    roof = roof_from_photos(
+        centroid1_px=seen.centroid_px,
+        area1_px=seen.area_px,
+        pose1=overview.pose,
+        centroid2_px=shape.centroid_px,
+        area2_px=shape.area_px,
+        pose2=photo.pose,
+        intrinsics=photo.intrinsics,
+    )
+    return None if roof is None else max(roof, 0.0)
 
 
 def _look(m: Mission, k: int, n: int, alt_m: float) -> Wait[_Look]:
@@ -104,7 +153,7 @@ def _look(m: Mission, k: int, n: int, alt_m: float) -> Wait[_Look]:
     why = ""
     if not j.judgeable:
         why = "; outline cut by the image border, not judged"
-    elif not j.not_mirror:
+    elif not j.not_mirror and j.score >= m.params.recognize.threshold:
         why = f"; as much like the target's mirror image: {j.mirror_score:.3f}"
     m.event(
         Level.INFO,
@@ -114,7 +163,9 @@ def _look(m: Mission, k: int, n: int, alt_m: float) -> Wait[_Look]:
     return _Look(photo, shapes, j, alt_m)
 
 
-def _look_again(m: Mission, look: _Look) -> tuple[Vec3, str] | None:
+def _look_again(
+    m: Mission, look: _Look, roof_m: float, ceiling_m: float
+) -> tuple[Vec3, str] | None:
     """Where to look from again and why, or None when the look was conclusive: a match, no
     candidate, a candidate of another hue, or a clear miss centred in the photo."""
     p = m.params.mission
@@ -133,5 +184,5 @@ def _look_again(m: Mission, look: _Look) -> tuple[Vec3, str] | None:
         why = "candidate off the photo's centre"
     else:
         return None
-    x, y = ground_point(u, v, photo.pose, photo.intrinsics, plane_z_m=p.roof_plane_z_m)
-    return (x, y, min(look.alt_m + p.recheck_climb_m, p.overview_alt_m)), why
+    x, y = ground_point(u, v, photo.pose, photo.intrinsics, plane_z_m=min(roof_m, look.alt_m - 1))
+    return (x, y, min(look.alt_m + p.recheck_climb_m, ceiling_m)), why

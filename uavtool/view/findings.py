@@ -118,6 +118,10 @@ class Findings:
         for p in self.pois:
             i = int(p["index"])
             label = f"{i}"
+            if "roof_m" in p:  # recordings before roof heights were measured have none
+                label += (
+                    f" (roof {float(p['roof_m']):.1f} m{'' if p.get('roof_measured') else '?'})"
+                )
             if i in self._scores:
                 label += f": {'MATCH ' if i == self._matched else ''}{self._scores[i]:.2f}"
             labels.append(label)

@@ -1,0 +1,130 @@
+"""The survey: two overview photos from above home, one ``mission.overview_climb_m`` higher
+than the other, give every building seen whole in both its roof height (a roof's size in
+pixels grows as the camera nears it: :mod:`uavtool.nav.heights`), and from it the building's
+position and size on the ground. The higher photo sees furthest; its shapes become the
+points of interest. A building whose height could not be measured is assumed as tall as
+``mission.assumed_roof_m`` until a closer look measures it."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from uavtool.mission.observations import Photo
+from uavtool.mission.outputs import Level, PointOfInterest
+from uavtool.mission.search import photo_shapes
+from uavtool.nav import NavError, ground_point, ground_polygon, min_area_rect
+from uavtool.nav.heights import roof_from_photos
+from uavtool.vision import Shape
+
+if TYPE_CHECKING:
+    from uavtool.mission.mission import Mission, Wait
+
+
+@dataclass(frozen=True, slots=True)
+class Survey:
+    """The higher overview ``photo``, its ``shapes``, and per shape its roof height above home
+    (measured or assumed) and footprint on the ground (ENU metres, at that height)."""
+
+    photo: Photo
+    shapes: tuple[Shape, ...]
+    roofs_m: tuple[float, ...]
+    measured: tuple[bool, ...]
+    footprints: tuple[tuple[tuple[float, float], ...], ...]
+    pois: tuple[PointOfInterest, ...]
+
+    @property
+    def highest_roof_m(self) -> float:
+        return max(self.roofs_m, default=0.0)
+
+
+def survey(m: Mission) -> Wait[Survey]:
+    """Photograph the scene from the overview altitude and from ``overview_climb_m`` higher."""
+    p = m.params.mission
+    low = yield from m.photo("overview", -90.0)
+    low_shapes = photo_shapes(m, low)
+    x, y, _ = low.pose.pos_enu_m
+    high_alt = p.overview_alt_m + p.overview_climb_m
+    yield from m.move((x, y, high_alt), None, "second overview position")
+    high = yield from m.photo("overview-2", -90.0)
+    shapes = photo_shapes(m, high)
+    found = [_measure(m, shape, high, low, low_shapes) for shape in shapes]
+    known_m = sorted(h for h in found if h is not None)
+    # An unmeasured roof is assumed tall where that is the safe guess (altitudes), and as
+    # high as the measured ones are (their median) where the best guess is (positions).
+    typical_m = known_m[len(known_m) // 2] if known_m else 0.0
+    measured = [h is not None for h in found]
+    roofs = [p.assumed_roof_m if h is None else h for h in found]
+    planes = [typical_m if h is None else h for h in found]
+    footprints = tuple(_footprint(s, high, z) for s, z in zip(shapes, planes, strict=True))
+    pois: list[PointOfInterest] = []
+    for i, shape in enumerate(shapes):
+        if shape.area_px < p.min_poi_area_px:
+            continue
+        u, v = shape.centroid_px
+        pos = ground_point(u, v, high.pose, high.intrinsics, plane_z_m=planes[i])
+        extent = _extent_m(footprints[i])
+        pois.append(
+            PointOfInterest(
+                len(pois), i, pos, shape.colour_rgb, shape.area_px, roofs[i], measured[i], extent
+            )
+        )
+    known = sum(measured)
+    m.event(
+        Level.INFO,
+        f"roof heights measured for {known} of {len(shapes)} buildings"
+        + (f" (others assumed {p.assumed_roof_m:g} m)" if known < len(shapes) else ""),
+    )
+    return Survey(high, shapes, tuple(roofs), tuple(measured), footprints, tuple(pois))
+
+
+def _measure(
+    m: Mission, shape: Shape, high: Photo, low: Photo, low_shapes: tuple[Shape, ...]
+) -> float | None:
+    """The roof height of ``shape`` (in the higher photo) from the same roof in the lower
+    one: same colour, whole in both, where the vertical climb puts it."""
+    if shape.cut_by_border:
+        return None
+    p = m.params.mission
+    k = high.intrinsics
+    tol = p.roof_colour_tolerance_dn
+    best: tuple[float, Shape] | None = None
+    for other in low_shapes:
+        if other.cut_by_border or not all(
+            abs(a - b) <= tol for a, b in zip(other.colour_rgb, shape.colour_rgb, strict=True)
+        ):
+            continue
+        # Climbing straight up, a roof's offset from the image centre shrinks as its size
+        # does: where the lower photo should show this roof, given its size there.
+        ratio = math.sqrt(other.area_px / shape.area_px)
+        u = k.cx_px + (shape.centroid_px[0] - k.cx_px) * ratio
+        v = k.cy_px + (shape.centroid_px[1] - k.cy_px) * ratio
+        miss = math.hypot(other.centroid_px[0] - u, other.centroid_px[1] - v)
+        if miss <= p.roof_match_px and (best is None or miss < best[0]):
+            best = (miss, other)
+    if best is None:
+        return None
+    other = best[1]
+    roof = roof_from_photos(
+        centroid1_px=other.centroid_px,
+        area1_px=other.area_px,
+        pose1=low.pose,
+        centroid2_px=shape.centroid_px,
+        area2_px=shape.area_px,
+        pose2=high.pose,
+        intrinsics=k,
+    )
+    return None if roof is None else max(roof, 0.0)
+
+
+def _footprint(shape: Shape, photo: Photo, roof_m: float) -> tuple[tuple[float, float], ...]:
+    try:
+        return ground_polygon(shape.polygon_px, photo.pose, photo.intrinsics, plane_z_m=roof_m)
+    except NavError:  # a roof assumed above the camera: place it on the ground instead
+        return ground_polygon(shape.polygon_px, photo.pose, photo.intrinsics, plane_z_m=0.0)
+
+
+def _extent_m(footprint: tuple[tuple[float, float], ...]) -> float:
+    rect = min_area_rect(footprint)
+    return math.hypot(rect.length_m, rect.width_m)

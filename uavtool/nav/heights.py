@@ -1,0 +1,106 @@
+"""Roof heights from nadir photos, and the altitudes that follow from them.
+
+Two photos of one roof from different camera positions tell its height twice over:
+
+* by its size: a roof at height ``h`` seen straight down from altitude ``a`` by a camera of
+  focal length ``f`` (pixels) spans ``f · W / (a − h)`` pixels for a roof ``W`` metres wide, so
+  ``s1 · (a1 − h) = s2 · (a2 − h)`` and ``h = (s2 · a2 − s1 · a1) / (s2 − s1)``, with ``s`` the
+  square root of its area in pixels (the outline's pixel error limits it to about 1 %);
+* by triangulation: the rays through the roof's centroid from both cameras meet at the roof,
+  ``P1 + (a1 − h) · v1 = P2 + (a2 − h) · v2`` with ``v`` a ray's horizontal run per metre of
+  descent; least squares gives ``h``. A centroid averages thousands of pixels, so this is
+  the sharper estimate — except for a roof straight below, whose rays barely differ.
+
+:func:`roof_from_photos` weighs both by their expected errors. Heights are metres above
+home, as the altitudes.
+"""
+
+from __future__ import annotations
+
+import math
+
+from uavtool.camera import CameraPose, Intrinsics
+
+SIZE_ERROR = 0.01
+"""Relative error of a roof's linear size in pixels (its outline's area, square-rooted)."""
+CENTROID_ERROR_PX = 0.5
+"""Error of a roof's centroid in pixels."""
+
+
+def roof_height_m(
+    *, area1_px: float, alt1_m: float, area2_px: float, alt2_m: float, min_ratio: float = 1.05
+) -> float | None:
+    """The roof height of one building seen whole in two nadir photos from ``alt1_m`` and
+    ``alt2_m`` (its outline's area in each, square pixels). None when the two sizes differ by
+    less than ``min_ratio`` (the altitudes are too close for the sizes to tell) or the result
+    is not below both cameras."""
+    if area1_px <= 0.0 or area2_px <= 0.0:
+        return None
+    s1, s2 = math.sqrt(area1_px), math.sqrt(area2_px)
+    if max(s1, s2) < min_ratio * min(s1, s2):
+        return None
+    h = (s2 * alt2_m - s1 * alt1_m) / (s2 - s1)
+    if not math.isfinite(h) or h >= min(alt1_m, alt2_m):
+        return None
+    return h
+
+
+def fit_altitude_m(*, roof_m: float, extent_m: float, intrinsics: Intrinsics, fill: float) -> float:
+    """The altitude from which a roof ``extent_m`` across (its longest dimension, any
+    direction) spans ``fill`` of the photo's shorter side, straight down."""
+    half_fov = math.radians(min(intrinsics.hfov_deg, intrinsics.vfov_deg)) / 2.0
+    return roof_m + extent_m / 2.0 / (fill * math.tan(half_fov))
+
+
+def roof_from_photos(
+    *,
+    centroid1_px: tuple[float, float],
+    area1_px: float,
+    pose1: CameraPose,
+    centroid2_px: tuple[float, float],
+    area2_px: float,
+    pose2: CameraPose,
+    intrinsics: Intrinsics,
+) -> float | None:
+    """The roof height of one building seen whole in two nadir photos (its outline's
+    centroid and area in each, and each camera's pose): the size and triangulation
+    estimates, each weighted by the inverse of its expected variance. None when neither
+    can tell."""
+    a1, a2 = pose1.pos_enu_m[2], pose2.pos_enu_m[2]
+    estimates: list[tuple[float, float]] = []  # (height, variance)
+    by_size = roof_height_m(area1_px=area1_px, alt1_m=a1, area2_px=area2_px, alt2_m=a2)
+    if by_size is not None:
+        s1, s2 = math.sqrt(area1_px), math.sqrt(area2_px)
+        sigma = SIZE_ERROR * s1 * s2 * abs(a2 - a1) / (s2 - s1) ** 2
+        estimates.append((by_size, sigma * sigma))
+    v1 = _run_per_descent(centroid1_px, pose1, intrinsics)
+    v2 = _run_per_descent(centroid2_px, pose2, intrinsics)
+    if v1 is not None and v2 is not None:
+        (x1, y1, _), (x2, y2, _) = pose1.pos_enu_m, pose2.pos_enu_m
+        ax = x1 + a1 * v1[0] - x2 - a2 * v2[0]
+        ay = y1 + a1 * v1[1] - y2 - a2 * v2[1]
+        bx, by = v1[0] - v2[0], v1[1] - v2[1]
+        bb = bx * bx + by * by
+        if bb > 1e-12:
+            h = (ax * bx + ay * by) / bb
+            metres_per_px = max(min(a1, a2) - h, 0.0) / intrinsics.fx_px
+            sigma = CENTROID_ERROR_PX * metres_per_px / math.sqrt(bb)
+            estimates.append((h, max(sigma * sigma, 1e-12)))
+    if not estimates:
+        return None
+    weight = sum(1.0 / var for _, var in estimates)
+    h = sum(est / var for est, var in estimates) / weight
+    return h if h < min(a1, a2) else None
+
+
+def _run_per_descent(
+    centroid_px: tuple[float, float], pose: CameraPose, intrinsics: Intrinsics
+) -> tuple[float, float] | None:
+    """East and north metres the ray through a pixel runs per metre it descends."""
+    right, down, forward = pose.axes()
+    x = (centroid_px[0] - intrinsics.cx_px) / intrinsics.fx_px
+    y = (centroid_px[1] - intrinsics.cy_px) / intrinsics.fy_px
+    d = [right[i] * x + down[i] * y + forward[i] for i in range(3)]
+    if not d[2] < 0.0:
+        return None
+    return d[0] / -d[2], d[1] / -d[2]
