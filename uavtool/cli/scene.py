@@ -3,10 +3,15 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 
 from uavtool.errors import InputError
+
+if TYPE_CHECKING:
+    from uavtool.world.hard import HardSceneInfo
+    from uavtool.world.scene import Scene
 
 
 def _floats(text: str, n: int, option: str, example: str) -> tuple[float, ...]:
@@ -158,10 +163,29 @@ def show(scene_ref: str, size: str, output: Path) -> None:
 @click.option(
     "--seed", required=True, type=int, help="Random seed; the same seed gives the same file."
 )
-@click.option("--buildings", default=8, show_default=True, type=int, help="Number of buildings.")
+@click.option(
+    "--buildings",
+    default=None,
+    type=int,
+    help="Number of buildings.  [default: 8; with --hard 5-8, drawn from the seed]",
+)
 @click.option(
     "--margin", default=4.0, show_default=True, help="Minimum gap between buildings, metres."
 )
+@click.option(
+    "--hard",
+    is_flag=True,
+    help="A hard scene: decoys of the target (mirror image in a close hue, scaled copy, "
+    "one vertex moved), stepped towers, arches, 3-25 m tall, spread past one overview.",
+)
+@click.option(
+    "--spread",
+    default=None,
+    type=float,
+    help="With --hard: half-side of the square around home the buildings stand in, "
+    "metres.  [default: 35]",
+)
+@click.option("--overhang", is_flag=True, help="With --hard: home under an arch 5-7 m up.")
 @click.option(
     "-o",
     "--output",
@@ -169,23 +193,68 @@ def show(scene_ref: str, size: str, output: Path) -> None:
     type=click.Path(path_type=Path),
     help="Scene file to write (.yaml or .json).",
 )
-def random_scene(seed: int, buildings: int, margin: float, output: Path) -> None:
+def random_scene(
+    seed: int,
+    buildings: int | None,
+    margin: float,
+    hard: bool,
+    spread: float | None,
+    overhang: bool,
+    output: Path,
+) -> None:
     """Generate a random scene file from a seed.
 
+    With --hard, the target has decoys (mirror image, scaled copy, near-identical shape),
+    some buildings are stepped towers or arches, and they stand wider apart than one
+    photo from 45 m covers; the file's description names the decoys.
+
     \b
-    Example:
+    Examples:
       uavtool scene random --seed 7 --buildings 10 -o random7.yaml
       uavtool scene show random7.yaml -o random7.png
+      uavtool scene random --hard --seed 7 -o hard7.yaml
     """
-    from uavtool.world.generator import generate_scene
     from uavtool.world.scene import dump_scene
 
-    s = generate_scene(seed=seed, buildings=buildings, margin_m=margin)
     suffix = output.suffix.lower()
     if suffix not in (".yaml", ".yml", ".json"):
         raise InputError(f"{output}: output must end in .yaml, .yml or .json")
+    if hard:
+        s, info = _hard_scene(seed, buildings, margin, spread, overhang)
+    else:
+        from uavtool.world.generator import generate_scene
+
+        for flag, given in (("--spread", spread is not None), ("--overhang", overhang)):
+            if given:
+                raise InputError(f"{flag} needs --hard")
+        s = generate_scene(
+            seed=seed, buildings=8 if buildings is None else buildings, margin_m=margin
+        )
     try:
         output.write_text(dump_scene(s, suffix=suffix), encoding="utf-8")
     except OSError as exc:
         raise InputError(f"{output}: cannot write: {exc.strerror}") from None
     click.echo(f"{output}: {len(s.buildings)} buildings, target {s.target!r}")
+    if hard:
+        click.echo(info.summary())
+
+
+def _hard_scene(
+    seed: int, buildings: int | None, margin: float, spread: float | None, overhang: bool
+) -> tuple[Scene, HardSceneInfo]:
+    from uavtool.world.hard import MAX_HARD_BUILDINGS, HardOptions, generate_hard_scene_with_info
+
+    default = HardOptions()
+    if buildings is not None and not 1 <= buildings <= MAX_HARD_BUILDINGS:
+        raise InputError(
+            f"--buildings must be in 1..{MAX_HARD_BUILDINGS} with --hard, got {buildings}"
+        )
+    # HardOptions checks the rest (SceneError, exit 2)
+    options = HardOptions(
+        min_buildings=default.min_buildings if buildings is None else buildings,
+        max_buildings=default.max_buildings if buildings is None else buildings,
+        margin_m=margin,
+        spread_m=default.spread_m if spread is None else spread,
+        home_overhang_p=1.0 if overhang else default.home_overhang_p,
+    )
+    return generate_hard_scene_with_info(seed=seed, options=options)

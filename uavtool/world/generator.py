@@ -2,7 +2,8 @@
 
 Only ``random.Random(seed).random()`` (Mersenne Twister, the same stream in every Python
 version) and ``math`` feed the result, and coordinates are rounded to centimetres, so a
-seed gives the same scene file on every machine.
+seed gives the same scene file on every machine. :mod:`uavtool.world.hard` builds on these
+helpers for hard scenes (decoys of the target, stepped towers, arches, spread out).
 """
 
 from __future__ import annotations
