@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import socket
 import threading
 import time
@@ -13,9 +14,10 @@ from click.testing import CliRunner
 from uavtool.cli import cli
 from uavtool.mission import Params, Status
 from uavtool.mission.params import with_overrides
-from uavtool.recording import summarize
+from uavtool.recording import RecordingReader, summarize
 from uavtool.replay import load_flight, replay
 from uavtool.runner.fly import FlyConfig, fly
+from uavtool.world import load_scene, scene_to_dict
 
 
 @pytest.fixture(scope="module")
@@ -134,3 +136,29 @@ def test_each_outcome_has_its_exit_code(args: list[str], status: str, code: int)
     result = CliRunner().invoke(cli, ["fly", "-q", "--no-record", *args])
     assert result.exit_code == code, result.output
     assert f"outcome        {status}" in result.output
+
+
+def test_a_collision_crashes_the_vehicle_and_ends_the_mission(tmp_path: Path) -> None:
+    """A mast the colour of the ground (the mission cannot see it) stands where the front
+    photo is taken: the vehicle's body touches it on the way down, the vehicle crashes, the
+    mission ends 'crashed' with exit code 5, and the recording has the vehicle's word."""
+    data = scene_to_dict(load_scene("paper"))
+    x, y, r = 10.18, -29.21, 0.4  # paper's front viewpoint
+    ring = [[x - r, y - r], [x + r, y - r], [x + r, y + r], [x - r, y + r]]
+    grey = list(data["ground"]["color"])
+    data["buildings"].append(
+        {"name": "mast", "color": grey, "blocks": [{"footprint": ring, "top_m": 5.9}]}
+    )
+    scene = tmp_path / "mast.json"
+    scene.write_text(json.dumps(data))
+    rec = tmp_path / "crash.mcap"
+    result = CliRunner().invoke(cli, ["fly", "-q", "--scene", str(scene), "--record", str(rec)])
+    assert result.exit_code == 5, result.output
+    assert "outcome        crashed: the vehicle disarmed in the air" in result.output
+    assert "from building 'mast'" in result.output
+    info = summarize(rec)
+    assert info.outcome is not None and info.outcome["status"] == "crashed"
+    assert float(info.outcome["closest_clearance_m"]) <= 0.0
+    with RecordingReader(rec) as reader:
+        texts = [str(e.value.payload["text"]) for e in reader.entries(["/mavlink/in/STATUSTEXT"])]  # type: ignore[union-attr]
+    assert "Crash: collision with building 'mast'" in texts

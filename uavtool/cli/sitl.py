@@ -23,6 +23,13 @@ def _interrupt(_signum: int, _frame: object) -> None:
 )
 @click.option("--home", default=None, metavar="LAT,LON,ALT,HDG", help="Home position and heading.")
 @click.option(
+    "--scene",
+    default=None,
+    metavar="NAME|FILE",
+    help="Fly among a scene's buildings (built-in name or scene file): touching one is a crash. "
+    "Home and heading default to the scene's.",
+)
+@click.option(
     "--speedup", default=1.0, show_default=True, type=float, help="Sim time runs N× wall time."
 )
 @click.option("--sysid", default=1, show_default=True, type=int, help="MAVLink system id.")
@@ -58,6 +65,7 @@ def _interrupt(_signum: int, _frame: object) -> None:
 def sitl(
     endpoints: tuple[str, ...],
     home: str | None,
+    scene: str | None,
     speedup: float,
     sysid: int,
     instance: int,
@@ -74,7 +82,7 @@ def sitl(
 
     \b
     Example:
-      uavtool sitl --speedup 5
+      uavtool sitl --speedup 5 --scene paper
       mavproxy.py --master tcp:127.0.0.1:5760
     """
     from uavtool.sitl import Sitl, SitlConfig, parse_home, parse_signing_key
@@ -82,8 +90,21 @@ def sitl(
     from uavtool.sitl.params import load_param_file
 
     kwargs: dict[str, object] = {}
+    home_point = None
     if home is not None:
-        kwargs["home"], kwargs["home_heading_deg"] = parse_home(home)
+        home_point, kwargs["home_heading_deg"] = parse_home(home)
+        kwargs["home"] = home_point
+    scene_text = ""
+    if scene is not None:
+        from uavtool.world import load_scene
+        from uavtool.world.obstacles import scene_obstacles
+
+        loaded = load_scene(scene)
+        if home_point is None:
+            kwargs["home"], kwargs["home_heading_deg"] = loaded.home, loaded.home_heading_deg
+        # With --home the buildings stay where the scene puts them on the map.
+        kwargs["obstacles"] = obstacles = scene_obstacles(loaded, home=home_point)
+        scene_text = f", scene {loaded.name!r} ({len(obstacles)} obstacles)"
     if wind is not None:
         kwargs["wind_speed_ms"], kwargs["wind_dir_deg"] = parse_wind(wind)
     if signing_key is not None:
@@ -100,7 +121,9 @@ def sitl(
         **kwargs,  # type: ignore[arg-type]
     )
     vehicle = Sitl(config)
-    click.echo(f"uavtool sitl: vehicle sysid {vehicle.sysid}, speedup {vehicle.speedup:g}x")
+    click.echo(
+        f"uavtool sitl: vehicle sysid {vehicle.sysid}, speedup {vehicle.speedup:g}x{scene_text}"
+    )
     for ep in vehicle.describe_endpoints():
         click.echo(f"  serving MAVLink on {ep}")
     click.echo("  Ctrl-C to stop")
@@ -112,3 +135,5 @@ def sitl(
     finally:
         vehicle.close()
     click.echo(f"uavtool sitl: stopped at sim time {vehicle.now_ns / 1e9:.1f} s")
+    if vehicle.crashed:
+        click.echo(f"  the vehicle crashed: {vehicle.crash_reason}")

@@ -1,9 +1,11 @@
 """How well a flight did against the scene's ground truth (only the runner knows the scene;
-the mission never sees it): which building was matched, and the model's volumetric IoU."""
+the mission never sees it): which building was matched, the model's volumetric IoU, whether
+the model kept the target's tunnels, and how close the vehicle came to any building."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -23,6 +25,12 @@ class Evaluation:
     matched_building: str = ""
     target_building: str = ""
     model_iou: float | None = None
+    tunnel_kept: bool | None = None
+    """Whether the model is open where the target has a tunnel (None: the target has none, or
+    there is no model)."""
+    clearance_m: float | None = None
+    """Least distance between the vehicle's body and any building while airborne."""
+    clearance_building: str = ""
 
 
 def evaluate(runner: Runner, scene: Scene | None) -> Evaluation:
@@ -41,10 +49,76 @@ def evaluate(runner: Runner, scene: Scene | None) -> Evaluation:
 
     visited = tuple(building_at(k) for k in outcome.visited)
     matched = building_at(outcome.matched_poi) if outcome.matched_poi >= 0 else ""
-    iou = None
+    iou = kept = None
     if mission.model is not None:
         iou = model_iou(mission.model.vertices_m, mission.model.faces, scene, offset)
-    return Evaluation(visited, matched, scene.target, iou)
+        kept = tunnel_kept(mission.model.vertices_m, mission.model.faces, scene, offset)
+    return Evaluation(visited, matched, scene.target, iou, kept)
+
+
+def closest_clearance(
+    route_enu_m: Sequence[tuple[float, float, float]],
+    scene: Scene,
+    *,
+    body_radius_m: float,
+    offset_en: tuple[float, float] = (0.0, 0.0),
+) -> tuple[float, str]:
+    """(least gap between a sphere of ``body_radius_m`` along the route and any building,
+    that building's name); ``(inf, "")`` for an empty route or scene. Route points are in
+    the vehicle's ENU frame, ``offset_en`` its home in the scene's frame."""
+    from uavtool.sitl.obstacles import ObstacleField  # noqa: PLC0415
+    from uavtool.world.obstacles import scene_obstacles  # noqa: PLC0415
+
+    field = ObstacleField(scene_obstacles(scene))
+    best, name = math.inf, ""
+    for x, y, z in route_enu_m:
+        distance, prism = field.nearest(x + offset_en[0], y + offset_en[1], z)
+        if prism is not None and distance - body_radius_m < best:
+            best, name = distance - body_radius_m, prism.name
+    return best, name
+
+
+def tunnel_kept(
+    vertices_m: Any, faces: Any, scene: Scene, offset_en: tuple[float, float] = (0.0, 0.0)
+) -> bool | None:
+    """Whether a model (vehicle-home ENU) is open where the target building has a tunnel: at
+    half the height of each raised block, over the part of its footprint no lower block
+    fills. None when the target has no raised block."""
+    import manifold3d  # noqa: PLC0415
+    import shapely  # noqa: PLC0415
+
+    blocks = scene.target_building.blocks
+    points = []
+    for block in blocks:
+        if block.base_m <= 0.0:
+            continue
+        under = shapely.Polygon(block.footprint_enu_m)
+        for other in blocks:
+            if other is not block and other.top_m <= block.base_m + 1e-6:
+                under = under.difference(shapely.Polygon(other.footprint_enu_m))
+        if under.area < 0.5:  # resting on what is below it all over: no tunnel
+            continue
+        inner = under.buffer(-0.3)  # away from the walls, where a model may bulge a little
+        p = (inner if not inner.is_empty else under).representative_point()
+        points.append((p.x - offset_en[0], p.y - offset_en[1], block.base_m / 2.0))
+    if not points:
+        return None
+    model = _manifold(vertices_m, faces)
+    probe_m = 0.2  # a small cube at each point: open if the model holds none of it
+    for x, y, z in points:
+        cube = manifold3d.Manifold.cube([probe_m] * 3, center=True).translate([x, y, z])
+        if (model ^ cube).volume() > 0.0:
+            return False
+    return True
+
+
+def _manifold(vertices_m: Any, faces: Any, offset_en: tuple[float, float] = (0.0, 0.0)) -> Any:
+    import manifold3d  # noqa: PLC0415
+
+    v = np.asarray(vertices_m, dtype=np.float64) + np.array([offset_en[0], offset_en[1], 0.0])
+    return manifold3d.Manifold(
+        manifold3d.Mesh(v.astype(np.float32), np.asarray(faces, dtype=np.uint32))
+    )
 
 
 def nearest_building(scene: Scene, point_en: tuple[float, float]) -> str:
@@ -60,10 +134,7 @@ def model_iou(
     """Volumetric IoU of a mesh (vehicle-home ENU) with the scene's target building."""
     import manifold3d  # noqa: PLC0415
 
-    v = np.asarray(vertices_m, dtype=np.float64) + np.array([offset_en[0], offset_en[1], 0.0])
-    model = manifold3d.Manifold(
-        manifold3d.Mesh(v.astype(np.float32), np.asarray(faces, dtype=np.uint32))
-    )
+    model = _manifold(vertices_m, faces, offset_en)
     truth_mesh = building_mesh(scene.target_building)
     truth = manifold3d.Manifold(
         manifold3d.Mesh(

@@ -32,7 +32,7 @@ from uavtool.mission import Level, Mission, Outcome, Params
 from uavtool.mission.params import to_dict
 from uavtool.recording import RecordingWriter
 from uavtool.runner.camera import open_camera
-from uavtool.runner.evaluate import Evaluation, evaluate
+from uavtool.runner.evaluate import Evaluation, closest_clearance, evaluate
 from uavtool.runner.live import LiveView
 from uavtool.runner.params import set_vehicle_params
 from uavtool.runner.record import ClockNs, MissionRecorder
@@ -85,6 +85,11 @@ class FlightSummary:
     vehicle: str
     vehicle_time_s: float
     """Vehicle time from the first observation to the end of the mission."""
+    clearance_m: float | None
+    """Least gap between the vehicle's body and any building of the scene while airborne (the
+    built-in vehicle's own, exact; from the telemetry for another vehicle with the sim
+    camera; None without a scene)."""
+    clearance_building: str
     flight_wall_s: float
     """Wall time of the same span (the mission itself, without start-up)."""
 
@@ -194,6 +199,18 @@ def fly(
             raise
         flight_wall_s, vehicle_s = time.perf_counter() - flight_wall0, clock() - vehicle0
         evaluation = evaluate(runner, scene if config.camera == "sim" else None)
+        clearance_m: float | None = None
+        clearance_building = ""
+        if config.connect is None:
+            clearance_m = lockstep.vehicle.closest_clearance_m
+            clearance_building = lockstep.vehicle.closest_obstacle
+        elif config.camera == "sim":
+            clearance_m, clearance_building = closest_clearance(
+                [p for _, p in runner.route],
+                scene,
+                body_radius_m=_body_radius_m(),
+                offset_en=runner.scene_offset,
+            )
         summary = FlightSummary(
             outcome,
             evaluation,
@@ -204,6 +221,8 @@ def fly(
             time.monotonic() - wall0,
             link.name,
             vehicle_s,
+            clearance_m if clearance_m is None or math.isfinite(clearance_m) else None,
+            clearance_building,
             flight_wall_s,
         )
         if recorder is not None:
@@ -230,6 +249,11 @@ def summary_record(s: FlightSummary) -> dict[str, object]:
         record["target_building"] = e.target_building
     if e.model_iou is not None:
         record["model_iou"] = round(e.model_iou, 4)
+    if e.tunnel_kept is not None:
+        record["tunnel_kept"] = e.tunnel_kept
+    if s.clearance_m is not None:
+        record["closest_clearance_m"] = round(s.clearance_m, 2)
+        record["closest_building"] = s.clearance_building
     return record
 
 
@@ -247,9 +271,11 @@ def _builtin_sitl(config: FlyConfig, scene: Scene) -> Iterator[LockstepTransport
     # Only when flying the built-in vehicle: a real one needs none of the simulator.
     from uavtool.sitl import SitlConfig  # noqa: PLC0415
     from uavtool.sitl.lockstep import SIM_EPOCH_UNIX_S, LockstepTransport  # noqa: PLC0415
+    from uavtool.world.obstacles import scene_obstacles  # noqa: PLC0415
 
     sitl_config = SitlConfig(
         endpoints=(),
+        obstacles=scene_obstacles(scene),
         home=scene.home,
         home_heading_deg=scene.home_heading_deg,
         seed=config.seed,
@@ -315,3 +341,9 @@ def _route_length(route: list[tuple[int, tuple[float, float, float]]]) -> float:
 
 def _flight_time(route: list[tuple[int, tuple[float, float, float]]]) -> float:
     return (route[-1][0] - route[0][0]) / 1000.0 if len(route) > 1 else 0.0
+
+
+def _body_radius_m() -> float:
+    from uavtool.sitl import SitlConfig  # noqa: PLC0415 - the simulator's default body
+
+    return SitlConfig().body_radius_m

@@ -44,5 +44,12 @@ def format_summary(s: FlightSummary) -> str:
         lines.append(f"model          built{iou}")
     else:
         lines.append("model          not built")
+    if s.clearance_m is not None:
+        lines.append(
+            f"clearance      {s.clearance_m:.2f} m from building {s.clearance_building!r} "
+            "at the closest (the vehicle's body to any wall or roof)"
+        )
+    if e.tunnel_kept is not None:
+        lines.append(f"tunnel         {'kept' if e.tunnel_kept else 'LOST'} in the model")
     lines.append(f"recording      {s.recording if s.recording else '(not recorded)'}")
     return "\n".join(lines)

@@ -8,7 +8,8 @@ Run it from the shell with ``uavtool sitl`` or in-process::
 """
 
 from uavtool.sitl.config import SitlConfig, parse_home, parse_signing_key
+from uavtool.sitl.obstacles import Prism
 from uavtool.sitl.server import Sitl
 from uavtool.sitl.state import Mode
 
-__all__ = ["Mode", "Sitl", "SitlConfig", "parse_home", "parse_signing_key"]
+__all__ = ["Mode", "Prism", "Sitl", "SitlConfig", "parse_home", "parse_signing_key"]

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from uavtool.errors import InputError
 from uavtool.geo import GeoPoint
+from uavtool.sitl.obstacles import Prism
 
 DEFAULT_ENDPOINTS = ("tcpin:127.0.0.1:5760", "udpout:127.0.0.1:14550")
 # ArduPilot SITL's default home: Canberra Model Aircraft Club field.
@@ -34,6 +36,14 @@ class SitlConfig:
     link_outages_s: tuple[tuple[float, float], ...] = ()
     """Fault injection: ``(start, duration)`` windows of sim time (s since start) during which
     every link is cut both ways, as if the radio failed."""
+    obstacles: tuple[Prism, ...] = ()
+    """What the vehicle can collide with: prisms in metres east/north of ``home`` and above it
+    (``uavtool sitl --scene`` turns a scene's buildings into these). Touching one in flight
+    is a crash; a NAV_TAKEOFF that would climb into one is DENIED."""
+    body_radius_m: float = 0.4
+    """The vehicle's body for collisions: a sphere of this radius around its position (0.4 m:
+    a 450–500 mm quadcopter with its propellers). Used against obstacles only; the ground is
+    met by the position itself, as landing gear would."""
 
     def __post_init__(self) -> None:
         for start_s, duration_s in self.link_outages_s:
@@ -51,6 +61,8 @@ class SitlConfig:
             raise InputError("signing key must be 32 bytes (64 hex digits)")
         if self.wind_speed_ms < 0:
             raise InputError(f"wind speed must be ≥ 0, got {self.wind_speed_ms}")
+        if not 0.0 < self.body_radius_m < math.inf:
+            raise InputError(f"body radius must be > 0 m, got {self.body_radius_m}")
 
 
 def parse_home(text: str) -> tuple[GeoPoint, float]:

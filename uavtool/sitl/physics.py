@@ -44,6 +44,15 @@ class Target:
     yaw_rate_dps: float | None = None
 
 
+@dataclass(frozen=True, slots=True)
+class Touchdown:
+    """How a step met the ground after being in the air: the velocity (m/s, NED) before ground
+    contact stopped it, and the greatest height (m above home) since it left the ground."""
+
+    vel_ned_ms: tuple[float, float, float]
+    peak_up_m: float
+
+
 @dataclass(slots=True)
 class State:
     pos_ned_m: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
@@ -82,6 +91,9 @@ class Multicopter:
         self._rng = rng or random.Random(0)
         self._hold: tuple[float, float, float] | None = None
         self.motors_on = False
+        self.touchdown: Touchdown | None = None
+        """How the last step met the ground; None when it did not (or was already on it)."""
+        self._peak_up_m = 0.0  # greatest height since the vehicle last left the ground
 
     def set_target(self, target: Target) -> None:
         self.target = target
@@ -89,6 +101,7 @@ class Multicopter:
 
     def step(self, dt_s: float) -> None:
         s = self.state
+        self.touchdown = None
         if not self.motors_on:
             self._settle_on_ground(dt_s)
             return
@@ -104,6 +117,7 @@ class Multicopter:
             ax, ay = ax * k, ay * k
         az = max(-lim.accel_z_mss * 2.5, min(lim.accel_z_mss * 2.5, az))
         self._update_gust(dt_s)
+        airborne = s.pos_ned_m[2] < 0.0
         for i, a in enumerate((ax, ay, az)):
             s.accel_ned_mss[i] = a
             s.vel_ned_ms[i] += a * dt_s
@@ -111,6 +125,8 @@ class Multicopter:
         self._update_attitude(ax, ay)
         self._update_yaw(dt_s)
         if s.pos_ned_m[2] >= 0.0:
+            if airborne:
+                self._touch_down()
             s.pos_ned_m[2] = 0.0
             s.vel_ned_ms[2] = min(s.vel_ned_ms[2], 0.0)
             s.on_ground = vel_des[2] >= 0.0
@@ -118,6 +134,13 @@ class Multicopter:
                 s.vel_ned_ms[0] = s.vel_ned_ms[1] = 0.0
         else:
             s.on_ground = False
+            if -s.pos_ned_m[2] > self._peak_up_m:  # noqa: PLR1730 (every step: no max() call)
+                self._peak_up_m = -s.pos_ned_m[2]
+
+    def _touch_down(self) -> None:
+        v = self.state.vel_ned_ms
+        self.touchdown = Touchdown((v[0], v[1], v[2]), self._peak_up_m)
+        self._peak_up_m = 0.0
 
     def _desired_velocity(self) -> tuple[float, float, float]:
         s, t, lim = self.state, self.target, self.limits
@@ -191,6 +214,8 @@ class Multicopter:
             s.vel_ned_ms[2] += GRAVITY_MSS * dt_s
             s.pos_ned_m[2] = min(0.0, s.pos_ned_m[2] + s.vel_ned_ms[2] * dt_s)
             s.on_ground = s.pos_ned_m[2] >= 0.0
+            if s.on_ground:
+                self._touch_down()
         else:
             s.on_ground = True
         if s.on_ground:

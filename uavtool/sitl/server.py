@@ -66,6 +66,8 @@ class Sitl:
             home_heading_deg=config.home_heading_deg,
             params=params,
             seed=config.seed,
+            obstacles=config.obstacles,
+            body_radius_m=config.body_radius_m,
         )
         self.telemetry = Telemetry(
             self.autopilot,
@@ -174,6 +176,27 @@ class Sitl:
     @property
     def now_ns(self) -> int:
         return self.autopilot.now_ns
+
+    @property
+    def crashed(self) -> bool:
+        """True once the vehicle has hit an obstacle or the ground hard (until it restarts)."""
+        return self.autopilot.crashed
+
+    @property
+    def crash_reason(self) -> str:
+        """The crash's STATUSTEXT, e.g. ``Crash: collision with building 'red'``; "" if none."""
+        return self.autopilot.crash_reason
+
+    @property
+    def closest_clearance_m(self) -> float:
+        """Least gap (m) between the body sphere and any obstacle while airborne so far (≤ 0
+        after a collision, inf without obstacles); see ``Autopilot.closest_clearance_m``."""
+        return self.autopilot.closest_clearance_m
+
+    @property
+    def closest_obstacle(self) -> str:
+        """Name of the obstacle ``closest_clearance_m`` was measured to ("" if none)."""
+        return self.autopilot.closest_obstacle
 
     def broadcast(self, msg: Any) -> None:
         for session in self.sessions:

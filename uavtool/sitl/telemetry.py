@@ -136,7 +136,9 @@ class Telemetry:
             base |= M.MAV_MODE_FLAG_AUTO_ENABLED
         if ap.armed:
             base |= M.MAV_MODE_FLAG_SAFETY_ARMED
-        if ap.in_failsafe:
+        if ap.crashed:  # for good: only a restart brings the vehicle back
+            status = M.MAV_STATE_EMERGENCY
+        elif ap.in_failsafe:
             status = M.MAV_STATE_CRITICAL
         elif ap.armed:
             status = M.MAV_STATE_ACTIVE
@@ -149,10 +151,12 @@ class Telemetry:
     def sys_status(self) -> Any:
         ap = self.ap
         enabled = _SENSORS if ap.armed else _SENSORS & ~M.MAV_SYS_STATUS_SENSOR_MOTOR_OUTPUTS
+        # After a crash the pre-arm checks fail (arming is refused until a restart).
+        health = _SENSORS & ~M.MAV_SYS_STATUS_PREARM_CHECK if ap.crashed else _SENSORS
         return M.MAVLink_sys_status_message(
             _SENSORS,
             enabled,
-            _SENSORS,
+            health,
             150,
             round(ap.battery_voltage() * 1000),
             round(ap.battery_current_a() * 100),
