@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
+from dataclasses import replace
+
 import pytest
 
 from tests.mission import scenes
@@ -29,6 +32,8 @@ def visit_all_flight(paper: Scene) -> Flown:
 @pytest.fixture(scope="session")
 def turned_flight() -> Flown:
     """``paper`` flown facing east, each look from where the roof fills the photo's height
-    (``look_fill`` 1): the red roof's first two photos score below the threshold, the third
-    (20 m higher than the first) matches."""
-    return fly(scenes.turned(90.0), scenes.with_mission(look_fill=1.0))
+    (``look_fill`` 1) and a strict threshold (0.9): the red roof's first photo scores below
+    it, the second (10 m higher) matches."""
+    params = scenes.with_mission(look_fill=1.0)
+    strict = dataclasses.replace(params, recognize=replace(params.recognize, threshold=0.9))
+    return fly(scenes.turned(90.0), strict)

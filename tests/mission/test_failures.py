@@ -125,9 +125,8 @@ def test_move_never_arriving_is_retried_then_aborts(paper: Scene) -> None:
     assert outcome.visited == ()
     assert not flight.of_type(Plan)
     p = flown.mission.params.mission
-    goals = [
-        g for g in flight.of_type(GoTo) if g.pos_enu_m[2] == p.overview_alt_m + p.overview_climb_m
-    ]
+    high = max(g.pos_enu_m[2] for g in flight.of_type(GoTo))  # the second overview photo's
+    goals = [g for g in flight.of_type(GoTo) if g.pos_enu_m[2] == high]
     assert len(goals) == 4
     sent = _sent_ms(flight, "GoTo")[-4:]
     slack_ms = p.move_slack_s * 1000
@@ -173,7 +172,8 @@ def test_pilot_takeover_stops_all_commands(paper: Scene, after: type, pilot_land
     script: tuple[PilotMode, ...] = (PilotMode(At(after=after), "LOITER"),)
     if pilot_lands:
         script += (PilotMode(At(after=after, delay_s=5.0), "LAND"),)
-    flown = fly(paper, scenes.with_mission(land_timeout_s=30.0), script=script)
+    land_timeout_s = 120.0  # LAND from the 97 m overview at the fake's 1 m/s takes ~97 s
+    flown = fly(paper, scenes.with_mission(land_timeout_s=land_timeout_s), script=script)
     flight = flown.flight
     assert flight.outcome.status is Status.TAKEOVER
     assert flight.outcome.reason == "mode changed to LOITER by the pilot or a failsafe"
@@ -196,7 +196,7 @@ def test_pilot_takeover_stops_all_commands(paper: Scene, after: type, pilot_land
     else:
         assert texts[-1] == "still flying when the mission stopped watching"
         end_ms = flight.steps[-1].time_ms
-        assert end_ms - flight.steps[seen].time_ms == pytest.approx(30_000, abs=200)
+        assert end_ms - flight.steps[seen].time_ms == pytest.approx(land_timeout_s * 1000, abs=200)
 
 
 # --- the link goes quiet ---------------------------------------------------------------------

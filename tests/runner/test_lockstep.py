@@ -112,7 +112,7 @@ def test_the_recording_clock_is_sim_time(paper: Path) -> None:
         messages = list(reader.messages())
         meta = dict(reader.metadata)
     assert start >= SIM_EPOCH_NS
-    assert 130e9 < end - start < 160e9  # the flight's vehicle time, not the wall's
+    assert 130e9 < end - start < 300e9  # the flight's vehicle time (minutes), not the wall's
     assert all(m.publish_time_ns == m.log_time_ns for m in messages)
     assert meta["vehicle"]["clock"] == "lockstep"
     assert "command_line" not in meta  # paths and speed-ups are not inputs of the flight

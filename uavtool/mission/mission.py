@@ -48,7 +48,7 @@ from uavtool.mission.outputs import (
     TakePhoto,
     Vec3,
 )
-from uavtool.mission.params import Params
+from uavtool.mission.params import MissionParams, Params
 
 T = TypeVar("T")
 Wait = Generator[None, Observation, T]
@@ -303,7 +303,7 @@ class Mission:
         p = self.params.mission
         for attempt in range(1, p.command_retries + 2):
             yield from self.command(lambda i: GoTo(i, pos_enu_m, heading_deg), what)
-            timeout_s = _distance(self.last, pos_enu_m) / p.cruise_speed_m_s + p.move_slack_s
+            timeout_s = _move_time_s(self.last, pos_enu_m, p) + p.move_slack_s
             arrived = yield from self.wait_until(
                 lambda t: self._arrived(t, pos_enu_m, heading_deg), timeout_s
             )
@@ -398,6 +398,15 @@ class Mission:
     def airborne(self) -> None:
         """From now until the return home, a vehicle that disarms has crashed."""
         self._airborne = True
+
+
+def _move_time_s(t: Telemetry | None, pos_enu_m: Vec3, p: MissionParams) -> float:
+    """The longest a move should take: across at the slowest cruise speed, up or down at the
+    slowest climb rate."""
+    if t is None:
+        return 0.0
+    across_m = math.hypot(t.pos_enu_m[0] - pos_enu_m[0], t.pos_enu_m[1] - pos_enu_m[1])
+    return across_m / p.cruise_speed_m_s + abs(t.pos_enu_m[2] - pos_enu_m[2]) / p.climb_speed_m_s
 
 
 def _distance(t: Telemetry | None, pos_enu_m: Vec3) -> float:

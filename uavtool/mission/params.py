@@ -27,9 +27,12 @@ class MissionParams:
     overview_alt_m: float = 45.0
     """Altitude above home of the first overview photo."""
     overview_climb_m: float = 15.0
-    """The second overview photo is taken this much higher, straight above the first: a
-    roof's size changes between them by how far below the camera it is, which gives every
-    building's roof height (and the higher photo sees further)."""
+    """The second overview photo is taken at least this much higher, straight above the
+    first: a roof's size and place change between them by how far below the camera it is,
+    which gives every building's roof height …"""
+    search_radius_m: float = 40.0
+    """… and high enough to see the whole search area: a square this many metres from home
+    east, west, north and south (straight down, the photo's shorter side spans it)."""
     assumed_roof_m: float = 25.0
     """Roof height assumed for a building whose height the overview photos could not measure
     (cut by the border, or seen in one photo only): the tallest expected. A look measures it."""
@@ -82,7 +85,8 @@ class MissionParams:
     cruise_speed_m_s: float = 5.0
     """Slowest speed a move is expected to make: its timeout is distance / this + slack."""
     climb_speed_m_s: float = 1.0
-    """Slowest climb rate expected during take-off (its timeout)."""
+    """Slowest climb or descent rate expected (the timeout of take-off and of every move's
+    vertical part)."""
     move_slack_s: float = 20.0
     """Extra time allowed for any move, climb or turn before it counts as failed."""
     retry_wait_s: float = 2.0
@@ -106,6 +110,7 @@ class MissionParams:
             "cruise_speed_m_s",
             "roof_match_px",
             "min_above_roof_m",
+            "search_radius_m",
         ):
             if not getattr(self, name) > 0:
                 raise InputError(f"mission.{name} must be positive, got {getattr(self, name)}")

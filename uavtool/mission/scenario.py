@@ -27,6 +27,7 @@ from uavtool.nav import (
     top_viewpoint,
     visit_order,
 )
+from uavtool.nav.geometry import point_polygon_distance
 from uavtool.nav.heights import fit_altitude_m
 from uavtool.vision.errors import VisionError
 from uavtool.vision.model3d import View, build_model, central_shape, model_glb, same_colour
@@ -140,16 +141,7 @@ def _model(
             continue
         if vp.fallback:
             m.event(Level.INFO, f"{vp.name} viewpoint: {vp.fallback}")
-        x, y, z = vp.pos_enu_m
-        yield from m.travel(
-            (x, y, transit_m), vp.heading_deg, transit_m, f"above the {vp.name} viewpoint"
-        )
-        yield from m.move((x, y, z), vp.heading_deg, f"{vp.name} viewpoint")
-        photo = yield from m.photo(vp.name, 0.0)
-        shapes = photo_shapes(m, photo, nadir=False)
-        silhouette = same_colour(shapes, obj.colour_rgb, hue_tolerance_deg=_SIDE_HUE_TOLERANCE_DEG)
-        views[vp.name] = View(silhouette, photo.pose, photo.intrinsics)
-        yield from m.move((x, y, transit_m), vp.heading_deg, f"climb from the {vp.name} viewpoint")
+        views[vp.name] = yield from _side_view(m, vp, obj.colour_rgb, obstacles, transit_m)
 
     missing = [name for name in ("front", "right") if name not in views]
     if missing:
@@ -181,6 +173,50 @@ def _model(
         Level.INFO,
         f"model built: height {model.height_m:.2f} m, volume {float(mesh.volume):.1f} m³",
     )
+
+
+def _side_view(
+    m: Mission,
+    vp: Viewpoint,
+    colour_rgb: tuple[int, int, int],
+    obstacles: list[tuple[tuple[float, float], ...]],
+    transit_m: float,
+) -> Wait[View]:
+    """A side photo from ``vp``; while the building touches the image border, the camera
+    backs away from it by half the planned distance and photographs it again (up to
+    ``max_looks`` photos), as long as that keeps the safety margin from every other
+    building."""
+    p = m.params.mission
+    margin_m = m.params.viewpoints.safety_margin_m
+    x, y, z = vp.pos_enu_m
+    h = math.radians(vp.heading_deg)
+    back_x, back_y = -math.sin(h), -math.cos(h)  # the camera looks along the heading
+    step_m = vp.distance_m * 0.5
+    yield from m.travel(
+        (x, y, transit_m), vp.heading_deg, transit_m, f"above the {vp.name} viewpoint"
+    )
+    for attempt in range(1, p.max_looks + 1):
+        yield from m.move((x, y, z), vp.heading_deg, f"{vp.name} viewpoint")
+        photo = yield from m.photo(vp.name if attempt == 1 else f"{vp.name}-{attempt}", 0.0)
+        shapes = photo_shapes(m, photo, nadir=False)
+        silhouette = same_colour(shapes, colour_rgb, hue_tolerance_deg=_SIDE_HUE_TOLERANCE_DEG)
+        if not any(s.cut_by_border for s in silhouette) or attempt == p.max_looks:
+            break
+        nx, ny = x + back_x * step_m, y + back_y * step_m
+        room_m = min((point_polygon_distance((nx, ny), o) for o in obstacles), default=math.inf)
+        if room_m < margin_m:
+            m.event(
+                Level.INFO,
+                f"{vp.name} photo: the building touches the border; no room to back away",
+            )
+            break
+        m.event(
+            Level.INFO,
+            f"{vp.name} photo: the building touches the image border; backing away {step_m:.1f} m",
+        )
+        x, y = nx, ny
+    yield from m.move((x, y, transit_m), vp.heading_deg, f"climb from the {vp.name} viewpoint")
+    return View(silhouette, photo.pose, photo.intrinsics)
 
 
 def _below(photo: Photo) -> float:

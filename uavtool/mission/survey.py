@@ -1,8 +1,9 @@
-"""The survey: two overview photos from above home, one ``mission.overview_climb_m`` higher
-than the other, give every building seen whole in both its roof height (a roof's size in
-pixels grows as the camera nears it: :mod:`uavtool.nav.heights`), and from it the building's
-position and size on the ground. The higher photo sees furthest; its shapes become the
-points of interest. A building whose height could not be measured is assumed as tall as
+"""The survey: two overview photos from above home — the second at least
+``mission.overview_climb_m`` higher, and high enough to see the whole search area — give every
+building seen whole in both its roof height (its roof's size and place change with the
+camera's height above it: :mod:`uavtool.nav.heights`), and from it the building's position and
+size on the ground. The higher photo sees furthest; its shapes become the points of interest.
+A building whose height could not be measured is assumed as tall as
 ``mission.assumed_roof_m`` until a closer look measures it."""
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from uavtool.camera import Intrinsics
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
 from uavtool.mission.search import photo_shapes
@@ -45,7 +47,7 @@ def survey(m: Mission) -> Wait[Survey]:
     low = yield from m.photo("overview", -90.0)
     low_shapes = photo_shapes(m, low)
     x, y, _ = low.pose.pos_enu_m
-    high_alt = p.overview_alt_m + p.overview_climb_m
+    high_alt = max(p.overview_alt_m + p.overview_climb_m, search_altitude_m(m, low.intrinsics))
     yield from m.move((x, y, high_alt), None, "second overview position")
     high = yield from m.photo("overview-2", -90.0)
     shapes = photo_shapes(m, high)
@@ -77,6 +79,12 @@ def survey(m: Mission) -> Wait[Survey]:
         + (f" (others assumed {p.assumed_roof_m:g} m)" if known < len(shapes) else ""),
     )
     return Survey(high, shapes, tuple(roofs), tuple(measured), footprints, tuple(pois))
+
+
+def search_altitude_m(m: Mission, intrinsics: Intrinsics) -> float:
+    """The altitude from which a nadir photo over home sees the whole search area."""
+    half_fov = math.radians(min(intrinsics.hfov_deg, intrinsics.vfov_deg)) / 2.0
+    return m.params.mission.search_radius_m / math.tan(half_fov)
 
 
 def _measure(

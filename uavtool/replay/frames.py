@@ -63,7 +63,7 @@ def reanalyse_frames(flight: RecordedFlight, params: Params) -> list[FrameChange
     for obs in flight.observations:
         if not isinstance(obs, Photo):
             continue
-        side = obs.tag in _SIDE_TAGS
+        side = obs.tag.split("-")[0] in _SIDE_TAGS  # "front", or "front-2" for a retake
         shapes = side_shapes(params, obs.image_rgb) if side else nadir_shapes(params, obs.image_rgb)
         score_after = matched_after = score_before = matched_before = None
         if obs.tag.startswith("poi-"):
