@@ -308,10 +308,15 @@ def main() -> None:
     parser.add_argument("--baseline", default=BASELINE)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--variants", default="new,baseline")
+    parser.add_argument("--seeds", default=None, help="comma-separated seeds (instead of a range)")
     parser.add_argument("--keep", type=Path, default=None, help="keep recordings and scenes here")
     args = parser.parse_args()
     variants = args.variants.split(",")
-    seeds = list(range(args.first_seed, args.first_seed + args.scenes))
+    seeds = (
+        [int(x) for x in args.seeds.split(",")]
+        if args.seeds
+        else list(range(args.first_seed, args.first_seed + args.scenes))
+    )
     print(f"{len(seeds)} hard scenes, seeds {seeds[0]}..{seeds[-1]}; variants {variants}")
     with tempfile.TemporaryDirectory() as tmp_text:
         tmp = args.keep or Path(tmp_text)

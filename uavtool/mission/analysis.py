@@ -56,7 +56,7 @@ class Judgement:
     mirror_score: float = 0.0
     """The candidate's score against the target's mirror image."""
     not_mirror: bool = True
-    """Whether the mirror rule holds (always for a target that is its own mirror image)."""
+    """Whether the mirror rule holds."""
 
 
 def judge(
@@ -75,6 +75,6 @@ def judge(
     rp = params.recognize
     mirrored = mirror_score(target, centre, rp)
     gap = 1.0 - mirror_score(target, target, rp)  # how unlike its mirror image the target is
-    not_mirror = gap < rp.symmetric_gap or score - mirrored >= rp.mirror_margin * gap
+    not_mirror = score - mirrored >= rp.mirror_margin * gap - rp.mirror_tolerance
     matched = judgeable and same_hue and not_mirror and score >= rp.threshold
     return Judgement(scores, candidate, score, matched, judgeable, same_hue, mirrored, not_mirror)

@@ -16,7 +16,7 @@ from uavtool.mission.outputs import (
     Viewpoints,
 )
 from uavtool.mission.search import Found, photo_shapes, search
-from uavtool.mission.survey import survey
+from uavtool.mission.survey import Survey, remeasured_obstacles, survey
 from uavtool.nav import (
     Viewpoint,
     ViewpointFailure,
@@ -74,16 +74,10 @@ def fly(m: Mission) -> Wait[None]:
         return
     m.matched_poi = found.poi.index
     m.match_score = found.score
-    obstacles = [f for i, f in enumerate(seen.footprints) if i != found.poi.shape_index]
-    yield from _model(m, found, obstacles, transit_m)
+    yield from _model(m, found, seen, transit_m)
 
 
-def _model(
-    m: Mission,
-    found: Found,
-    obstacles: list[tuple[tuple[float, float], ...]],
-    transit_m: float,
-) -> Wait[None]:
+def _model(m: Mission, found: Found, seen: Survey, transit_m: float) -> Wait[None]:
     """Top, front and right photos from planned viewpoints, then the model. The side photos
     are taken only once the top photo shows the whole building."""
     p = m.params.mission
@@ -99,7 +93,8 @@ def _model(
         found.shape.polygon_px, found.photo.pose, k, plane_z_m=min(roof, _below(found.photo))
     )
     rect = min_area_rect(footprint)
-    front, right = plan_viewpoints(rect, obstacles, k, vp_params)
+    others = [f for i, f in enumerate(seen.footprints) if i != found.poi.shape_index]
+    front, right = plan_viewpoints(rect, others, k, vp_params)
     front_heading = (
         front.heading_deg if isinstance(front, Viewpoint) else (rect.long_axis_deg + 90.0) % 360.0
     )
@@ -128,6 +123,8 @@ def _model(
     else:
         m.no_model = f"the top photo never showed the whole building ({p.max_looks} tries)"
         raise m.end(Status.PARTIAL, f"target found; model not built: {m.no_model}")
+    # The top photo, low over the target, measures the neighbours the overview could not.
+    obstacles = remeasured_obstacles(m, seen, found.poi.shape_index, top_photo, top_shapes)
     # The top photo is centred on the building: plan the side photos from its footprint.
     footprint = ground_polygon(obj.polygon_px, top_photo.pose, top_photo.intrinsics, plane_z_m=roof)
     rect = min_area_rect(footprint)
@@ -215,6 +212,11 @@ def _side_view(
             f"{vp.name} photo: the building touches the image border; backing away {step_m:.1f} m",
         )
         x, y = nx, ny
+        # Up, across and down again: the way back may pass a building the plan did not know.
+        yield from m.move(
+            (photo.pose.pos_enu_m[0], photo.pose.pos_enu_m[1], transit_m), None, "climb"
+        )
+        yield from m.travel((x, y, z), vp.heading_deg, transit_m, f"{vp.name} viewpoint")
     yield from m.move((x, y, transit_m), vp.heading_deg, f"climb from the {vp.name} viewpoint")
     return View(silhouette, photo.pose, photo.intrinsics)
 

@@ -17,6 +17,7 @@ from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
 from uavtool.mission.search import photo_shapes
 from uavtool.nav import NavError, ground_point, ground_polygon, min_area_rect
+from uavtool.nav.geometry import convex_hull
 from uavtool.nav.heights import roof_from_photos
 from uavtool.vision import Shape
 
@@ -27,7 +28,8 @@ if TYPE_CHECKING:
 @dataclass(frozen=True, slots=True)
 class Survey:
     """The higher overview ``photo``, its ``shapes``, and per shape its roof height above home
-    (measured or assumed) and footprint on the ground (ENU metres, at that height)."""
+    (measured or assumed) and footprint on the ground (ENU metres; for a building of unknown
+    height, everywhere it may stand)."""
 
     photo: Photo
     shapes: tuple[Shape, ...]
@@ -59,7 +61,10 @@ def survey(m: Mission) -> Wait[Survey]:
     measured = [h is not None for h in found]
     roofs = [p.assumed_roof_m if h is None else h for h in found]
     planes = [typical_m if h is None else h for h in found]
-    footprints = tuple(_footprint(s, high, z) for s, z in zip(shapes, planes, strict=True))
+    footprints = tuple(
+        _footprint(s, high, z) if h is not None else _anywhere(s, high, p.assumed_roof_m)
+        for s, z, h in zip(shapes, planes, found, strict=True)
+    )
     pois: list[PointOfInterest] = []
     for i, shape in enumerate(shapes):
         if shape.area_px < p.min_poi_area_px:
@@ -131,6 +136,65 @@ def _footprint(shape: Shape, photo: Photo, roof_m: float) -> tuple[tuple[float, 
         return ground_polygon(shape.polygon_px, photo.pose, photo.intrinsics, plane_z_m=roof_m)
     except NavError:  # a roof assumed above the camera: place it on the ground instead
         return ground_polygon(shape.polygon_px, photo.pose, photo.intrinsics, plane_z_m=0.0)
+
+
+def remeasured_obstacles(
+    m: Mission, seen: Survey, target: int, photo: Photo, shapes: tuple[Shape, ...]
+) -> list[tuple[tuple[float, float], ...]]:
+    """The footprints of every building but ``target``, those of unknown height measured
+    again against a later nadir ``photo`` (its ``shapes``) where it shows them whole."""
+    p = m.params.mission
+    out = []
+    for i, shape in enumerate(seen.shapes):
+        if i == target:
+            continue
+        footprint = seen.footprints[i]
+        if not seen.measured[i] and not shape.cut_by_border:
+            roof = _measure_against(m, shape, seen.photo, photo, shapes)
+            if roof is not None and roof <= p.assumed_roof_m + p.min_above_roof_m:
+                footprint = _footprint(shape, seen.photo, roof)
+        out.append(footprint)
+    return out
+
+
+def _measure_against(
+    m: Mission, shape: Shape, photo: Photo, other: Photo, others: tuple[Shape, ...]
+) -> float | None:
+    """The roof height of ``shape`` (in ``photo``) triangulated with the same roof in another
+    nadir photo: its colour, whole, nearest where it falls on the ground."""
+    tol = m.params.mission.roof_colour_tolerance_dn
+    k = photo.intrinsics
+    here = ground_point(*shape.centroid_px, photo.pose, k)
+    best: tuple[float, Shape] | None = None
+    for cand in others:
+        if cand.cut_by_border or not all(
+            abs(a - b) <= tol for a, b in zip(cand.colour_rgb, shape.colour_rgb, strict=True)
+        ):
+            continue
+        there = ground_point(*cand.centroid_px, other.pose, other.intrinsics)
+        miss = math.dist(here, there)
+        if miss <= m.params.viewpoints.max_distance_m and (best is None or miss < best[0]):
+            best = (miss, cand)
+    if best is None:
+        return None
+    roof = roof_from_photos(
+        centroid1_px=shape.centroid_px,
+        area1_px=shape.area_px,
+        pose1=photo.pose,
+        centroid2_px=best[1].centroid_px,
+        area2_px=best[1].area_px,
+        pose2=other.pose,
+        intrinsics=k,
+    )
+    return None if roof is None else max(roof, 0.0)
+
+
+def _anywhere(shape: Shape, photo: Photo, tallest_m: float) -> tuple[tuple[float, float], ...]:
+    """Where a building of unknown height (up to ``tallest_m``) may stand: its roof's outline
+    projected on the ground and on the tallest roof plane, and everything between."""
+    ground = _footprint(shape, photo, 0.0)
+    top = _footprint(shape, photo, tallest_m)
+    return tuple(convex_hull([*ground, *top]))
 
 
 def _extent_m(footprint: tuple[tuple[float, float], ...]) -> float:

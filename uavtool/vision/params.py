@@ -114,13 +114,14 @@ class RecognizeParams:
     by this fraction of the reference's chirality gap (1 − the reference's score against its
     own mirror image). The true building then wins by about the whole gap, its mirror image
     loses by it."""
-    symmetric_gap: float = 0.05
-    """A reference whose chirality gap is below this is its own mirror image (a rectangle, a
-    T, a U): the mirror rule cannot and need not tell them apart, and does not apply."""
+    mirror_tolerance: float = 0.01
+    """… less this: how far an outline's score and its mirror image's may differ by pixel
+    noise alone. For a reference that is its own mirror image (a rectangle, a T) the rule
+    then only refuses a candidate clearly more like the mirror image."""
 
     def __post_init__(self) -> None:
         _check_positive(self, "angle_scale_deg", "length_scale")
-        _check_non_negative(self, "merge_cost", "hole_penalty", "mirror_margin", "symmetric_gap")
+        _check_non_negative(self, "merge_cost", "hole_penalty", "mirror_margin", "mirror_tolerance")
         if self.max_merge < 1:
             raise VisionParamError(f"vision.max_merge must be ≥ 1, got {self.max_merge}")
         if not 0.0 <= self.threshold <= 1.0:
