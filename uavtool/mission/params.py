@@ -8,6 +8,7 @@ calls. Keys are dotted paths (``mission.look_fill``, ``vectorize.rdp_epsilon_px`
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import json
 import typing
 from collections.abc import Iterable
@@ -188,12 +189,29 @@ def _flatten(data: dict[str, Any], prefix: str = "") -> dict[str, Any]:
     return out
 
 
+def _suggest(key: str, known: tuple[str, ...]) -> str:
+    """The closest valid keys; else the keys of the key's group; else the groups."""
+    close = difflib.get_close_matches(key, known, n=3, cutoff=0.75)
+    if not close:  # the right name in the wrong group
+        name = key.rsplit(".", 1)[-1]
+        names = difflib.get_close_matches(name, [k.split(".", 1)[1] for k in known], cutoff=0.75)
+        close = [k for k in known if k.split(".", 1)[1] in names][:3]
+    if close:
+        return f"did you mean {' or '.join(close)}?"
+    group = key.split(".", 1)[0]
+    same = [k for k in known if k.startswith(group + ".")]
+    if same:
+        return f"valid {group} keys: {', '.join(k.split('.', 1)[1] for k in same)}"
+    groups = sorted({k.split(".", 1)[0] for k in known})
+    return f"keys are GROUP.NAME with GROUP one of {', '.join(groups)}"
+
+
 def _apply(params: Params, pairs: dict[str, Any], *, source: str) -> Params:
     grouped: dict[str, dict[str, Any]] = {}
     known = valid_keys()
     for key, raw in pairs.items():
         if key not in known:
-            raise InputError(f"{source}: unknown parameter {key!r}; valid: {', '.join(known)}")
+            raise InputError(f"{source}: unknown parameter {key!r}; {_suggest(key, known)}")
         group, name = key.split(".", 1)
         sub = getattr(params, group)
         hint = typing.get_type_hints(type(sub))[name]
