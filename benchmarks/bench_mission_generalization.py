@@ -151,6 +151,7 @@ def judge(seed: int, scene: Scene, info: HardSceneInfo, row: dict[str, Any]) -> 
     plan: dict[str, Any] | None = None
     outcome: dict[str, Any] = {}
     model: dict[str, Any] | None = None
+    views: dict[str, Any] | None = None
     with RecordingReader(path) as reader:
         for entry in reader.entries([OBSERVATIONS, OUTPUTS]):
             value = entry.value
@@ -167,11 +168,19 @@ def judge(seed: int, scene: Scene, info: HardSceneInfo, row: dict[str, Any]) -> 
                 plan = data
             elif kind == "ModelBuilt":
                 model = data
+            elif kind == "Viewpoints":
+                views = data
             elif kind == "Outcome":
                 outcome = data
+    # The building matched is the one the mission went on to photograph from above (a look
+    # taken again may have centred on another roof than its point of interest's).
     matched = ""
     poi = int(outcome.get("matched_poi", -1))
-    if plan is not None and poi >= 0:
+    if views is not None:
+        ring = views["footprint_en_m"]
+        centre = (sum(x for x, _ in ring) / len(ring), sum(y for _, y in ring) / len(ring))
+        matched = nearest_building(scene, centre)
+    elif plan is not None and poi >= 0:
         matched = nearest_building(scene, tuple(plan["pois"][poi]["pos_en_m"]))
     iou = tunnel = None
     if model is not None:

@@ -47,6 +47,7 @@ from uavtool.mission.outputs import (
     Takeoff,
     TakePhoto,
     Vec3,
+    Viewpoints,
 )
 from uavtool.mission.params import MissionParams, Params
 
@@ -84,6 +85,7 @@ class Mission:
         self.match_score = 0.0
         self.model_built = False
         self.plan: Plan | None = None
+        self.viewpoints: Viewpoints | None = None
         self.model: ModelBuilt | None = None
         self._out: list[Output] = []
         self._next_id = 0

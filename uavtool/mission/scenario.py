@@ -129,7 +129,8 @@ def _model(m: Mission, found: Found, seen: Survey, transit_m: float) -> Wait[Non
     footprint = ground_polygon(obj.polygon_px, top_photo.pose, top_photo.intrinsics, plane_z_m=roof)
     rect = min_area_rect(footprint)
     front, right = plan_viewpoints(rect, obstacles, top_photo.intrinsics, vp_params)
-    m.emit(Viewpoints(footprint, top, front, right))
+    m.viewpoints = Viewpoints(footprint, top, front, right)
+    m.emit(m.viewpoints)
 
     views: dict[str, View] = {}
     for vp in (front, right):

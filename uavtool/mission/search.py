@@ -109,7 +109,9 @@ def search(
             shape = look.shapes[j.candidate]
             seen = overview_shapes[poi.shape_index]
             roof = _roof_again(seen, overview, look.photo, shape)
-            best = Found(poi, look.photo, shape, j.score, poi.roof_m if roof is None else roof)
+            if roof is None or roof > p.assumed_roof_m:  # beyond the tallest expected: a
+                roof = poi.roof_m  # mismatched pair of outlines, not a measurement
+            best = Found(poi, look.photo, shape, j.score, roof)
             if not p.visit_all:
                 break
     if best is None:

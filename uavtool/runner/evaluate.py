@@ -49,6 +49,11 @@ def evaluate(runner: Runner, scene: Scene | None) -> Evaluation:
 
     visited = tuple(building_at(k) for k in outcome.visited)
     matched = building_at(outcome.matched_poi) if outcome.matched_poi >= 0 else ""
+    if mission.viewpoints is not None:  # the building it went on to photograph from above
+        ring = mission.viewpoints.footprint_en_m
+        x = sum(p[0] for p in ring) / len(ring) + offset[0]
+        y = sum(p[1] for p in ring) / len(ring) + offset[1]
+        matched = nearest_building(scene, (x, y))
     iou = kept = None
     if mission.model is not None:
         iou = model_iou(mission.model.vertices_m, mission.model.faces, scene, offset)
