@@ -19,6 +19,7 @@ from uavtool.nav import (
     plan_viewpoints,
     top_viewpoint,
 )
+from uavtool.nav.geometry import point_polygon_distance, triangle_hits_polygon
 from uavtool.world import building_footprint, load_scene
 
 K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
@@ -109,13 +110,31 @@ def test_line_of_sight_blocked_but_camera_clear() -> None:
         fallback="opposite side",
     )
     walls = [wall, [(x, -y) for x, y in wall]]
-    front, right = plan(walls, ViewpointParams(max_distance_m=20.0))  # base distance only
+    square_on = ViewpointParams(max_distance_m=20.0, oblique_deg=())  # base distance only
+    front, right = plan(walls, square_on)
     assert isinstance(front, ViewpointFailure)
     assert front.reason == (
         "front: long-a at 17.3 m: no line of sight (obstacle 0); "
         "long-b at 17.3 m: no line of sight (obstacle 1) (tried up to 20 m)"
     )
     assert_view(right, pos=(5.0 + D0, 0.0, 6.0), heading=270.0, side="short-a", distance=D0)
+
+
+def test_blocked_square_on_the_camera_turns_around_the_building() -> None:
+    """Both long sides hidden by walls straight in front of them: the camera turns 25°
+    around the building, where it sees all four corners past the walls."""
+    wall = [(-1.0, -12.0), (1.0, -12.0), (1.0, -11.0), (-1.0, -11.0)]
+    walls = [wall, [(x, -y) for x, y in wall]]
+    front, _ = plan(walls, ViewpointParams(max_distance_m=40.0))
+    assert isinstance(front, Viewpoint)
+    assert front.fallback.startswith("turned +25° from the long-")
+    cam = front.pos_enu_m[:2]
+    corners = [(-5.0, -4.0), (5.0, -4.0), (5.0, 4.0), (-5.0, 4.0)]
+    for wall_ring in walls:
+        for i, a in enumerate(corners):
+            for b in corners[i + 1 :]:
+                assert not triangle_hits_polygon((cam, a, b), wall_ring)
+    assert min(point_polygon_distance(cam, w) for w in walls) >= P.safety_margin_m
 
 
 def test_obstacles_by_both_long_side_cameras_give_a_larger_distance() -> None:

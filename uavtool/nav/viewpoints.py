@@ -46,6 +46,10 @@ class ViewpointParams:
     """Farthest a camera may stand from the side it photographs."""
     distance_step: float = 1.25
     """Factor by which the distance grows on each fallback round."""
+    oblique_deg: tuple[float, ...] = (25.0, -25.0, 45.0, -45.0)
+    """Last fallbacks, tried in order when no side can be seen square on: the camera turned
+    this far around the building from a side's normal (it then sees two walls; the model
+    needs its two side photos only ``model.min_view_separation_deg`` apart)."""
 
     def __post_init__(self) -> None:
         checks = (
@@ -177,6 +181,12 @@ def _plan_one(
             tried.append(f"{side} at {distance:.1f} m: " + " and ".join(why))
         rounds += 1
         factor *= params.distance_step
+    for offset in params.oblique_deg if tried else ():  # none fit at all: say so below
+        for side in (first_side, _OPPOSITE[first_side]):
+            found = _oblique(name, rect, side, offset, obstacles, intrinsics, params)
+            if isinstance(found, Viewpoint):
+                return found
+            tried.append(found)
     if not tried:
         return ViewpointFailure(
             name,
@@ -186,6 +196,65 @@ def _plan_one(
     return ViewpointFailure(
         name, f"{name}: " + "; ".join(tried) + f" (tried up to {params.max_distance_m:g} m)"
     )
+
+
+def _oblique(
+    name: str,
+    rect: Rect,
+    side: str,
+    offset_deg: float,
+    obstacles: list[list[Point]],
+    intrinsics: Intrinsics,
+    params: ViewpointParams,
+) -> Viewpoint | str:
+    """A camera on ``side``'s normal turned ``offset_deg`` around the building's centre, at
+    the first distance (growing as square-on ones do) where it keeps the safety margin and
+    sees every corner past the obstacles; else what blocked it."""
+    _, _, normal = _side_geometry(rect, side)
+    a = math.radians(offset_deg)
+    u = (
+        normal[0] * math.cos(a) - normal[1] * math.sin(a),
+        normal[0] * math.sin(a) + normal[1] * math.cos(a),
+    )
+    cx, cy = rect.center_en
+    corners = rect.corners()
+    depth = max((x - cx) * u[0] + (y - cy) * u[1] for x, y in corners)
+    across = [(x - cx) * -u[1] + (y - cy) * u[0] for x, y in corners]
+    d0 = base_distance_m(max(across) - min(across), intrinsics, params)
+    factor = 1.0
+    blocked = ""
+    while d0 * factor <= params.max_distance_m * (1.0 + 1e-12):
+        distance = d0 * factor
+        cam = (cx + (depth + distance) * u[0], cy + (depth + distance) * u[1])
+        near = [
+            i
+            for i, poly in enumerate(obstacles)
+            if point_polygon_distance(cam, poly) < params.safety_margin_m
+        ]
+        hidden = [
+            i
+            for i, poly in enumerate(obstacles)
+            if any(
+                triangle_hits_polygon((cam, corners[j], corners[k]), poly)
+                for j in range(4)
+                for k in range(j + 1, 4)
+            )
+        ]
+        if not near and not hidden:
+            return Viewpoint(
+                name=name,
+                pos_enu_m=(cam[0], cam[1], params.camera_alt_m),
+                heading_deg=_heading(-u[0], -u[1]),
+                side=side,
+                distance_m=distance,
+                fallback=f"turned {offset_deg:+g}° from the {side} side"
+                + (f", distance {factor:.2f}x" if factor > 1.0 else ""),
+            )
+        blocked = f"{side} turned {offset_deg:+g}°: " + (
+            "no line of sight" if hidden else "no room"
+        )
+        factor *= params.distance_step
+    return blocked or f"{side} turned {offset_deg:+g}°: beyond nav.max_distance_m"
 
 
 def plan_viewpoints(
