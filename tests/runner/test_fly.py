@@ -127,7 +127,7 @@ def test_garbage_instead_of_a_vehicle(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("args", "status", "code"),
     [
-        (["--scene", "dense"], "partial: target found; model not built", 3),
+        (["--set", "viewpoints.max_distance_m=5"], "partial: target found; model not built", 3),
         (["--set", "recognize.threshold=0.999"], "no-match", 4),
         (["--link-outage", "15:1e6", "--set", "mission.link_lost_abort_s=5"], "link-lost", 1),
     ],

@@ -199,10 +199,11 @@ def _metadata_difference(
     for (name, x), (_, y) in zip(a, b, strict=True):
         if x != y:
             key = next(k for k in sorted(set(x) | set(y)) if x.get(k) != y.get(k))
-            return (
-                f"metadata {name}.{key}: {_short(x.get(key))} recorded, "
-                f"{_short(y.get(key))} re-flown"
-            )
+            try:  # a JSON value (the parameters): name the field inside it
+                inner = _json_difference(json.loads(x[key]), json.loads(y[key]))
+            except (KeyError, TypeError, ValueError):
+                inner = f"{_short(x.get(key))} recorded, {_short(y.get(key))} re-flown"
+            return f"metadata {name}.{key}: {inner}"
     return None
 
 
