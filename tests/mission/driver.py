@@ -267,7 +267,9 @@ def fly(
 
 
 def assert_home_safely(flown: Flown) -> None:
-    """After the mission's end at most RTL is commanded, and the vehicle lands at home."""
+    """After the mission's end it flies home over the roofs it knows (straight up, across to
+    above home at the transit altitude) then commands RTL once at most, and the vehicle lands
+    at home."""
     flight = flown.flight
     end = next(
         i
@@ -275,7 +277,14 @@ def assert_home_safely(flown: Flown) -> None:
         if isinstance(o, Event) and o.text.startswith("mission ends")
     )
     after = [o for o in flight.outputs[end:] if isinstance(o, Command)]
-    assert all(c == SetMode(c.id, "RTL") for c in after) and len(after) <= 1
+    moves = [c for c in after if isinstance(c, GoTo)]
+    modes = [c for c in after if not isinstance(c, GoTo)]
+    assert all(c == SetMode(c.id, "RTL") for c in modes) and len(modes) <= 1
+    assert after[len(moves) :] == modes  # the moves come first
+    transit = flown.mission.transit_m
+    assert all(g.pos_enu_m[2] == transit for g in moves)
+    if moves:
+        assert moves[-1].pos_enu_m[:2] == (0.0, 0.0)
     assert flight.texts()[-1] == "landed and disarmed"
     fake = flown.fake
     assert fake.landed and not fake.armed

@@ -66,6 +66,10 @@ class _End(Exception):  # noqa: N818 - control flow inside the generator, never 
         self.reason = reason
 
 
+_FLIES_HOME = frozenset({Status.COMPLETED, Status.PARTIAL, Status.NO_MATCH})
+"""Outcomes after which the mission still flies the way home itself before RTL."""
+
+
 class Mission:
     """One flight of the mission. Call :meth:`start` once, then :meth:`step` with each
     observation until :attr:`outcome` is set.
@@ -85,6 +89,8 @@ class Mission:
         self.match_score = 0.0
         self.model_built = False
         self.plan: Plan | None = None
+        self.transit_m: float | None = None
+        """The altitude that clears every known roof (once the survey has measured them)."""
         self.viewpoints: Viewpoints | None = None
         self.model: ModelBuilt | None = None
         self._out: list[Output] = []
@@ -181,6 +187,10 @@ class Mission:
             self._expected_modes = frozenset()
             self.event(Level.INFO, "no more commands; watching until the vehicle lands")
         elif not landed(self.last):
+            if self.transit_m is not None and status in _FLIES_HOME:
+                # The vehicle's RTL flies straight home at its own altitude: go home over
+                # every known roof first.
+                yield from self.travel((0.0, 0.0, self.transit_m), None, self.transit_m, "home")
             self.event(Level.INFO, "returning home (RTL)")
             yield from self.set_mode("RTL", also=("LAND",))
         ok = yield from self.wait_until(landed, self.params.mission.land_timeout_s)

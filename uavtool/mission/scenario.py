@@ -66,7 +66,10 @@ def fly(m: Mission) -> Wait[None]:
     m.emit(m.plan)
     m.event(Level.INFO, f"{len(pois)} points of interest; visiting order {list(order)}")
 
-    transit_m = seen.highest_roof_m + m.params.viewpoints.safety_margin_m
+    # Over every known roof by the safety margin, even where the vehicle flies the arrival
+    # radius lower than told.
+    transit_m = seen.highest_roof_m + m.params.viewpoints.safety_margin_m + p.arrive_radius_m
+    m.transit_m = transit_m
     found = yield from search(
         m, pois, order, overview=seen.photo, overview_shapes=seen.shapes, transit_m=transit_m
     )
@@ -139,7 +142,10 @@ def _model(m: Mission, found: Found, seen: Survey, transit_m: float) -> Wait[Non
             continue
         if vp.fallback:
             m.event(Level.INFO, f"{vp.name} viewpoint: {vp.fallback}")
-        views[vp.name] = yield from _side_view(m, vp, obj.colour_rgb, obstacles, transit_m)
+        # Backing away must keep clear of the survey's cautious footprints too: a neighbour
+        # measured again may have been paired with the wrong roof.
+        cautious = obstacles + others
+        views[vp.name] = yield from _side_view(m, vp, obj.colour_rgb, cautious, transit_m)
 
     missing = [name for name in ("front", "right") if name not in views]
     if missing:
