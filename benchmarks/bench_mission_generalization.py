@@ -34,14 +34,14 @@ import os
 import statistics
 import subprocess
 import sys
-import tarfile
 import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from io import BytesIO
 from pathlib import Path
 from typing import Any
+
+from bench_fly import extract  # run as a script: its folder is on sys.path
 
 from uavtool.recording import JsonDocument, RecordingReader
 from uavtool.recording.topics import OBSERVATIONS, OUTPUTS
@@ -89,15 +89,6 @@ class Result:
     crashed: bool
     flight_s: float
     wall_s: float
-
-
-def extract(commit: str, into: Path) -> Path:
-    data = subprocess.run(
-        ["git", "-C", str(ROOT), "archive", commit, "uavtool"], check=True, capture_output=True
-    ).stdout
-    with tarfile.open(fileobj=BytesIO(data)) as tar:
-        tar.extractall(into, filter="data")
-    return into
 
 
 def fly_batch(

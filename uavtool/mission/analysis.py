@@ -7,8 +7,9 @@ from dataclasses import dataclass
 
 from uavtool.camera import Intrinsics
 from uavtool.mission.errors import MissionInputError
-from uavtool.mission.observations import U8Array
+from uavtool.mission.observations import Photo, U8Array
 from uavtool.mission.params import Params
+from uavtool.nav.heights import roof_from_photos
 from uavtool.vision import Shape, best_match, mirror_score, vectorize
 from uavtool.vision.merge import merge_touching
 from uavtool.vision.model3d import central_shape
@@ -78,3 +79,21 @@ def judge(
     not_mirror = score - mirrored >= rp.mirror_margin * gap - rp.mirror_tolerance
     matched = judgeable and same_hue and not_mirror and score >= rp.threshold
     return Judgement(scores, candidate, score, matched, judgeable, same_hue, mirrored, not_mirror)
+
+
+def roof_between(a: Shape, photo_a: Photo, b: Shape, photo_b: Photo) -> float | None:
+    """The height above home of one roof seen as ``a`` in ``photo_a`` and ``b`` in
+    ``photo_b`` (nadir photos), at least 0; None when either outline is cut by its border or
+    the two views cannot tell."""
+    if a.cut_by_border or b.cut_by_border:
+        return None
+    roof = roof_from_photos(
+        centroid1_px=a.centroid_px,
+        area1_px=a.area_px,
+        pose1=photo_a.pose,
+        centroid2_px=b.centroid_px,
+        area2_px=b.area_px,
+        pose2=photo_b.pose,
+        intrinsics=photo_a.intrinsics,
+    )
+    return None if roof is None else max(roof, 0.0)

@@ -13,11 +13,11 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from uavtool.camera import Intrinsics
-from uavtool.mission.analysis import Judgement, judge, nadir_shapes, side_shapes
+from uavtool.mission.analysis import Judgement, judge, nadir_shapes, roof_between, side_shapes
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest, Recognition, Shapes, Status, Vec3
 from uavtool.nav import ground_point
-from uavtool.nav.heights import fit_altitude_m, roof_from_photos
+from uavtool.nav.heights import fit_altitude_m
 from uavtool.vision import Shape
 
 if TYPE_CHECKING:
@@ -108,7 +108,7 @@ def search(
         if j.matched and (best is None or j.score > best.score):
             shape = look.shapes[j.candidate]
             seen = overview_shapes[poi.shape_index]
-            roof = _roof_again(seen, overview, look.photo, shape)
+            roof = roof_between(seen, overview, shape, look.photo)
             if roof is None or roof > p.assumed_roof_m:  # beyond the tallest expected: a
                 roof = poi.roof_m  # mismatched pair of outlines, not a measurement
             best = Found(poi, look.photo, shape, j.score, roof)
@@ -125,23 +125,6 @@ def search(
         f"roof {best.roof_m:.1f} m above home",
     )
     return best
-
-
-def _roof_again(seen: Shape, overview: Photo, photo: Photo, shape: Shape) -> float | None:
-    """The roof height from the overview and the look, both whole: the cameras are far
-    apart, so the estimate is closer than the overview pair's."""
-    if shape.cut_by_border or seen.cut_by_border:
-        return None
-    roof = roof_from_photos(
-        centroid1_px=seen.centroid_px,
-        area1_px=seen.area_px,
-        pose1=overview.pose,
-        centroid2_px=shape.centroid_px,
-        area2_px=shape.area_px,
-        pose2=photo.pose,
-        intrinsics=photo.intrinsics,
-    )
-    return None if roof is None else max(roof, 0.0)
 
 
 def _look(m: Mission, k: int, n: int, alt_m: float) -> Wait[_Look]:

@@ -13,12 +13,12 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from uavtool.camera import Intrinsics
+from uavtool.mission.analysis import roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
 from uavtool.mission.search import photo_shapes
 from uavtool.nav import NavError, ground_point, ground_polygon, min_area_rect
 from uavtool.nav.geometry import convex_hull
-from uavtool.nav.heights import roof_from_photos
 from uavtool.vision import Shape
 
 if TYPE_CHECKING:
@@ -118,17 +118,7 @@ def _measure(
             best = (miss, other)
     if best is None:
         return None
-    other = best[1]
-    roof = roof_from_photos(
-        centroid1_px=other.centroid_px,
-        area1_px=other.area_px,
-        pose1=low.pose,
-        centroid2_px=shape.centroid_px,
-        area2_px=shape.area_px,
-        pose2=high.pose,
-        intrinsics=k,
-    )
-    return None if roof is None else max(roof, 0.0)
+    return roof_between(best[1], low, shape, high)
 
 
 def _footprint(shape: Shape, photo: Photo, roof_m: float) -> tuple[tuple[float, float], ...]:
@@ -175,18 +165,7 @@ def _measure_against(
         miss = math.dist(here, there)
         if miss <= m.params.viewpoints.max_distance_m and (best is None or miss < best[0]):
             best = (miss, cand)
-    if best is None:
-        return None
-    roof = roof_from_photos(
-        centroid1_px=shape.centroid_px,
-        area1_px=shape.area_px,
-        pose1=photo.pose,
-        centroid2_px=best[1].centroid_px,
-        area2_px=best[1].area_px,
-        pose2=other.pose,
-        intrinsics=k,
-    )
-    return None if roof is None else max(roof, 0.0)
+    return None if best is None else roof_between(shape, photo, best[1], other)
 
 
 def _anywhere(shape: Shape, photo: Photo, tallest_m: float) -> tuple[tuple[float, float], ...]:
