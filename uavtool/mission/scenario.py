@@ -16,7 +16,7 @@ from uavtool.mission.outputs import (
     Viewpoints,
 )
 from uavtool.mission.search import Found, photo_shapes, search
-from uavtool.mission.survey import Survey, remeasured_obstacles, survey
+from uavtool.mission.survey import Survey, obstacles_around, remeasured_obstacles, survey
 from uavtool.nav import (
     Viewpoint,
     ViewpointFailure,
@@ -96,7 +96,7 @@ def _model(m: Mission, found: Found, seen: Survey, transit_m: float) -> Wait[Non
         found.shape.polygon_px, found.photo.pose, k, plane_z_m=min(roof, _below(found.photo))
     )
     rect = min_area_rect(footprint)
-    others = [f for i, f in enumerate(seen.footprints) if i != found.poi.shape_index]
+    others = obstacles_around(m, seen, found.poi.shape_index)
     front, right = plan_viewpoints(rect, others, k, vp_params)
     front_heading = (
         front.heading_deg if isinstance(front, Viewpoint) else (rect.long_axis_deg + 90.0) % 360.0

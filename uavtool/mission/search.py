@@ -19,6 +19,7 @@ from uavtool.mission.outputs import Level, PointOfInterest, Recognition, Shapes,
 from uavtool.nav import ground_point
 from uavtool.nav.heights import fit_altitude_m
 from uavtool.vision import Shape
+from uavtool.vision.model3d import central_shape
 
 if TYPE_CHECKING:
     from uavtool.mission.mission import Mission, Wait
@@ -110,8 +111,8 @@ def search(
             seen = overview_shapes[poi.shape_index]
             roof = roof_between(seen, overview, shape, look.photo)
             if roof is None or roof > p.assumed_roof_m:  # beyond the tallest expected: a
-                roof = poi.roof_m  # mismatched pair of outlines, not a measurement
-            best = Found(poi, look.photo, shape, j.score, roof)
+                roof = yield from _measure_from_lower(m, k, poi, look, shape)  # mismatch
+            best = Found(poi, look.photo, shape, j.score, poi.roof_m if roof is None else roof)
             if not p.visit_all:
                 break
     if best is None:
@@ -125,6 +126,31 @@ def search(
         f"roof {best.roof_m:.1f} m above home",
     )
     return best
+
+
+def _measure_from_lower(
+    m: Mission, k: int, poi: PointOfInterest, look: _Look, shape: Shape
+) -> Wait[float | None]:
+    """The matched roof's height when the overview could not tell it (cut by its border):
+    one more photo straight below the look, ``overview_climb_m`` lower (never closer than
+    ``min_above_roof_m`` over the roof as assumed), compared with the look by size."""
+    p = m.params.mission
+    x, y, alt = look.photo.pose.pos_enu_m
+    lower = max(alt - p.overview_climb_m, poi.roof_m + p.min_above_roof_m)
+    if shape.cut_by_border or lower > alt - p.overview_climb_m / 2.0:
+        return None
+    yield from m.move((x, y, lower), None, f"point of interest {k}, measuring its roof")
+    photo = yield from m.photo(f"poi-{k}-roof", -90.0)
+    candidate = central_shape(photo_shapes(m, photo), photo.intrinsics)
+    if candidate is None:
+        return None
+    roof = roof_between(shape, look.photo, candidate, photo)
+    m.event(
+        Level.INFO,
+        f"point of interest {k}: roof "
+        + (f"{roof:.1f} m above home" if roof is not None else "height not measurable"),
+    )
+    return roof if roof is not None and roof <= p.assumed_roof_m else None
 
 
 def _look(m: Mission, k: int, n: int, alt_m: float) -> Wait[_Look]:

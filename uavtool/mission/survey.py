@@ -18,7 +18,7 @@ from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
 from uavtool.mission.search import photo_shapes
 from uavtool.nav import NavError, ground_point, ground_polygon, min_area_rect
-from uavtool.nav.geometry import convex_hull
+from uavtool.nav.geometry import convex_hull, point_polygon_distance
 from uavtool.vision import Shape
 
 if TYPE_CHECKING:
@@ -128,15 +128,49 @@ def _footprint(shape: Shape, photo: Photo, roof_m: float) -> tuple[tuple[float, 
         return ground_polygon(shape.polygon_px, photo.pose, photo.intrinsics, plane_z_m=0.0)
 
 
+def same_building(m: Mission, seen: Survey, target: int) -> frozenset[int]:
+    """``target`` and the survey's other shapes of its colour that touch it, within the
+    safety margin: the roofs of one stepped building, split in the overview by the walls
+    between its tiers, are not obstacles to photographing it."""
+    tol = m.params.mission.roof_colour_tolerance_dn
+    margin_m = m.params.viewpoints.safety_margin_m
+    own = seen.footprints[target]
+    colour = seen.shapes[target].colour_rgb
+    parts = {target}
+    for i, shape in enumerate(seen.shapes):
+        if i == target or not all(
+            abs(a - b) <= tol for a, b in zip(shape.colour_rgb, colour, strict=True)
+        ):
+            continue
+        other = seen.footprints[i]
+        gap = min(
+            *(point_polygon_distance(q, own) for q in other),
+            *(point_polygon_distance(q, other) for q in own),
+        )
+        if gap <= margin_m:
+            parts.add(i)
+    return frozenset(parts)
+
+
+def obstacles_around(
+    m: Mission, seen: Survey, target: int
+) -> list[tuple[tuple[float, float], ...]]:
+    """The survey's footprints of every building but the target (and its other roofs)."""
+    own = same_building(m, seen, target)
+    return [f for i, f in enumerate(seen.footprints) if i not in own]
+
+
 def remeasured_obstacles(
     m: Mission, seen: Survey, target: int, photo: Photo, shapes: tuple[Shape, ...]
 ) -> list[tuple[tuple[float, float], ...]]:
-    """The footprints of every building but ``target``, those of unknown height measured
-    again against a later nadir ``photo`` (its ``shapes``) where it shows them whole."""
+    """The footprints of every building but ``target`` (and its other roofs), those of
+    unknown height measured again against a later nadir ``photo`` (its ``shapes``) where it
+    shows them whole."""
     p = m.params.mission
+    own = same_building(m, seen, target)
     out = []
     for i, shape in enumerate(seen.shapes):
-        if i == target:
+        if i in own:
             continue
         footprint = seen.footprints[i]
         if not seen.measured[i] and not shape.cut_by_border:
