@@ -2,7 +2,8 @@
 
 Writing a value and reading it back gives an equal value: these types are both the write API
 and what the reader decodes to. Times are not part of the values; they travel alongside in
-`Entry` (``log_time_ns`` = receive time, ``publish_time_ns`` = vehicle time).
+`Entry` (``log_time_ns`` = receive time, ``publish_time_ns`` = the writer's publish time,
+equal to the log time in what ``uavtool fly`` records).
 """
 
 from __future__ import annotations

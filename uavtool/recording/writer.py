@@ -61,7 +61,7 @@ class RecordingWriter:
     ``metadata`` maps record names (``mission``, ``scene``, ``seeds``, ``command_line`` …) to
     string key/value pairs, written first after a ``uavtool`` record (tool version, dialect).
     Every ``write_*`` takes ``log_time_ns`` (receive time, > 0, one epoch per file) and
-    optionally ``publish_time_ns`` (vehicle time; defaults to the log time). Raises
+    optionally ``publish_time_ns`` (defaults to the log time). Raises
     `ValueError` on misuse (time ≤ 0, unregistered topic, NaN in JSON, writing after close)
     and `RecordingError` once a write or fsync has failed (disk full, I/O error).
     """
