@@ -19,7 +19,7 @@ from uavtool.link import VehicleLink
 from uavtool.mavlink import mavlink as M
 from uavtool.mavlink.dialect import COPTER_MODES
 from uavtool.sitl import Mode, Prism, Sitl, SitlConfig
-from uavtool.sitl.autopilot import CLEARANCE_RESOLUTION_M
+from uavtool.sitl.crash import CLEARANCE_RESOLUTION_M
 from uavtool.sitl.lockstep import LockstepTransport
 from uavtool.sitl.obstacles import prism_distance_m
 from uavtool.world import load_scene

@@ -15,7 +15,8 @@ from collections.abc import Sequence
 from uavtool.geo import GeoPoint, enu_from_geo, geo_from_enu, wrap_180
 from uavtool.mavlink.dialect import mavlink
 from uavtool.sitl.auto import AutoMission
-from uavtool.sitl.obstacles import ObstacleField, Prism
+from uavtool.sitl.crash import Collisions
+from uavtool.sitl.obstacles import Prism
 from uavtool.sitl.params import ParamStore
 from uavtool.sitl.physics import Multicopter, State, Target
 from uavtool.sitl.state import (
@@ -29,19 +30,6 @@ from uavtool.sitl.state import (
 )
 
 FORCE_MAGIC = 21196  # ArduPilot's "force" value for ARM_DISARM param2
-CRASH_VERTICAL_SPEED_MS = 3.0
-"""Meeting the ground armed and descending faster than this (m/s) is a crash. A normal landing
-descends at LAND_SPEED: 0.5 m/s by default, 0.3-2 m/s in ArduCopter's documented range."""
-CRASH_HORIZONTAL_SPEED_MS = 2.0
-"""Meeting the ground armed and moving sideways faster than this (m/s) is a crash: the vehicle
-tips over on its landing gear."""
-CRASH_MIN_HEIGHT_M = 0.5
-"""A touchdown is judged only after the vehicle has been at least this high since it left the
-ground: turbulence lifting an idling vehicle by centimetres (≈ 2 cm per m/s of SIM_WIND_TURB)
-and setting it down again is not a landing."""
-CLEARANCE_RESOLUTION_M = 0.01
-"""``closest_clearance_m`` is at most this much above the least clearance of the 50 Hz samples
-(it is never below it): hovering beside a wall then costs no geometry. Collisions are exact."""
 _NS = 1_000_000_000
 _SEV = mavlink  # severities: MAV_SEVERITY_*
 
@@ -83,24 +71,7 @@ class Autopilot:
         self.land_ne = (0.0, 0.0)
         self._velocity_deadline_ns = 0
         self.battery_used_mah = 0.0
-        self.obstacles = ObstacleField(obstacles)
-        self.body_radius_m = body_radius_m
-        self.crashed = False
-        self.crash_reason = ""
-        """Why the vehicle crashed (the STATUSTEXT it sent), "" while it has not."""
-        self.closest_clearance_m = math.inf
-        """Least distance (m) between the body sphere's surface and any obstacle while flying
-        (armed and off the ground) so far, to CLEARANCE_RESOLUTION_M; ≤ 0 after a collision;
-        inf without obstacles (or before the first step in the air)."""
-        self.closest_obstacle = ""
-        """The obstacle ``closest_clearance_m`` was measured to ("" while it is inf)."""
-        # Where the nearest obstacle distance was last measured (NED m), and how far (squared)
-        # the vehicle may move from there before it must be measured again (< 0: at once).
-        # The distance changes no faster than the vehicle moves, so far from obstacles the
-        # check is a few multiplications per step.
-        self._has_obstacles = len(obstacles) > 0
-        self._clearance_at = (0.0, 0.0, 0.0)
-        self._clearance_free2_m2 = -1.0
+        self.collisions = Collisions(obstacles, body_radius_m)
         self.apply_params()
 
     # ------------------------------------------------------------------ params
@@ -144,6 +115,25 @@ class Autopilot:
 
     def say(self, severity: int, text: str) -> None:
         self.events.append((severity, text[:50]))
+
+    @property
+    def crashed(self) -> bool:
+        return self.collisions.crashed
+
+    @property
+    def crash_reason(self) -> str:
+        """Why the vehicle crashed (the STATUSTEXT it sent), "" while it has not."""
+        return self.collisions.crash_reason
+
+    @property
+    def closest_clearance_m(self) -> float:
+        """See ``Collisions.closest_clearance_m``: ≤ 0 after a collision, inf without obstacles."""
+        return self.collisions.closest_clearance_m
+
+    @property
+    def closest_obstacle(self) -> str:
+        """The obstacle ``closest_clearance_m`` was measured to ("" while it is inf)."""
+        return self.collisions.closest_obstacle
 
     # ------------------------------------------------------------------ commands
     def arm(self, *, force: bool) -> Result:
@@ -226,29 +216,11 @@ class Autopilot:
         fence = self.fence_check((self.state.pos_ned_m[0], self.state.pos_ned_m[1], -alt_m))
         if fence is not None:
             return fence
-        blocked = self._takeoff_obstacle(alt_m)
+        blocked = self.collisions.takeoff_obstacle(self.state.pos_ned_m, alt_m)
         if blocked is not None:
             return blocked
         self.start_takeoff(alt_m)
         return ACCEPTED
-
-    def _takeoff_obstacle(self, alt_m: float) -> Result | None:
-        """DENIED if the body sphere, climbing straight up to ``alt_m``, would touch a prism."""
-        if not self._has_obstacles:
-            return None
-        n, e, d = self.state.pos_ned_m
-        up_m = -d
-        hit = self.obstacles.first_above(
-            e, n, from_up_m=up_m, to_up_m=alt_m, radius_m=self.body_radius_m
-        )
-        if hit is None:
-            return None
-        prism, distance_m = hit
-        above_m = prism.base_m - up_m
-        if above_m > 0.0:
-            return denied(f"Takeoff: obstacle above at {above_m:.1f} m")
-        # Not overhead but beside (or around) the vehicle: leaving the ground would touch it.
-        return denied(f"Takeoff: obstacle {prism.name!r} within {max(distance_m, 0.0):.1f} m")
 
     def start_takeoff(self, alt_m: float) -> None:
         n, e, _ = self.state.pos_ned_m
@@ -382,56 +354,19 @@ class Autopilot:
         if self.armed:
             self._run_mode()
         self.vehicle.step(dt_s)
-        if self.armed and (self._has_obstacles or self.vehicle.touchdown is not None):
-            self._check_crash()
+        if self.armed and (self.collisions.has_obstacles or self.vehicle.touchdown is not None):
+            reason = self.collisions.check(self.vehicle)
+            if reason is not None:
+                self.crash(reason)
         self._update_gimbal(dt_s)
         self._update_battery(dt_s)
         self._check_failsafes()
         self._check_landed()
 
-    def _check_crash(self) -> None:
-        """Collision of the body sphere with an obstacle in flight, or a hard touchdown."""
-        s = self.vehicle.state
-        if self._has_obstacles and not s.on_ground:
-            n, e, d = s.pos_ned_m
-            at = self._clearance_at
-            dn, de, dd = n - at[0], e - at[1], d - at[2]
-            if dn * dn + de * de + dd * dd >= self._clearance_free2_m2:
-                name = self._measure_clearance(n, e, d)
-                if name is not None and self.closest_clearance_m < 0.0:
-                    self.crash(f"Crash: collision with building {name!r}")
-                    return
-        touchdown = self.vehicle.touchdown
-        if touchdown is not None and touchdown.peak_up_m >= CRASH_MIN_HEIGHT_M:
-            vn, ve, vd = touchdown.vel_ned_ms
-            horizontal_ms = math.hypot(vn, ve)
-            if vd > CRASH_VERTICAL_SPEED_MS or horizontal_ms > CRASH_HORIZONTAL_SPEED_MS:
-                speed_ms = math.hypot(horizontal_ms, vd)
-                self.crash(f"Crash: hit the ground at {speed_ms:.1f} m/s")
-
-    def _measure_clearance(self, n: float, e: float, d: float) -> str | None:
-        """Measure the distance to the nearest obstacle at (n, e, d) (NED metres) and update
-        ``closest_clearance_m``; the obstacle's name when it set a new record."""
-        distance_m, prism = self.obstacles.nearest(e, n, -d)
-        radius = self.body_radius_m
-        clearance_m = distance_m - radius
-        name = None
-        if prism is not None and clearance_m < self.closest_clearance_m:
-            name = self.closest_obstacle = prism.name
-            self.closest_clearance_m = clearance_m
-        # Measure again only where the distance may have fallen below the body radius or below
-        # the record less its resolution: the distance changes no faster than the vehicle moves.
-        needed_m = radius + max(self.closest_clearance_m - CLEARANCE_RESOLUTION_M, 0.0)
-        free_m = distance_m - needed_m
-        self._clearance_at = (n, e, d)
-        self._clearance_free2_m2 = free_m * free_m if free_m > 0.0 else -1.0
-        return name
-
     def crash(self, reason: str) -> None:
         """Crash now: say ``reason`` (EMERGENCY), cut the motors and disarm; the wreck falls to
         the ground and refuses to arm until the vehicle restarts."""
-        self.crashed = True
-        self.crash_reason = reason
+        self.collisions.record_crash(reason)
         self.say(mavlink.MAV_SEVERITY_EMERGENCY, reason)
         s = self.vehicle.state
         # It stopped against what it hit and has no control left: it can only fall.
