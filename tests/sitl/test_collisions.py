@@ -325,8 +325,8 @@ def test_clearance_is_the_least_over_every_step() -> None:
     assert not ap.crashed
     assert not ap.armed
     assert least < 3.0  # it did pass close
-    assert least <= ap.closest_clearance_m <= least + CLEARANCE_RESOLUTION_M
-    assert ap.closest_obstacle == nearest
+    assert least <= ap.collisions.closest_clearance_m <= least + CLEARANCE_RESOLUTION_M
+    assert ap.collisions.closest_obstacle == nearest
     sitl.close()
 
 

@@ -114,7 +114,7 @@ def _model(m: Mission, found: Found, seen: Survey, transit_m: float) -> Wait[Non
         obj = central_shape(top_shapes, top_photo.intrinsics)
         if obj is None:
             m.no_model = "the top photo shows no building"
-            raise m.end(Status.PARTIAL, f"target found; model not built: {m.no_model}")
+            return
         if not obj.cut_by_border:
             break
         m.event(
@@ -125,7 +125,7 @@ def _model(m: Mission, found: Found, seen: Survey, transit_m: float) -> Wait[Non
         alt = roof + (alt - roof) * 1.5
     else:
         m.no_model = f"the top photo never showed the whole building ({p.max_looks} tries)"
-        raise m.end(Status.PARTIAL, f"target found; model not built: {m.no_model}")
+        return
     # The top photo, low over the target, measures the neighbours the overview could not.
     obstacles = remeasured_obstacles(m, seen, found.poi.shape_index, top_photo, top_shapes)
     # The top photo is centred on the building: plan the side photos from its footprint.

@@ -120,21 +120,6 @@ class Autopilot:
     def crashed(self) -> bool:
         return self.collisions.crashed
 
-    @property
-    def crash_reason(self) -> str:
-        """Why the vehicle crashed (the STATUSTEXT it sent), "" while it has not."""
-        return self.collisions.crash_reason
-
-    @property
-    def closest_clearance_m(self) -> float:
-        """See ``Collisions.closest_clearance_m``: ≤ 0 after a collision, inf without obstacles."""
-        return self.collisions.closest_clearance_m
-
-    @property
-    def closest_obstacle(self) -> str:
-        """The obstacle ``closest_clearance_m`` was measured to ("" while it is inf)."""
-        return self.collisions.closest_obstacle
-
     # ------------------------------------------------------------------ commands
     def arm(self, *, force: bool) -> Result:
         if self.crashed:  # even forced: the airframe is wrecked until the vehicle reboots

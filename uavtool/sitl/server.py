@@ -180,23 +180,23 @@ class Sitl:
     @property
     def crashed(self) -> bool:
         """True once the vehicle has hit an obstacle or the ground hard (until it restarts)."""
-        return self.autopilot.crashed
+        return self.autopilot.collisions.crashed
 
     @property
     def crash_reason(self) -> str:
         """The crash's STATUSTEXT, e.g. ``Crash: collision with building 'red'``; "" if none."""
-        return self.autopilot.crash_reason
+        return self.autopilot.collisions.crash_reason
 
     @property
     def closest_clearance_m(self) -> float:
         """Least gap (m) between the body sphere and any obstacle while airborne so far (≤ 0
-        after a collision, inf without obstacles); see ``Autopilot.closest_clearance_m``."""
-        return self.autopilot.closest_clearance_m
+        after a collision, inf without obstacles); see ``sitl.crash.Collisions``."""
+        return self.autopilot.collisions.closest_clearance_m
 
     @property
     def closest_obstacle(self) -> str:
         """Name of the obstacle ``closest_clearance_m`` was measured to ("" if none)."""
-        return self.autopilot.closest_obstacle
+        return self.autopilot.collisions.closest_obstacle
 
     def broadcast(self, msg: Any) -> None:
         for session in self.sessions:
