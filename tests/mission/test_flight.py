@@ -14,6 +14,7 @@ from tests.mission.driver import Flight, Flown, assert_home_safely, fly
 from uavtool.geo import wrap_180
 from uavtool.mission import (
     Command,
+    DiagonalView,
     ModelBuilt,
     Outcome,
     Photo,
@@ -133,7 +134,11 @@ def test_photos_are_taken_where_planned(paper_flight: Flown) -> None:
         poi = plan.pois[k]
         alt = min(look_altitude_m(paper_flight.mission, poi, photos["overview-2"].intrinsics), high)
         expected[f"poi-{k}"] = ((*poi.pos_en_m, alt), None, -90.0)
-    for vp in (views.top, views.front, views.right):
+    # Red has two tunnels: the model is open beneath, so a diagonal photo is planned too.
+    (diagonal,) = flight.of_type(DiagonalView)
+    assert diagonal.open_beneath > p.diagonal_open_beneath
+    for vp in (views.top, views.front, views.right, diagonal.viewpoint):
+        assert isinstance(vp, Viewpoint)
         expected[vp.name] = (vp.pos_enu_m, vp.heading_deg, vp.pitch_deg)
     assert sorted(photos) == sorted(expected)
     for tag, (pos, heading, pitch) in expected.items():

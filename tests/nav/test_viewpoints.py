@@ -16,10 +16,12 @@ from uavtool.nav import (
     ViewpointFailure,
     ViewpointParams,
     min_area_rect,
+    plan_diagonal,
     plan_viewpoints,
     top_viewpoint,
 )
 from uavtool.nav.geometry import point_polygon_distance, triangle_hits_polygon
+from uavtool.nav.viewpoints import base_distance_m
 from uavtool.world import building_footprint, load_scene
 
 K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
@@ -251,3 +253,34 @@ def test_blocked_front_scene_falls_back_to_the_north() -> None:
         distance=D0,
         fallback="opposite side",
     )
+
+
+def test_diagonal_looks_across_the_corner_between_front_and_right() -> None:
+    """Front from the south, right from the east: the diagonal camera stands south-east of
+    the centre and looks north-west, at the distance that fits the box's extent across
+    that direction (its diagonal, 10·cos45° + 8·cos45°)."""
+    front, right = plan([])
+    assert isinstance(front, Viewpoint) and isinstance(right, Viewpoint)
+    diag = plan_diagonal(BOX, front, right, [], K, P)
+    assert isinstance(diag, Viewpoint), diag
+    assert diag.name == "diagonal" and diag.heading_deg == pytest.approx(315.0)
+    across = (10.0 + 8.0) / math.sqrt(2.0)
+    d = base_distance_m(across, K, P)
+    depth = 9.0 / math.sqrt(2.0)  # the corner (5, −4) along the south-east unit vector
+    r = (depth + d) / math.sqrt(2.0)
+    assert diag.pos_enu_m == pytest.approx((r, -r, P.camera_alt_m))
+    assert diag.fallback == "between the front and right cameras"
+
+
+def test_diagonal_blocked_goes_behind_both_cameras() -> None:
+    front, right = plan([])
+    assert isinstance(front, Viewpoint) and isinstance(right, Viewpoint)
+    wall = square(9.0, -9.0, 1.0)  # between the box's south-east corner and that camera
+    diag = plan_diagonal(BOX, front, right, [wall], K, P)
+    assert isinstance(diag, Viewpoint), diag
+    assert diag.fallback == "behind the front and right cameras"
+    assert diag.heading_deg == pytest.approx(135.0)  # from the north-west, looking south-east
+    boxed = [square(x, y, 3.0) for x in (-17.0, 17.0) for y in (-17.0, 17.0)]  # every diagonal
+    failure = plan_diagonal(BOX, front, right, boxed, K, ViewpointParams(max_distance_m=30.0))
+    assert isinstance(failure, ViewpointFailure)
+    assert failure.reason.startswith("diagonal: between the front and right cameras: ")

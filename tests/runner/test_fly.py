@@ -13,6 +13,7 @@ from click.testing import CliRunner
 
 from uavtool.cli import cli
 from uavtool.mission import Params, Status
+from uavtool.mission.observations import Photo
 from uavtool.mission.params import with_overrides
 from uavtool.recording import RecordingReader, summarize
 from uavtool.replay import load_flight, replay
@@ -39,7 +40,8 @@ def test_paper_mission_finds_the_red_building_and_builds_its_model(
     assert e.visited == ("purple", "yellow", "blue", "red")
     assert o.model_built
     assert e.model_iou is not None and e.model_iou > 0.85
-    assert summary.frames == 9  # type: ignore[attr-defined]  # 2 overviews, 4 looks, 3 sides
+    # 2 overviews, 4 looks, top, front, right and a diagonal (red has two tunnels)
+    assert summary.frames == 10  # type: ignore[attr-defined]
 
 
 def test_recording_is_whole_and_replays_identically(paper_flight: tuple[object, Path]) -> None:
@@ -162,3 +164,19 @@ def test_a_collision_crashes_the_vehicle_and_ends_the_mission(tmp_path: Path) ->
     with RecordingReader(rec) as reader:
         texts = [str(e.value.payload["text"]) for e in reader.entries(["/mavlink/in/STATUSTEXT"])]  # type: ignore[union-attr]
     assert "Crash: collision with building 'mast'" in texts
+
+
+def test_an_arch_gets_a_diagonal_photo_and_its_model_keeps_the_tunnels(tmp_path: Path) -> None:
+    """Red in the `arch` scene is an L-shaped deck on two pillars: the front and right photos
+    see through under its legs but not under its corner (a pillar stands behind it from both
+    sides). The model from them is open underneath, so the mission takes a diagonal photo,
+    and the model built with it is open all the way through."""
+    rec = tmp_path / "arch.mcap"
+    summary = fly(FlyConfig(scene="arch", record=rec))
+    o, e = summary.outcome, summary.evaluation
+    assert o.status is Status.COMPLETED, o.reason
+    assert e.matched_building == "red"
+    tags = [obs.tag for obs in load_flight(rec).observations if isinstance(obs, Photo)]
+    assert tags[-3:] == ["front", "right", "diagonal"], tags
+    assert e.tunnel_kept is True
+    assert e.model_iou is not None and e.model_iou > 0.85

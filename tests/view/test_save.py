@@ -87,7 +87,7 @@ def test_one_frame_per_camera_image(saved: Saved, facts: Facts) -> None:
     photos = data.last("world/photos")
     assert len(photos["Points3D:positions"]) == facts.frames
     assert photos["Points3D:labels"][0] == "overview"
-    assert photos["Points3D:labels"][-3:] == ["top", "front", "right"]
+    assert photos["Points3D:labels"][-4:] == ["top", "front", "right", "diagonal"]
 
 
 def test_telemetry_in_bulk_and_the_route_complete(saved: Saved, facts: Facts) -> None:

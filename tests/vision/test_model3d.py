@@ -10,7 +10,14 @@ import trimesh
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.vision import vectorize
 from uavtool.vision.errors import ModelInputError
-from uavtool.vision.model3d import Model, View, build_model, model_glb, same_colour
+from uavtool.vision.model3d import (
+    Model,
+    View,
+    build_model,
+    model_glb,
+    open_beneath,
+    same_colour,
+)
 from uavtool.world import building_mesh, load_scene, render
 
 K = Intrinsics.from_hfov()
@@ -91,3 +98,57 @@ def test_bad_views_are_refused_with_a_reason() -> None:
         build_model(v["front"], v["front"], v["right"])
     with pytest.raises(ModelInputError, match="no silhouette"):
         build_model(View((), POSES["top"], K), v["front"], v["right"])
+
+
+def _arch_scene_views(building: str, poses: dict[str, CameraPose]) -> dict[str, View]:
+    scene = load_scene("arch")
+    colour = scene.building(building).color_rgb
+    return {
+        name: View(
+            same_colour(
+                vectorize(render(scene, pose, K, noise_seed=7)), colour, hue_tolerance_deg=15
+            ),
+            pose,
+            K,
+        )
+        for name, pose in poses.items()
+    }
+
+
+def test_open_beneath_tells_a_building_on_its_footprint_from_one_with_tunnels() -> None:
+    # Green in the `arch` scene: a stepped tower (8 × 8 m to 9 m, 4 × 4 m to 15 m).
+    v = _arch_scene_views(
+        "green",
+        {
+            "top": CameraPose((12.0, 10.0, 40.0), 0.0, -90.0),
+            "front": CameraPose((12.0, 40.0, 8.0), 180.0, 0.0),  # north, looking south
+            "right": CameraPose((40.0, 10.0, 8.0), 270.0, 0.0),  # east, looking west
+        },
+    )
+    assert open_beneath(build_model(v["top"], v["front"], v["right"])) < 0.02
+    # Paper's red has two tunnels through it, seen through from the front and the right.
+    assert open_beneath(_paper_model()) > 0.15
+
+
+def test_a_diagonal_view_carves_what_the_square_on_views_cannot_see_through() -> None:
+    """The `arch` scene's red: an L-shaped deck 4–8 m up on two pillars under the ends of
+    its legs. Its corner (x 4–8, y −16…−12) stands on nothing, but from the south and from
+    the east a pillar stands behind it: only a diagonal view sees through under it."""
+    v = _arch_scene_views(
+        "red",
+        {
+            "top": CameraPose((10.0, -11.5, 30.0), 0.0, -90.0),
+            "front": CameraPose((10.0, -38.0, 6.0), 0.0, 0.0),  # south, looking north
+            "right": CameraPose((38.0, -11.5, 6.0), 270.0, 0.0),  # east, looking west
+            "diagonal": CameraPose((28.0, -32.0, 6.0), 315.0, 0.0),  # south-east, looking NW
+        },
+    )
+    corner, deck = (6.0, -14.0, 2.0), (6.0, -14.0, 6.0)
+    three = build_model(v["top"], v["front"], v["right"])
+    assert open_beneath(three) > 0.15  # under the legs, seen through from the side
+    assert _occupied(three.mesh, corner)
+    four = build_model(v["top"], v["front"], v["right"], more=(v["diagonal"],))
+    assert not _occupied(four.mesh, corner)
+    assert _occupied(four.mesh, deck)
+    assert four.mesh.is_watertight
+    assert four.mesh.volume < three.mesh.volume

@@ -15,6 +15,7 @@ from uavtool.mission.observations import (
 from uavtool.mission.outputs import (
     Arm,
     Command,
+    DiagonalView,
     Event,
     GoTo,
     Level,
@@ -38,6 +39,7 @@ __all__ = [
     "Arm",
     "Command",
     "CommandResult",
+    "DiagonalView",
     "Event",
     "GoTo",
     "Level",

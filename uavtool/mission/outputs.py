@@ -148,6 +148,16 @@ class Viewpoints:
 
 
 @dataclass(frozen=True, slots=True)
+class DiagonalView:
+    """The model from the top, front and right photos is open under ``open_beneath`` of its
+    largest section (the side photos saw through under the building): the diagonal photo
+    planned to carve what they could not see through, or why there is none."""
+
+    open_beneath: float
+    viewpoint: Viewpoint | ViewpointFailure
+
+
+@dataclass(frozen=True, slots=True)
 class ModelBuilt:
     """The 3D model (world ENU metres): mesh arrays as nested tuples, and GLB bytes."""
 
@@ -190,4 +200,6 @@ class Outcome:
     model_built: bool
 
 
-Output = Command | Event | Shapes | Plan | Recognition | Viewpoints | ModelBuilt | Outcome
+Output = (
+    Command | Event | Shapes | Plan | Recognition | Viewpoints | DiagonalView | ModelBuilt | Outcome
+)

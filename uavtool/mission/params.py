@@ -47,6 +47,11 @@ class MissionParams:
     """… and the top photo for the model from the altitude at which it spans this fraction."""
     min_above_roof_m: float = 6.0
     """No photo is taken closer than this above the roof it looks at."""
+    diagonal_open_beneath: float = 0.15
+    """When the model from the top, front and right photos is open under at least this
+    fraction of its largest section (just above the ground: the side photos saw through under
+    the building), a third side photo from a diagonal carves what they could not see through,
+    and the model is built again with it (above 1 = never)."""
     roof_gap_px: float = 6.0
     """Same-coloured roofs closer than this (pixels) in a nadir photo are one building: blocks
     of different heights show as separate roofs split by a strip of wall."""

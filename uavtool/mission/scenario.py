@@ -3,40 +3,16 @@ photos for the model, and the model. Each step is a generator run by :class:`Mis
 
 from __future__ import annotations
 
-import dataclasses
-import math
 from typing import TYPE_CHECKING
 
-from uavtool.mission.observations import Photo
-from uavtool.mission.outputs import (
-    Level,
-    ModelBuilt,
-    Plan,
-    Status,
-    Viewpoints,
-)
-from uavtool.mission.search import Found, photo_shapes, search
-from uavtool.mission.survey import Survey, obstacles_around, remeasured_obstacles, survey
-from uavtool.nav import (
-    Viewpoint,
-    ViewpointFailure,
-    ground_polygon,
-    min_area_rect,
-    plan_viewpoints,
-    route_length_m,
-    top_viewpoint,
-    visit_order,
-)
-from uavtool.nav.geometry import point_polygon_distance
-from uavtool.nav.heights import fit_altitude_m
-from uavtool.vision.errors import VisionError
-from uavtool.vision.model3d import View, build_model, central_shape, model_glb, same_colour
+from uavtool.mission.modelling import photograph_and_model
+from uavtool.mission.outputs import Level, Plan, Status
+from uavtool.mission.search import search
+from uavtool.mission.survey import survey
+from uavtool.nav import route_length_m, visit_order
 
 if TYPE_CHECKING:
     from uavtool.mission.mission import Mission, Wait
-
-# Hue window for "the same building" in the side photos (walls are shaded darker than roofs).
-_SIDE_HUE_TOLERANCE_DEG = 15.0
 
 
 def fly(m: Mission) -> Wait[None]:
@@ -77,157 +53,4 @@ def fly(m: Mission) -> Wait[None]:
         return
     m.matched_poi = found.poi.index
     m.match_score = found.score
-    yield from _model(m, found, seen, transit_m)
-
-
-def _model(m: Mission, found: Found, seen: Survey, transit_m: float) -> Wait[None]:
-    """Top, front and right photos from planned viewpoints, then the model. The side photos
-    are taken only once the top photo shows the whole building."""
-    p = m.params.mission
-    roof = found.roof_m
-    k = found.photo.intrinsics
-    # Side photos: a horizontal camera halfway up, its view holding the whole height.
-    vp_params = dataclasses.replace(
-        m.params.viewpoints,
-        camera_alt_m=max(m.params.viewpoints.camera_alt_m, roof / 2.0),
-        assumed_height_m=max(m.params.viewpoints.assumed_height_m, roof),
-    )
-    footprint = ground_polygon(
-        found.shape.polygon_px, found.photo.pose, k, plane_z_m=min(roof, _below(found.photo))
-    )
-    rect = min_area_rect(footprint)
-    others = obstacles_around(m, seen, found.poi.shape_index)
-    front, right = plan_viewpoints(rect, others, k, vp_params)
-    front_heading = (
-        front.heading_deg if isinstance(front, Viewpoint) else (rect.long_axis_deg + 90.0) % 360.0
-    )
-    extent = math.hypot(rect.length_m, rect.width_m)
-    alt = max(
-        fit_altitude_m(roof_m=roof, extent_m=extent, intrinsics=k, fill=p.top_fill),
-        roof + p.min_above_roof_m,
-    )
-    for attempt in range(1, p.max_looks + 1):
-        top = top_viewpoint(rect, front_heading, alt_m=alt)
-        yield from m.travel(top.pos_enu_m, top.heading_deg, transit_m, "top viewpoint")
-        top_photo = yield from m.photo("top" if attempt == 1 else f"top-{attempt}", -90.0)
-        top_shapes = photo_shapes(m, top_photo)
-        obj = central_shape(top_shapes, top_photo.intrinsics)
-        if obj is None:
-            m.no_model = "the top photo shows no building"
-            return
-        if not obj.cut_by_border:
-            break
-        m.event(
-            Level.INFO,
-            f"top photo from {alt:.1f} m: the building touches the image border; "
-            + ("again from higher" if attempt < p.max_looks else "giving up"),
-        )
-        alt = roof + (alt - roof) * 1.5
-    else:
-        m.no_model = f"the top photo never showed the whole building ({p.max_looks} tries)"
-        return
-    # The top photo, low over the target, measures the neighbours the overview could not.
-    obstacles = remeasured_obstacles(m, seen, found.poi.shape_index, top_photo, top_shapes)
-    # The top photo is centred on the building: plan the side photos from its footprint.
-    footprint = ground_polygon(obj.polygon_px, top_photo.pose, top_photo.intrinsics, plane_z_m=roof)
-    rect = min_area_rect(footprint)
-    front, right = plan_viewpoints(rect, obstacles, top_photo.intrinsics, vp_params)
-    m.viewpoints = Viewpoints(footprint, top, front, right)
-    m.emit(m.viewpoints)
-
-    views: dict[str, View] = {}
-    for vp in (front, right):
-        if isinstance(vp, ViewpointFailure):
-            m.event(Level.WARNING, f"{vp.name} viewpoint impossible: {vp.reason}")
-            continue
-        if vp.fallback:
-            m.event(Level.INFO, f"{vp.name} viewpoint: {vp.fallback}")
-        # Backing away must keep clear of the survey's cautious footprints too: a neighbour
-        # measured again may have been paired with the wrong roof.
-        cautious = obstacles + others
-        views[vp.name] = yield from _side_view(m, vp, obj.colour_rgb, cautious, transit_m)
-
-    missing = [name for name in ("front", "right") if name not in views]
-    if missing:
-        m.no_model = f"no {' or '.join(missing)} photo"
-        m.event(Level.WARNING, f"model not built: {m.no_model}")
-        return
-    try:
-        model = build_model(
-            View((obj,), top_photo.pose, top_photo.intrinsics),
-            views["front"],
-            views["right"],
-            m.params.model,
-        )
-    except VisionError as exc:
-        m.no_model = str(exc)
-        m.event(Level.ERROR, f"model not built: {exc}")
-        return
-    mesh = model.mesh
-    m.model = ModelBuilt(
-        tuple(tuple(v) for v in mesh.vertices.tolist()),
-        tuple(tuple(f) for f in mesh.faces.tolist()),
-        model_glb(model),
-        model.height_m,
-        float(mesh.volume),
-    )
-    m.emit(m.model)
-    m.model_built = True
-    m.event(
-        Level.INFO,
-        f"model built: height {model.height_m:.2f} m, volume {float(mesh.volume):.1f} m³",
-    )
-
-
-def _side_view(
-    m: Mission,
-    vp: Viewpoint,
-    colour_rgb: tuple[int, int, int],
-    obstacles: list[tuple[tuple[float, float], ...]],
-    transit_m: float,
-) -> Wait[View]:
-    """A side photo from ``vp``; while the building touches the image border, the camera
-    backs away from it by half the planned distance and photographs it again (up to
-    ``max_looks`` photos), as long as that keeps the safety margin from every other
-    building."""
-    p = m.params.mission
-    margin_m = m.params.viewpoints.safety_margin_m
-    x, y, z = vp.pos_enu_m
-    h = math.radians(vp.heading_deg)
-    back_x, back_y = -math.sin(h), -math.cos(h)  # the camera looks along the heading
-    step_m = vp.distance_m * 0.5
-    yield from m.travel(
-        (x, y, transit_m), vp.heading_deg, transit_m, f"above the {vp.name} viewpoint"
-    )
-    for attempt in range(1, p.max_looks + 1):
-        yield from m.move((x, y, z), vp.heading_deg, f"{vp.name} viewpoint")
-        photo = yield from m.photo(vp.name if attempt == 1 else f"{vp.name}-{attempt}", 0.0)
-        shapes = photo_shapes(m, photo, nadir=False)
-        silhouette = same_colour(shapes, colour_rgb, hue_tolerance_deg=_SIDE_HUE_TOLERANCE_DEG)
-        if not any(s.cut_by_border for s in silhouette) or attempt == p.max_looks:
-            break
-        nx, ny = x + back_x * step_m, y + back_y * step_m
-        room_m = min((point_polygon_distance((nx, ny), o) for o in obstacles), default=math.inf)
-        if room_m < margin_m:
-            m.event(
-                Level.INFO,
-                f"{vp.name} photo: the building touches the border; no room to back away",
-            )
-            break
-        m.event(
-            Level.INFO,
-            f"{vp.name} photo: the building touches the image border; backing away {step_m:.1f} m",
-        )
-        x, y = nx, ny
-        # Up, across and down again: the way back may pass a building the plan did not know.
-        yield from m.move(
-            (photo.pose.pos_enu_m[0], photo.pose.pos_enu_m[1], transit_m), None, "climb"
-        )
-        yield from m.travel((x, y, z), vp.heading_deg, transit_m, f"{vp.name} viewpoint")
-    yield from m.move((x, y, transit_m), vp.heading_deg, f"climb from the {vp.name} viewpoint")
-    return View(silhouette, photo.pose, photo.intrinsics)
-
-
-def _below(photo: Photo) -> float:
-    """Just below the camera: the highest plane a nadir photo's pixels can be put on."""
-    return photo.pose.pos_enu_m[2] - 0.5
+    yield from photograph_and_model(m, found, seen, transit_m)

@@ -14,6 +14,7 @@ from uavtool.nav.viewpoints import (
     Viewpoint,
     ViewpointFailure,
     ViewpointParams,
+    plan_diagonal,
     plan_viewpoints,
     top_viewpoint,
 )
@@ -28,6 +29,7 @@ __all__ = [
     "ground_point",
     "ground_polygon",
     "min_area_rect",
+    "plan_diagonal",
     "plan_viewpoints",
     "poi_offset",
     "route_length_m",

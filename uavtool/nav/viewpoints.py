@@ -216,6 +216,34 @@ def _oblique(
         normal[0] * math.cos(a) - normal[1] * math.sin(a),
         normal[0] * math.sin(a) + normal[1] * math.cos(a),
     )
+    found = _from_direction(
+        name,
+        rect,
+        u,
+        side,
+        f"turned {offset_deg:+g}° from the {side} side",
+        obstacles,
+        intrinsics,
+        params,
+    )
+    if isinstance(found, Viewpoint):
+        return found
+    return f"{side} turned {offset_deg:+g}°: {found}"
+
+
+def _from_direction(
+    name: str,
+    rect: Rect,
+    u: Point,
+    side: str,
+    label: str,
+    obstacles: list[list[Point]],
+    intrinsics: Intrinsics,
+    params: ViewpointParams,
+) -> Viewpoint | str:
+    """A camera out from the rectangle's centre along the unit vector ``u``, looking back at
+    it, at the first distance (growing as square-on ones do) where it keeps the safety
+    margin and sees every corner past the obstacles; else what blocked it."""
     cx, cy = rect.center_en
     corners = rect.corners()
     depth = max((x - cx) * u[0] + (y - cy) * u[1] for x, y in corners)
@@ -247,14 +275,11 @@ def _oblique(
                 heading_deg=_heading(-u[0], -u[1]),
                 side=side,
                 distance_m=distance,
-                fallback=f"turned {offset_deg:+g}° from the {side} side"
-                + (f", distance {factor:.2f}x" if factor > 1.0 else ""),
+                fallback=label + (f", distance {factor:.2f}x" if factor > 1.0 else ""),
             )
-        blocked = f"{side} turned {offset_deg:+g}°: " + (
-            "no line of sight" if hidden else "no room"
-        )
+        blocked = "no line of sight" if hidden else "no room"
         factor *= params.distance_step
-    return blocked or f"{side} turned {offset_deg:+g}°: beyond nav.max_distance_m"
+    return blocked or "beyond nav.max_distance_m"
 
 
 def plan_viewpoints(
@@ -282,6 +307,46 @@ def plan_viewpoints(
     right_side = "short-a" if front_side == "long-a" else "short-b"
     right = _plan_one("right", target, right_side, polys, intrinsics, params)
     return front, right
+
+
+def plan_diagonal(
+    target: Rect,
+    front: Viewpoint,
+    right: Viewpoint,
+    obstacles: Sequence[Sequence[tuple[float, float]]] | Sequence[Any],
+    intrinsics: Intrinsics,
+    params: ViewpointParams | None = None,
+) -> Viewpoint | ViewpointFailure:
+    """A third side photo, looking at ``target`` across a corner: from halfway between the
+    front and right cameras' directions, else from behind both, else from the two other
+    diagonals. It sees under a building along lines the square-on photos cannot (the corner
+    of an L-shaped arch), so its silhouette carves what theirs leave standing."""
+    params = params or ViewpointParams()
+    polys = [as_points(p, what=f"obstacles[{i}]") for i, p in enumerate(obstacles)]
+    cx, cy = target.center_en
+    units = []
+    for vp in (front, right):
+        ex, ey = vp.pos_enu_m[0] - cx, vp.pos_enu_m[1] - cy
+        n = math.hypot(ex, ey) or 1.0
+        units.append((ex / n, ey / n))
+    (fx, fy), (rx, ry) = units
+    tried = []
+    for label, (ux, uy) in (
+        ("between the front and right cameras", (fx + rx, fy + ry)),
+        ("behind the front and right cameras", (-fx - rx, -fy - ry)),
+        ("between the front camera and the right one's opposite", (fx - rx, fy - ry)),
+        ("between the right camera and the front one's opposite", (rx - fx, ry - fy)),
+    ):
+        n = math.hypot(ux, uy)
+        if n < 1e-9:  # front and right from the same direction: no diagonal between them
+            continue
+        found = _from_direction(
+            "diagonal", target, (ux / n, uy / n), "diagonal", label, polys, intrinsics, params
+        )
+        if isinstance(found, Viewpoint):
+            return found
+        tried.append(f"{label}: {found}")
+    return ViewpointFailure("diagonal", "diagonal: " + "; ".join(tried))
 
 
 def top_viewpoint(target: Rect, front_heading_deg: float, *, alt_m: float) -> Viewpoint:

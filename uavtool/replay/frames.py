@@ -10,7 +10,7 @@ from uavtool.mission import Params, Photo
 from uavtool.mission.analysis import judge, nadir_shapes, side_shapes, target_shapes
 from uavtool.replay.load import RecordedFlight
 
-_SIDE_TAGS = ("front", "right")
+_SIDE_TAGS = ("front", "right", "diagonal")
 
 
 @dataclass(frozen=True, slots=True)

@@ -61,7 +61,8 @@ _OBS_SCHEMA = {
 _OUT_SCHEMA = {
     "title": "uavtool.Output",
     "description": "What the mission produced, in order: commands (SetMode, Arm, Takeoff, "
-    "GoTo, SetGimbal, TakePhoto), Event, Shapes, Plan, Recognition, Viewpoints, ModelBuilt, "
+    "GoTo, SetGimbal, TakePhoto), Event, Shapes, Plan, Recognition, Viewpoints, DiagonalView, "
+    "ModelBuilt, "
     "Outcome.",
     "type": "object",
     "properties": {

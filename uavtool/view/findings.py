@@ -36,6 +36,7 @@ class Findings:
         self.pois: list[Mapping[str, Any]] = []
         self._scores: dict[int, float] = {}
         self._matched: int | None = None
+        self._viewpoints: tuple[Sequence[Any], list[Mapping[str, Any]]] = ([], [])
 
     def shapes(self, out: Output) -> None:
         frame = int(out.get("frame_index", -1))
@@ -88,7 +89,20 @@ class Findings:
     def viewpoints(self, out: Output) -> list[str]:
         """Draws the planned viewpoints; returns why each failed one failed."""
         views = [out[k] for k in ("top", "front", "right") if isinstance(out.get(k), Mapping)]
-        footprint = out.get("footprint_en_m") or []
+        self._viewpoints = (out.get("footprint_en_m") or [], views)
+        return self._draw_viewpoints(views)
+
+    def diagonal(self, out: Output) -> None:
+        """Adds the diagonal viewpoint, if there is one, to those drawn (the mission's event
+        says why there is none)."""
+        footprint, views = self._viewpoints
+        view = out.get("viewpoint")
+        if isinstance(view, Mapping) and "pos_enu_m" in view:
+            self._viewpoints = (footprint, [*views, view])
+            self._draw_viewpoints(self._viewpoints[1])
+
+    def _draw_viewpoints(self, views: list[Mapping[str, Any]]) -> list[str]:
+        footprint, _ = self._viewpoints
         ent.log_viewpoints(self.rec, self.paths, footprint_en_m=footprint, viewpoints=views)
         return [
             f"viewpoint {v.get('name')}: {v.get('reason', 'failed')}"

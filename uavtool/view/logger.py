@@ -231,6 +231,7 @@ _OUTPUT_HANDLERS: dict[str, Callable[[MissionLogger, Mapping[str, Any]], None]] 
     "Plan": lambda self, out: self.findings.plan(out),
     "Recognition": lambda self, out: self.findings.recognition(out),
     "Viewpoints": MissionLogger._viewpoints,
+    "DiagonalView": lambda self, out: self.findings.diagonal(out),
     "ModelBuilt": lambda self, out: self.findings.model(out),
     "Outcome": MissionLogger._outcome,
 }

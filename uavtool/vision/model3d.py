@@ -60,8 +60,18 @@ class Model:
     footprint_enu_m: FloatArray
 
 
-def build_model(top: View, front: View, right: View, params: ModelParams | None = None) -> Model:
+def build_model(
+    top: View,
+    front: View,
+    right: View,
+    params: ModelParams | None = None,
+    *,
+    more: Sequence[View] = (),
+) -> Model:
     """The object's 3D model from its top, front and right views.
+
+    ``more``: further side views (e.g. from a diagonal); each one's cone cuts the solid
+    too, carving what the front and right views cannot see through (an arch's corner).
 
     Raises :class:`ModelInputError` when a view has no silhouette, a silhouette touches the
     image border (unless allowed), the top photo is not close to nadir, the side photos are
@@ -70,9 +80,9 @@ def build_model(top: View, front: View, right: View, params: ModelParams | None 
     import manifold3d  # noqa: PLC0415 — heavy; only model building needs it
 
     p = params if params is not None else ModelParams()
-    _check_views(top, front, right, p)
+    _check_views(top, front, right, p, more)
     side = manifold3d.Manifold.batch_boolean(
-        [_cone(front), _cone(right)], manifold3d.OpType.Intersect
+        [_cone(view) for view in (front, right, *more)], manifold3d.OpType.Intersect
     )
     side = side.trim_by_plane((0.0, 0.0, 1.0), p.ground_z_m)
     if side.is_empty():
@@ -91,6 +101,28 @@ def build_model(top: View, front: View, right: View, params: ModelParams | None 
     return Model(mesh, float(mesh.bounds[1][2]) - p.ground_z_m, rings[0])
 
 
+def open_beneath(model: Model, *, ground_z_m: float = 0.0, above_m: float = 0.5) -> float:
+    """The fraction of the model's largest horizontal section that is empty ``above_m`` over
+    the ground: 0 for a building that stands on its whole footprint, large where the side
+    photos saw through under it (an arch, a bridge, a deck on pillars)."""
+    import manifold3d  # noqa: PLC0415
+
+    mesh = model.mesh
+    solid = manifold3d.Manifold(
+        manifold3d.Mesh(
+            np.asarray(mesh.vertices, dtype=np.float32), np.asarray(mesh.faces, dtype=np.uint32)
+        )
+    )
+    top = float(mesh.bounds[1][2])
+    low = ground_z_m + above_m
+    if top <= low:
+        return 0.0
+    largest = max(float(solid.slice(float(z)).area()) for z in np.linspace(low, top - 1e-3, 16))
+    if largest <= 0.0:
+        return 0.0
+    return max(0.0, 1.0 - float(solid.slice(low).area()) / float(largest))
+
+
 def model_glb(model: Model) -> bytes:
     """The model's mesh as binary glTF bytes."""
     data = model.mesh.export(file_type="glb")
@@ -99,8 +131,13 @@ def model_glb(model: Model) -> bytes:
     return data
 
 
-def _check_views(top: View, front: View, right: View, p: ModelParams) -> None:
-    for name, view in (("top", top), ("front", front), ("right", right)):
+def _check_views(top: View, front: View, right: View, p: ModelParams, more: Sequence[View]) -> None:
+    sides = [
+        ("front", front),
+        ("right", right),
+        *((f"side {i + 3}", v) for i, v in enumerate(more)),
+    ]
+    for name, view in [("top", top), *sides]:
         if not view.shapes:
             raise ModelInputError(f"{name}: no silhouette of the object in the photo")
         if not p.allow_border_cut and any(s.cut_by_border for s in view.shapes):
@@ -113,7 +150,7 @@ def _check_views(top: View, front: View, right: View, p: ModelParams) -> None:
             f"top: gimbal pitch {top.pose.pitch_deg:g}° is not within "
             f"{p.max_top_tilt_deg:g}° of nadir (−90°)"
         )
-    for name, view in (("front", front), ("right", right)):
+    for name, view in sides:
         if abs(view.pose.pitch_deg) > p.max_side_tilt_deg:
             raise ModelInputError(
                 f"{name}: gimbal pitch {view.pose.pitch_deg:g}° is not within "
