@@ -7,18 +7,29 @@ from pathlib import Path
 
 import click
 
+from uavtool.errors import InputError
+
 _PATH = click.Path(dir_okay=False, path_type=Path)
 
 
 @click.command()
 @click.argument("rec", type=_PATH)
+@click.option(
+    "--verify/--no-verify",
+    default=True,
+    show_default=True,
+    help="Read every chunk and check its CRC; --no-verify reads the summary alone (instant "
+    "on any size, but finds no damage inside the chunks).",
+)
 @click.option("--recover", is_flag=True, help="Rewrite everything readable as a whole file.")
 @click.option("-o", "--output", type=_PATH, help="Where --recover writes (required with it).")
-def info(rec: Path, recover: bool, output: Path | None) -> None:
+def info(rec: Path, verify: bool, recover: bool, output: Path | None) -> None:
     """Show a recording's duration, topics, frames, outcome and file health.
 
-    A truncated file (the recorder crashed) is reported, not refused; --recover copies
-    what it still holds into a whole, indexed file.
+    Every chunk's CRC is checked: a corrupt chunk is reported with its topics, log times
+    and the messages lost, and the command then exits 2. A truncated file (the recorder
+    crashed) is reported, not refused. --recover copies what the file still holds into a
+    whole, indexed file, leaving corrupt chunks out.
 
     \b
     Example:
@@ -29,14 +40,22 @@ def info(rec: Path, recover: bool, output: Path | None) -> None:
         raise click.UsageError("--recover and -o/--output go together")
     from uavtool.recording import info as recording_info
 
-    click.echo(recording_info.format_info(recording_info.summarize(rec)))
+    summary = recording_info.summarize(rec, verify=verify or recover)
+    click.echo(recording_info.format_info(summary))
     if recover and output is not None:
         from uavtool.recording.recover import recover as do_recover
 
         result = do_recover(rec, output)
+        for dropped in result.dropped:
+            click.echo(f"dropped {dropped}")
         click.echo(
             f"recovered {result.messages} messages on {result.channels} channels to {output}"
+            + (f"; {result.messages_lost} messages lost" if result.messages_lost else "")
         )
+        return
+    problem = recording_info.damage_problem(summary)
+    if problem:
+        raise InputError(f"{rec}: {problem}")
 
 
 @click.command()

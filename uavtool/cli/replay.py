@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from uavtool.errors import InputError
+from uavtool.errors import FailureError, InputError
 
 
 @click.command()
@@ -74,6 +74,7 @@ def replay(
       uavtool replay --refly recordings/golden/paper.mcap   # vehicle, renderer and mission
     """
     from uavtool.mission.params import parse_settings, with_overrides
+    from uavtool.recording.files import refuse_same_file
     from uavtool.replay import load_flight, reanalyse_frames
     from uavtool.replay import replay as run_replay
     from uavtool.replay.write import write_replay
@@ -94,6 +95,8 @@ def replay(
             f"{recording.with_suffix('.outputs.txt')}"
         )
         return
+    if out is not None:
+        refuse_same_file(out, [recording])  # now, not after the whole replay
     flight = load_flight(recording)
     overrides: dict[str, object] = {}
     if params_file is not None:
@@ -105,6 +108,11 @@ def replay(
         raise InputError(
             f"{recording}: the recording is truncated (cut while writing); --check needs a whole "
             f"file. `uavtool info --recover {recording} -o fixed.mcap` saves what it holds"
+        )
+    if check and not vision_only and not flight.has_outcome:
+        raise FailureError(
+            f"{recording}: no Outcome among its {len(flight.outputs)} recorded outputs: the "
+            "mission did not finish, or its end was lost; --check cannot vouch for it"
         )
     if flight.truncated:
         click.echo(

@@ -13,12 +13,15 @@ from typing import Any
 
 from uavtool.errors import LinkError
 from uavtool.geo import GeoPoint
+from uavtool.link.freshness import FreshnessFilter
 from uavtool.link.transport import Transport
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mavlink.framing import FrameParser, new_encoder
 
 GCS_SYSID = 255
 GCS_COMPID = M.MAV_COMP_ID_MISSIONPLANNER
+ANNOUNCE_S = 1.0
+"""How often a link that has not heard a vehicle yet sends its heartbeat (MAVProxy's rate)."""
 Tap = Callable[[str, bytes], None]
 """Called with ``("in" | "out", frame bytes)`` for every whole frame that crosses the link."""
 
@@ -57,16 +60,26 @@ in real time, the vehicle's own clock for one stepped in lockstep."""
 
 class VehicleLink:
     """A connection to one vehicle. ``poll`` reads what arrived and returns the messages from
-    the vehicle; ``send`` packs and sends. ``clock`` is what every wait on this link is timed
-    by. Not thread-safe (the runner owns it)."""
+    the vehicle, stale ones left out (``freshness`` counts them); ``send`` packs and sends.
+    ``clock`` is what every wait on this link is timed by. ``tap`` hears every frame, stale or
+    not. With ``announce`` the link sends its heartbeat before it has heard a vehicle, as
+    MAVProxy and MAVSDK do: a vehicle listening on UDP learns from it where to send. Not
+    thread-safe (the runner owns it)."""
 
     def __init__(
-        self, transport: Transport, *, tap: Tap | None = None, clock: Clock = time.monotonic
+        self,
+        transport: Transport,
+        *,
+        tap: Tap | None = None,
+        clock: Clock = time.monotonic,
+        announce: bool = True,
     ) -> None:
         self.transport = transport
         self.clock = clock
         self.name = transport.name
         self.tap = tap
+        self.announce = announce
+        self.freshness = FreshnessFilter()
         self._parser = FrameParser()
         self._mav = new_encoder(sysid=GCS_SYSID, compid=GCS_COMPID)
         self.target_system = 0
@@ -88,7 +101,7 @@ class VehicleLink:
             if self.tap is not None:
                 self.tap("in", frame.raw)
             msg = frame.msg
-            if self._accept(msg):
+            if self._accept(msg) and self.freshness.fresh(msg):
                 self._update(msg)
                 out.append(msg)
         return out
@@ -158,15 +171,20 @@ class VehicleLink:
         link's clock); LinkError if not."""
         deadline = self.clock() + timeout_s
         last_request: float | None = None
+        last_announce: float | None = None
         while self.state.home is None or self.state.position is None or last_request is None:
             now = self.clock()
             if now > deadline:
                 what = "heartbeat" if self.target_system == 0 else "home position"
                 raise LinkError(f"{self.name}: no {what} from a vehicle in {timeout_s:g} s")
-            if self.target_system and (last_request is None or now - last_request > 2.0):
+            if self.target_system:
+                if last_request is None or now - last_request > 2.0:
+                    self.heartbeat()
+                    self.request_streams()
+                    last_request = now
+            elif self.announce and (last_announce is None or now - last_announce >= ANNOUNCE_S):
                 self.heartbeat()
-                self.request_streams()
-                last_request = now
+                last_announce = now
             if on_wait is not None:
                 on_wait()
             self.poll(0.05)

@@ -276,16 +276,22 @@ class Mission:
     # --- commands -----------------------------------------------------------------------------
 
     def command(
-        self, make: Callable[[int], Command], what: str, *, retries: int = -1
+        self,
+        make: Callable[[int], Command],
+        what: str,
+        *,
+        retries: int = -1,
+        done: Callable[[Telemetry], bool] | None = None,
     ) -> Wait[None]:
-        """Issue a command until the vehicle accepts it; abort (RTL) after the retries."""
+        """Issue a command until the vehicle accepts it, or the telemetry shows it ``done``
+        (its ACK lost on the link); abort (RTL) after the retries."""
         attempts = 1 + (self.params.mission.command_retries if retries < 0 else retries)
         detail = ""
         for attempt in range(1, attempts + 1):
             cmd = make(self._new_id())
             self.emit(cmd)
             result = yield from self._result(cmd.id)
-            if result.accepted:
+            if result.accepted or (done is not None and self.last is not None and done(self.last)):
                 return
             detail = result.detail
             self.event(Level.WARNING, f"{what}: {detail} (attempt {attempt} of {attempts})")
@@ -398,7 +404,11 @@ class Mission:
         ok = yield from self.wait_until(lambda t: t.armed, p.move_slack_s)
         if not ok:
             raise _End(Status.ABORTED, "the vehicle accepted arming but never showed armed")
-        yield from self.command(lambda i: Takeoff(i, alt_m), f"take-off to {alt_m:g} m")
+        # A take-off whose ACK was lost is flying: the vehicle refuses it again, and that is no
+        # failure.
+        yield from self.command(
+            lambda i: Takeoff(i, alt_m), f"take-off to {alt_m:g} m", done=lambda t: not t.landed
+        )
         self.airborne()
         climbed = yield from self.wait_until(
             lambda t: t.pos_enu_m[2] >= alt_m - p.arrive_radius_m,

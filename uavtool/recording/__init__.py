@@ -2,6 +2,7 @@
 and bridge to MAVProxy's ``.tlog``. The topic list is in README.md, "Recording format"."""
 
 from uavtool.recording.errors import (
+    CorruptRecordingError,
     NotMcapError,
     RecordingError,
     TlogError,
@@ -32,6 +33,7 @@ from uavtool.recording.writer import RecordingWriter
 __all__ = [
     "CameraCalibration",
     "CompressedImage",
+    "CorruptRecordingError",
     "Direction",
     "Entry",
     "FrameTransform",

@@ -38,6 +38,11 @@ class UnknownSchemaError(RecordingError):
     """A channel's schema or encoding is not one this reader decodes."""
 
 
+class CorruptRecordingError(RecordingError):
+    """Part of the recording fails its checks (a chunk's CRC, a record that does not parse)
+    and what was asked for cannot be read whole."""
+
+
 class TlogError(RecordingError):
     """A telemetry log (.tlog) holds no MAVLink frames we can read."""
 
@@ -48,3 +53,8 @@ def create_file(path: str | Path) -> BinaryIO:
         return Path(path).open("wb")
     except OSError as exc:
         raise RecordingError(path, f"cannot create: {exc.strerror}") from exc
+
+
+def write_failed(path: str | Path, exc: OSError) -> RecordingError:
+    """The error for a write to ``path`` that the OS refused (a full disk …)."""
+    return RecordingError(path, f"cannot write: {exc.strerror or exc}")

@@ -38,18 +38,27 @@ class RecordingInfo:
     topics: tuple[TopicInfo, ...]
     metadata_names: tuple[str, ...]
     outcome: dict[str, str] | None
+    verified: bool = False  # every chunk was read and checked
+    summary_problem: str = ""  # why the summary was not used ("" if used or absent)
+    damage: tuple[str, ...] = ()  # each corrupt chunk or damaged record, in words
+    messages_lost: int = 0  # in the corrupt chunks, as far as their indexes tell
 
     @property
     def duration_s(self) -> float:
         return (self.end_ns - self.start_ns) / 1e9
 
 
-def summarize(path: str | Path) -> RecordingInfo:
-    """Inspect a recording; never fails on a truncated file (it says so instead).
+def summarize(path: str | Path, *, verify: bool = True) -> RecordingInfo:
+    """Inspect a recording; never fails on a truncated or damaged file (it says so instead).
+    ``verify`` reads every chunk and checks its CRC (and the data-section CRC, when there is
+    one); without it a whole file's summary alone is read, and only damage outside the chunks
+    (metadata records) is found.
 
     Raises `NotMcapError` if the file is missing, empty or not MCAP.
     """
     with RecordingReader(path) as reader:
+        damage = reader.verify() if verify else reader.damage
+        lost = sum(d.messages_lost for d in damage)
         health = reader.health
         start_ns, end_ns = reader.time_range_ns
         duration_s = (end_ns - start_ns) / 1e9
@@ -86,19 +95,54 @@ def summarize(path: str | Path) -> RecordingInfo:
             library=reader.library,
             start_ns=start_ns,
             end_ns=end_ns,
-            message_count=sum(counts.values()),
+            # the summary counts what was written; a scan counts only what it could read
+            message_count=sum(counts.values()) + (0 if health.indexed else lost),
             frame_count=frames,
             topics=topics,
             metadata_names=tuple(name for name, _ in metadata),
             outcome=outcome,
+            verified=verify,
+            summary_problem=reader.summary_problem,
+            damage=tuple(reader.describe(d) for d in damage),
+            messages_lost=lost,
         )
+
+
+def damage_problem(info: RecordingInfo) -> str:
+    """One line on what is damaged ("" if nothing is): the reason `uavtool info` fails."""
+    if info.damage:
+        lost = f" ({info.messages_lost} messages lost)" if info.messages_lost else ""
+        return (
+            f"{len(info.damage)} damaged part(s){lost}, first {info.damage[0]}; "
+            f"`uavtool info --recover {info.path} -o fixed.mcap` keeps every good chunk"
+        )
+    if info.summary_problem:
+        return (
+            f"{info.summary_problem} (every message is still readable); "
+            f"`uavtool info --recover {info.path} -o fixed.mcap` writes a sound summary"
+        )
+    return ""
 
 
 def format_info(info: RecordingInfo) -> str:
     """The human-readable report `uavtool info` prints."""
     lines = [f"file:      {info.path} ({info.size_bytes} bytes, written by {info.library or '?'})"]
-    if info.whole:
-        lines.append("health:    whole, " + ("indexed" if info.indexed else "no summary or index"))
+    if info.damage:
+        lost = f", {info.messages_lost} messages lost" if info.messages_lost else ""
+        lines.append(f"health:    DAMAGED — {len(info.damage)} part(s) fail their checks{lost}")
+        lines.extend(f"           {d}" for d in info.damage)
+        lines.append(
+            f"           keep every good chunk with: "
+            f"uavtool info --recover {info.path} -o fixed.mcap"
+        )
+        if not info.whole:
+            lines.append(f"           and it is TRUNCATED — {info.problem}")
+    elif info.whole:
+        checked = ", CRCs checked" if info.verified else ", chunks not checked"
+        index = "indexed" if info.indexed else "no summary or index"
+        if info.summary_problem:
+            index = f"{info.summary_problem}: every record read by a scan instead"
+        lines.append(f"health:    whole, {index}{checked}")
     else:
         rescued = " (some from a cut chunk)" if info.partial_chunk else ""
         lines.append(f"health:    TRUNCATED — {info.problem}")
@@ -108,7 +152,10 @@ def format_info(info: RecordingInfo) -> str:
             f"recover them with: uavtool info --recover {info.path} -o fixed.mcap"
         )
     lines.append(f"duration:  {info.duration_s:.3f} s")
-    lines.append(f"messages:  {info.message_count}")
+    readable = (
+        f" ({info.message_count - info.messages_lost} readable)" if info.messages_lost else ""
+    )
+    lines.append(f"messages:  {info.message_count}{readable}")
     lines.append(f"frames:    {info.frame_count}")
     if info.outcome is None:
         lines.append("outcome:   unknown (no 'outcome' record: the mission did not finish)")

@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import mmap
 import struct
+import zlib
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -16,26 +17,24 @@ from types import TracebackType
 from typing import Any
 
 from uavtool.recording import foxglove
+from uavtool.recording.chunks import Block, ChunkDamaged, Damage, chunk_damage, read_chunk
 from uavtool.recording.errors import (
+    CorruptRecordingError,
     NotMcapError,
     RecordingError,
     TopicNotFoundError,
     UnknownSchemaError,
 )
-from uavtool.recording.layout import (
-    Block,
+from uavtool.recording.files import NotRegularFileError, open_input
+from uavtool.recording.layout import Health, Layout, read_layout
+from uavtool.recording.records import (
     Channel,
-    Health,
-    Layout,
     NotMcap,
     Op,
     Schema,
-    chunk_payload,
-    decompress,
     iter_records,
     parse_channel,
     parse_schema,
-    read_layout,
 )
 from uavtool.recording.schemas import (
     JSON_ENCODING,
@@ -45,7 +44,6 @@ from uavtool.recording.schemas import (
 from uavtool.recording.values import Direction, Entry, JsonDocument, MavlinkFrame, Value
 
 _MSG = struct.Struct("<HIQQ")
-_REC = struct.Struct("<BQ")
 
 
 @dataclass(frozen=True, slots=True)
@@ -63,17 +61,27 @@ class Message:
 class RecordingReader:
     """Reads an MCAP recording; a truncated one up to its last whole record, without raising.
 
-    Raises `NotMcapError` (missing, empty, not MCAP) on open.
+    Every chunk is checked when it is read (see `chunks.read_chunk`): a chunk that fails
+    raises `CorruptRecordingError` naming where it is, its topics, log times and the messages
+    lost, and so does any read of all messages that yields fewer than the file's statistics
+    promise. With ``skip_damaged`` such chunks are skipped instead and listed in `damage`
+    (for recovery). Raises `NotMcapError` (missing, empty, not MCAP, not a regular file) on
+    open.
     """
 
-    def __init__(self, path: str | Path) -> None:
+    def __init__(self, path: str | Path, *, skip_damaged: bool = False) -> None:
         self.path = Path(path)
+        self._skip_damaged = skip_damaged
+        self._found: list[Damage] = []  # damage found while reading
+        self._checked: set[int] = set()  # offsets of chunks read and found good
         try:
-            with self.path.open("rb") as f:
+            with open_input(self.path) as f:
                 size = f.seek(0, 2)
                 self._map: mmap.mmap | None = (
                     mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) if size else None
                 )
+        except NotRegularFileError as exc:
+            raise NotMcapError(path, str(exc).removeprefix(f"{path}: ")) from None
         except OSError as exc:
             raise NotMcapError(path, f"cannot open: {exc.strerror}") from exc
         self._buf: Any = self._map if self._map is not None else b""
@@ -107,6 +115,12 @@ class RecordingReader:
         return self._layout.health
 
     @property
+    def summary_problem(self) -> str:
+        """Why the file's summary was not used and the file was scanned instead ("" if it
+        was used, or there is none)."""
+        return self._layout.summary_problem
+
+    @property
     def library(self) -> str:
         return self._layout.library
 
@@ -120,12 +134,14 @@ class RecordingReader:
 
     @property
     def metadata(self) -> list[tuple[str, dict[str, str]]]:
-        """Metadata records in file order as ``(name, record)``."""
+        """Metadata records in file order as ``(name, record)``; damaged ones are left out
+        (see `damage`)."""
         return list(self._layout.metadata)
 
     @property
     def message_counts(self) -> dict[int, int]:
-        """Readable messages per channel id."""
+        """Messages per channel id: the summary's statistics for a whole file, what the scan
+        could read for any other."""
         return dict(self._layout.counts)
 
     @property
@@ -133,9 +149,81 @@ class RecordingReader:
         """First and last log time of the readable messages (0, 0 if none)."""
         return self._layout.start_ns, self._layout.end_ns
 
+    @property
+    def damage(self) -> list[Damage]:
+        """What could not be read so far: found while finding the layout, while reading, or
+        by `verify`."""
+        return [*self._layout.damage, *self._found]
+
     def topics(self) -> list[str]:
         """The distinct topics of the readable channels, sorted."""
         return sorted({c.topic for c in self._layout.channels.values()})
+
+    def verify(self) -> list[Damage]:
+        """Read and check every chunk not read yet (and the data-section CRC when the file
+        has one); returns all the damage known. Never raises for damage."""
+        layout = self._layout
+        if layout.health.indexed:  # a scan has checked every chunk already
+            for block in layout.blocks:
+                if block.chunked and block.data is None and block.offset not in self._checked:
+                    self._read_block(block, raise_damage=False)
+        crc = layout.data_crc
+        if crc and not self.damage and self._crc32(layout.data_end) != crc:
+            self._found.append(
+                Damage(
+                    "data section",
+                    8,
+                    layout.data_end - 8,
+                    "CRC mismatch outside every chunk (a metadata or other record)",
+                )
+            )
+        return self.damage
+
+    def _crc32(self, end: int) -> int:
+        with memoryview(self._buf) as view, view[:end] as data:  # no copy of the file
+            return zlib.crc32(data)
+
+    def require_intact(self) -> None:
+        """`verify`, and raise `CorruptRecordingError` for the first damage found."""
+        damage = self.verify()
+        if damage:
+            raise self._corrupt(damage[0])
+
+    def require_metadata(self, names: Iterable[str]) -> None:
+        """Raise `CorruptRecordingError` if a metadata record named in ``names`` (or one whose
+        name is unknown) is damaged."""
+        wanted = set(names)
+        for d in self._layout.damage:
+            if d.kind == "metadata" and (not d.name or d.name in wanted):
+                what = f"metadata record {d.name!r}" if d.name else "a metadata record"
+                raise CorruptRecordingError(
+                    self.path, f"byte {d.offset}: {what} is damaged ({d.problem})"
+                )
+
+    def describe(self, damage: Damage) -> str:
+        """One line: where the damage is, what it held and what was lost."""
+        if damage.kind != "chunk":
+            name = f" {damage.name!r}" if damage.name else ""
+            return f"byte {damage.offset}: damaged {damage.kind} record{name} ({damage.problem})"
+        t0 = self._layout.start_ns
+        when = (
+            f", log time {(damage.start_ns - t0) / 1e9:.3f}–{(damage.end_ns - t0) / 1e9:.3f} s"
+            if damage.end_ns >= damage.start_ns >= t0 > 0
+            else ""
+        )
+        lost = (
+            f"{damage.messages_lost} messages lost on {_listing(self._topics(damage.lost))}"
+            if damage.lost
+            else "its messages are lost (how many is unknown)"
+        )
+        return (
+            f"byte {damage.offset}: corrupt chunk of {damage.length} bytes ({damage.problem})"
+            f"{when}: {lost}"
+        )
+
+    def _topics(self, channel_ids: Iterable[int]) -> list[str]:
+        channels = self._layout.channels
+        return sorted({channels[c].topic if c in channels else f"channel {c}" for c in channel_ids})
 
     # --- messages ----------------------------------------------------------------------------
 
@@ -147,7 +235,8 @@ class RecordingReader:
         end_ns: int | None = None,
     ) -> Iterator[Message]:
         """Messages of ``topics`` (all if None) with ``start_ns <= log_time < end_ns``, in file
-        order. Raises `TopicNotFoundError` if a named topic is not in the file."""
+        order. Raises `TopicNotFoundError` if a named topic is not in the file, and
+        `CorruptRecordingError` (see the class) when they cannot all be read."""
         wanted: set[int] | None = None
         if topics is not None:
             wanted = set()
@@ -157,11 +246,25 @@ class RecordingReader:
                 if not ids:
                     raise TopicNotFoundError(self.path, topic, present)
                 wanted |= ids
+        if not self._skip_damaged:
+            for d in self._layout.damage:  # chunks a scan found bad: not in the blocks
+                if d.kind == "chunk" and (
+                    not d.lost or wanted is None or wanted.intersection(d.lost)
+                ):
+                    raise self._corrupt(d)
         lo = 0 if start_ns is None else start_ns
         hi = 1 << 64 if end_ns is None else end_ns
         return self._iter(wanted, lo, hi)
 
+    def _corrupt(self, damage: Damage) -> CorruptRecordingError:
+        return CorruptRecordingError(
+            self.path,
+            f"{self.describe(damage)}; `uavtool info --recover {self.path} -o fixed.mcap` "
+            "keeps every good chunk",
+        )
+
     def _iter(self, wanted: set[int] | None, lo: int, hi: int) -> Iterator[Message]:
+        count = 0
         for block in self._layout.blocks:
             if (
                 wanted is not None
@@ -171,47 +274,61 @@ class RecordingReader:
                 continue
             if block.end_ns < lo or block.start_ns >= hi:
                 continue
-            records, start, end = self._records(block)
-            yield from self._block_messages(records, start, end, wanted=wanted, lo=lo, hi=hi)
+            records = self._read_block(block, raise_damage=not self._skip_damaged)
+            for message in self._block_messages(records, wanted=wanted, lo=lo, hi=hi):
+                count += 1
+                yield message
+        if lo == 0 and hi == 1 << 64 and not self._skip_damaged:
+            counts = self._layout.counts
+            expected = sum(n for c, n in counts.items() if wanted is None or c in wanted)
+            if count < expected:
+                raise CorruptRecordingError(
+                    self.path,
+                    f"read {count} of the {expected} messages its summary counts on "
+                    f"{_listing(self._topics(wanted or counts))}: the file holds less than "
+                    "it says",
+                )
 
-    def _records(self, block: Block) -> tuple[Any, int, int]:
+    def _read_block(self, block: Block, *, raise_damage: bool) -> Any:
+        """The records of ``block`` (a checked chunk's, a cut chunk's rescued prefix, or the
+        file for a message outside chunks); b"" for a damaged chunk unless ``raise_damage``."""
         if block.data is not None:
-            return block.data, 0, len(block.data)
-        buf = self._buf
+            return block.data
         if not block.chunked:
-            return buf, block.offset, block.offset + block.length
-        op, n = _REC.unpack_from(buf, block.offset)
-        if op != Op.CHUNK:
-            raise RecordingError(self.path, f"byte {block.offset}: the index points at no chunk")
-        s = block.offset + 9
-        compression, rs, rn, usize, _crc = chunk_payload(buf, s, s + n)
+            return self._buf[block.offset : block.offset + block.length]
         try:
-            data = decompress(compression, buf[rs : rs + rn], usize)
-        except Exception as exc:
-            raise RecordingError(
-                self.path, f"byte {block.offset}: unreadable chunk ({exc})"
-            ) from exc
-        return data, 0, len(data)
+            data = read_chunk(self._buf, block)
+        except ChunkDamaged as exc:
+            damage = chunk_damage(self._buf, block, str(exc))
+            if all(d.offset != block.offset for d in self._found):
+                self._found.append(damage)
+            if raise_damage:
+                raise self._corrupt(damage) from None
+            return b""
+        self._checked.add(block.offset)
+        return data
 
     def _block_messages(
-        self, buf: Any, start: int, end: int, *, wanted: set[int] | None, lo: int, hi: int
+        self, buf: Any, *, wanted: set[int] | None, lo: int, hi: int
     ) -> Iterator[Message]:
         channels, schemas = self._layout.channels, self._layout.schemas
         unpack_msg = _MSG.unpack_from
-        for op, s, e in iter_records(buf, start, end):
+        for op, s, e in iter_records(buf, 0, len(buf)):
             if op == Op.MESSAGE:
                 cid, seq, log_t, pub_t = unpack_msg(buf, s)
                 if (wanted is None or cid in wanted) and lo <= log_t < hi:
                     channel = channels.get(cid)
                     if channel is None:
+                        if self._skip_damaged:  # its channel was defined in a damaged chunk
+                            continue
                         raise RecordingError(self.path, f"message on unknown channel id {cid}")
                     schema = schemas.get(channel.schema_id)
                     yield Message(channel, schema, seq, log_t, pub_t, bytes(buf[s + 22 : e]))
             elif op == Op.SCHEMA:  # files without a summary define these inside chunks
-                schema = parse_schema(buf, s)
+                schema = parse_schema(buf, s, e)
                 schemas.setdefault(schema.id, schema)
             elif op == Op.CHANNEL:
-                channel = parse_channel(buf, s)
+                channel = parse_channel(buf, s, e)
                 channels.setdefault(channel.id, channel)
 
     def entries(
@@ -265,3 +382,10 @@ class RecordingReader:
             self.path,
             f"topic {channel.topic!r}: cannot decode {encoding!r} messages of schema {name!r}",
         )
+
+
+def _listing(topics: list[str], most: int = 4) -> str:
+    """``/a, /b, /c and 5 more topics``: short enough for a one-line error."""
+    if len(topics) <= most:
+        return ", ".join(topics)
+    return f"{', '.join(topics[:most])} and {len(topics) - most} more topics"

@@ -13,7 +13,8 @@ import struct
 from dataclasses import dataclass
 from pathlib import Path
 
-from uavtool.recording.errors import TlogError, UnknownSchemaError, create_file
+from uavtool.recording.errors import TlogError, UnknownSchemaError, create_file, write_failed
+from uavtool.recording.files import NotRegularFileError, atomic_output, open_input
 from uavtool.recording.reader import RecordingReader
 from uavtool.recording.schemas import DEFAULT_DIALECT, MAVLINK_ENCODING, MAVLINK_RAW, MavlinkDecoder
 from uavtool.recording.values import Direction
@@ -33,19 +34,28 @@ class TlogResult:
 
 def export_tlog(rec: str | Path, out: str | Path) -> TlogResult:
     """Write every ``/mavlink/raw`` frame of ``rec``, both directions in recorded order, to a
-    tlog stamped with each frame's log time. Raises `TopicNotFoundError` without MAVLink."""
+    tlog stamped with each frame's log time. ``out`` appears only once complete. Raises
+    `TopicNotFoundError` without MAVLink, `SameFileError` if ``out`` is ``rec``,
+    `CorruptRecordingError` if frames cannot be read, `RecordingError` if ``out`` cannot be
+    written."""
     with RecordingReader(rec) as reader:
         messages = reader.messages([MAVLINK_RAW])
         count = 0
-        with create_file(out) as f:
-            for message in messages:
-                if message.channel.message_encoding != MAVLINK_ENCODING:
-                    raise UnknownSchemaError(
-                        rec, f"{MAVLINK_RAW} has encoding {message.channel.message_encoding!r}"
-                    )
-                f.write(_STAMP.pack(message.log_time_ns // 1000))
-                f.write(message.data)
-                count += 1
+        with atomic_output(out, inputs=[rec]) as tmp:
+            f = create_file(tmp)
+            try:
+                with f:
+                    for message in messages:
+                        if message.channel.message_encoding != MAVLINK_ENCODING:
+                            raise UnknownSchemaError(
+                                rec,
+                                f"{MAVLINK_RAW} has encoding {message.channel.message_encoding!r}",
+                            )
+                        f.write(_STAMP.pack(message.log_time_ns // 1000))
+                        f.write(message.data)
+                        count += 1
+            except OSError as exc:
+                raise write_failed(out, exc) from None
     return TlogResult(count, 0)
 
 
@@ -65,7 +75,10 @@ def read_tlog(
 ) -> tuple[list[tuple[int, bytes]], int]:
     """``([(time_us, frame), …], skipped_bytes)`` of a tlog. Raises `TlogError`."""
     try:
-        buf = Path(path).read_bytes()
+        with open_input(path) as f:
+            buf = f.read()
+    except NotRegularFileError as exc:
+        raise TlogError(path, str(exc).removeprefix(f"{path}: ")) from None
     except OSError as exc:
         raise TlogError(path, f"cannot open: {exc.strerror}") from exc
     if not buf:
@@ -98,7 +111,10 @@ def import_tlog(
     received (``in``). Log time = the tlog's time stamp."""
     frames, skipped = read_tlog(tlog, dialect=dialect)
     meta = {"import": {"source": Path(tlog).name, "format": "tlog", "gcs_sysid": str(gcs_sysid)}}
-    with RecordingWriter(out, metadata=meta, dialect=dialect, fsync=False) as writer:
+    with (
+        atomic_output(out, inputs=[tlog]) as tmp,
+        RecordingWriter(tmp, metadata=meta, dialect=dialect, fsync=False) as writer,
+    ):
         for time_us, frame in frames:
             sysid = frame[5] if frame[0] == _V2 else frame[3]
             direction = Direction.OUT if sysid == gcs_sysid else Direction.IN

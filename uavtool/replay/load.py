@@ -18,6 +18,8 @@ from uavtool.mission.params import from_dict
 from uavtool.recording import CompressedImage, JsonDocument, RecordingReader
 from uavtool.recording.topics import IMAGE, OBSERVATIONS, OUTPUTS, TARGET
 
+_NEEDED_METADATA = ("mission", "uavtool")  # the parameters, the version that recorded them
+
 
 class ReplayInputError(InputError):
     """The recording cannot be replayed (not a mission recording, frames missing …)."""
@@ -44,12 +46,18 @@ class RecordedFlight:
     truncated: bool
     tool_version: str
 
+    @property
+    def has_outcome(self) -> bool:
+        """Whether the recorded outputs end the mission with an Outcome."""
+        return any(o.data.get("type") == "Outcome" for o in self.outputs)
+
 
 def load_flight(path: str | Path) -> RecordedFlight:
     """Read a recording made by ``uavtool fly``; raises a one-line InputError naming the file
     and what is missing or wrong."""
     path = Path(path)
     with RecordingReader(path) as reader:
+        reader.require_metadata(_NEEDED_METADATA)
         meta = dict(reader.metadata)
         if "mission" not in meta or OBSERVATIONS not in reader.topics():
             raise ReplayInputError(
@@ -82,6 +90,7 @@ def load_flight(path: str | Path) -> RecordedFlight:
                 n, step = int(data.pop("n")), int(data.pop("step"))
                 outputs.append(RecordedOutput(n, step, data))
         truncated = not reader.health.whole
+        _check_counts(reader, path, {OBSERVATIONS: len(raw_obs), OUTPUTS: len(outputs)})
     if target is None:
         raise ReplayInputError(f"{path}: the target picture ({TARGET}) is missing")
     observations = []
@@ -113,3 +122,18 @@ def load_flight(path: str | Path) -> RecordedFlight:
         truncated,
         tool_version,
     )
+
+
+def _check_counts(reader: RecordingReader, path: Path, read: dict[str, int]) -> None:
+    """Refuse a flight read with fewer messages on a topic than the file's statistics count
+    (the reader raises first for a corrupt chunk; this is the last word)."""
+    counts, channels = reader.message_counts, reader.channels
+    for topic, got in read.items():
+        expected = sum(
+            n for cid, n in counts.items() if cid in channels and channels[cid].topic == topic
+        )
+        if got < expected:
+            raise ReplayInputError(
+                f"{path}: read {got} of the {expected} messages on {topic} that the file "
+                "counts; it cannot be replayed whole"
+            )

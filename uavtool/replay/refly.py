@@ -21,6 +21,7 @@ from uavtool.errors import InputError
 from uavtool.mission import Params
 from uavtool.mission.params import from_dict
 from uavtool.recording import CompressedImage, RecordingReader
+from uavtool.recording.files import refuse_same_file
 from uavtool.recording.reader import Message
 from uavtool.recording.topics import TARGET
 from uavtool.runner.fly import FlightSummary, FlyConfig, fly
@@ -63,6 +64,8 @@ def refly_config(path: Path, *, out: Path, workdir: Path) -> FlyConfig:
     """The :class:`FlyConfig` that made the lockstep recording ``path``, recording to ``out``
     (a target picture the user gave is written into ``workdir``). Raises ReflyInputError."""
     with RecordingReader(path) as reader:
+        reader.require_metadata(("mission", "scene", "flight", "vehicle"))
+        reader.require_intact()  # now, not after flying: the comparison needs all of it
         meta = dict(reader.metadata)
         vehicle = meta.get("vehicle", {})
         if not is_lockstep(path):
@@ -114,6 +117,8 @@ def refly(
     """Fly ``path``'s configuration again (to ``out``, or a temporary file that is removed)
     and compare the two recordings message by message."""
     path = Path(path)
+    if out is not None:
+        refuse_same_file(out, [path])
     with tempfile.TemporaryDirectory(prefix="uavtool-refly-") as tmp:
         work = Path(tmp)
         target = out if out is not None else work / "reflown.mcap"

@@ -15,6 +15,7 @@ from uavtool.recording import (
     RecordingReader,
     RecordingWriter,
 )
+from uavtool.recording.files import atomic_output
 from uavtool.recording.topics import EVENTS, MODEL, OBSERVATIONS, OUTPUTS
 from uavtool.replay.load import RecordedOutput
 from uavtool.runner.record import MissionRecorder
@@ -32,8 +33,9 @@ def write_replay(
     outcome: dict[str, str] | None = None,
 ) -> None:
     """Copy ``source``'s inputs into ``out`` and write ``outputs`` (with each model's GLB from
-    ``glbs`` by output number) at the log time of the observation that produced them."""
-    with RecordingReader(source) as reader:
+    ``glbs`` by output number) at the log time of the observation that produced them.
+    ``out`` appears only once complete; `SameFileError` if it is ``source``."""
+    with RecordingReader(source) as reader, atomic_output(out, inputs=[source]) as tmp:
         meta = {
             name: record
             for name, record in reader.metadata
@@ -41,7 +43,7 @@ def write_replay(
         }
         meta["mission"] = {"params": json.dumps(to_dict(params))}
         meta["replay"] = {"source": str(source)}
-        with RecordingWriter(out, metadata=meta) as writer:
+        with RecordingWriter(tmp, metadata=meta) as writer:
             recorder = MissionRecorder(writer)
             pending = list(outputs)
             last_t = 0

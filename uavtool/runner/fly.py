@@ -30,7 +30,8 @@ from uavtool.mavlink.dialect import COPTER_MODES
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mission import Level, Mission, Outcome, Params
 from uavtool.mission.params import to_dict
-from uavtool.recording import RecordingWriter
+from uavtool.recording import RecordingError, RecordingWriter
+from uavtool.recording.files import atomic_output
 from uavtool.runner.camera import open_camera
 from uavtool.runner.evaluate import Evaluation, closest_clearance, evaluate
 from uavtool.runner.live import LiveView
@@ -92,6 +93,9 @@ class FlightSummary:
     clearance_building: str
     flight_wall_s: float
     """Wall time of the same span (the mission itself, without start-up)."""
+    stale_dropped: tuple[tuple[str, int], ...] = ()
+    """Messages dropped as older than one already taken (late on the link), per message name;
+    the recording keeps them."""
 
 
 def default_recording_path(now: datetime | None = None) -> Path:
@@ -147,10 +151,18 @@ def fly(
             clock, clock_ns, true_pose = time.monotonic, time.time_ns, None
         path = None if config.no_record else (config.record or default_recording_path())
         recorder = None
+        flown: list[bool] = []  # set once the mission starts: from then on the file is kept
         if path is not None:
             path.parent.mkdir(parents=True, exist_ok=True)
+            partial = stack.enter_context(
+                atomic_output(
+                    path,
+                    inputs=(config.target, config.scene if isinstance(config.scene, str) else None),
+                    keep_on_error=lambda _exc: bool(flown),
+                )
+            )
             writer = stack.enter_context(
-                RecordingWriter(path, metadata=flight_metadata(config, scene))
+                RecordingWriter(partial, metadata=flight_metadata(config, scene))
             )
             recorder = MissionRecorder(writer, clock_ns=clock_ns)
             recorder.target(target_png)
@@ -166,7 +178,13 @@ def fly(
             stack.callback(live.close)
             if live.url:
                 say(f"Rerun web viewer at {live.url}")
-        link = VehicleLink(transport, tap=recorder.mavlink if recorder else None, clock=clock)
+        # The built-in vehicle speaks first; announcing ourselves would change its recordings.
+        link = VehicleLink(
+            transport,
+            tap=recorder.mavlink if recorder else None,
+            clock=clock,
+            announce=config.connect is not None,
+        )
         link.wait_vehicle(config.connect_timeout_s)
         home = link.state.home
         assert home is not None
@@ -192,10 +210,14 @@ def fly(
             progress=progress,
         )
         flight_wall0, vehicle0 = time.perf_counter(), clock()
+        flown.append(True)
         try:
             outcome = runner.run()
         except KeyboardInterrupt:
             _abort(link, recorder, "interrupted by the user: RTL sent")
+            raise
+        except Exception as exc:
+            _failed(recorder, exc)
             raise
         flight_wall_s, vehicle_s = time.perf_counter() - flight_wall0, clock() - vehicle0
         evaluation = evaluate(runner, scene if config.camera == "sim" else None)
@@ -224,6 +246,7 @@ def fly(
             clearance_m if clearance_m is None or math.isfinite(clearance_m) else None,
             clearance_building,
             flight_wall_s,
+            tuple(sorted(link.freshness.dropped_by_type.items())),
         )
         if recorder is not None:
             recorder.outcome(summary_record(summary))
@@ -254,6 +277,8 @@ def summary_record(s: FlightSummary) -> dict[str, object]:
     if s.clearance_m is not None:
         record["closest_clearance_m"] = round(s.clearance_m, 2)
         record["closest_building"] = s.clearance_building
+    if s.stale_dropped:  # only on lossy links: a lockstep flight's record stays as it was
+        record["stale_dropped"] = sum(n for _, n in s.stale_dropped)
     return record
 
 
@@ -330,6 +355,16 @@ def _abort(link: VehicleLink, recorder: MissionRecorder | None, why: str) -> Non
     if recorder is not None:
         recorder.note(Level.WARNING, why)
         recorder.outcome({"status": "interrupted", "reason": why})
+
+
+def _failed(recorder: MissionRecorder | None, exc: Exception) -> None:
+    """Say in the recording that the run stopped on an error, so it never passes for a
+    mission that ended (the file is kept: the flight did happen)."""
+    if recorder is not None:
+        with contextlib.suppress(RecordingError, ValueError):  # the recording may be what failed
+            recorder.outcome(
+                {"status": "failed", "reason": f"the run stopped with an error: {exc}"}
+            )
 
 
 def _route_length(route: list[tuple[int, tuple[float, float, float]]]) -> float:

@@ -51,5 +51,11 @@ def format_summary(s: FlightSummary) -> str:
         )
     if e.tunnel_kept is not None:
         lines.append(f"tunnel         {'kept' if e.tunnel_kept else 'LOST'} in the model")
+    if s.stale_dropped:
+        kinds = ", ".join(f"{n} {name}" for name, n in s.stale_dropped)
+        lines.append(
+            f"link           {sum(n for _, n in s.stale_dropped)} stale messages dropped "
+            f"(older than one already received: {kinds})"
+        )
     lines.append(f"recording      {s.recording if s.recording else '(not recorded)'}")
     return "\n".join(lines)

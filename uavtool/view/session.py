@@ -14,6 +14,7 @@ from urllib.parse import quote
 
 import rerun as rr
 
+from uavtool.recording.files import atomic_output
 from uavtool.view.blueprint import default_blueprint
 from uavtool.view.errors import ViewError
 from uavtool.view.logger import LogCounts, MissionLogger
@@ -105,7 +106,24 @@ def view(
     """Show the recording at ``path`` (and ``compare`` beside it) in Rerun; see
     `open_viewer` for the sinks. With ``save`` the file is complete on return; with ``web``
     the caller keeps the process alive while the returned `Viewer` serves, then closes it.
-    Raises `NotMcapError` / `ViewError` for a file that is not a mission recording."""
+    Raises `NotMcapError` / `ViewError` for a file that is not a mission recording, and
+    `SameFileError` if ``save`` is one of the recordings. ``save`` appears only once it is
+    complete: nothing is left behind when the view fails."""
+    if save is not None:
+        with atomic_output(save, inputs=[path, compare]) as tmp:
+            return _view(path, save=tmp, web=False, compare=compare)
+    return _view(path, save=None, web=web, compare=compare, web_port=web_port, grpc_port=grpc_port)
+
+
+def _view(
+    path: str | Path,
+    *,
+    save: Path | None,
+    web: bool,
+    compare: str | Path | None,
+    web_port: int | None = None,
+    grpc_port: int | None = None,
+) -> ViewResult:
     viewer = open_viewer(
         save=save,
         web=web,

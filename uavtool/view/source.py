@@ -35,6 +35,7 @@ def log_recording(path: str | Path, logger: MissionLogger) -> None:
         present = set(reader.topics())
         if OBSERVATIONS not in present:
             raise ViewError(f"{path}: no {OBSERVATIONS} topic: not a mission recording")
+        reader.require_metadata(("scene", "mission"))  # else the view would lack them quietly
         metadata = dict(reader.metadata)
         _setup(path, reader, metadata, logger)
         wanted = [t for t in (OBSERVATIONS, OUTPUTS, IMAGE, EVENTS, STATUSTEXT) if t in present]

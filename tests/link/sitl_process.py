@@ -1,0 +1,41 @@
+"""``uavtool sitl`` as a separate process on a loopback UDP port, as a user would run it."""
+
+from __future__ import annotations
+
+import os
+import socket
+import subprocess
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+
+def free_udp_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.bind(("127.0.0.1", 0))
+        port: int = sock.getsockname()[1]
+        return port
+
+
+@contextmanager
+def sitl_udpin(*, speedup: float, scene: str = "paper") -> Iterator[int]:
+    """A vehicle listening on ``udpin:127.0.0.1:PORT`` (yields the port), stopped on exit."""
+    port = free_udp_port()
+    endpoint = f"udpin:127.0.0.1:{port}"
+    command = ["uavtool", "sitl", "--speedup", str(speedup), "--scene", scene]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", *command, "--endpoint", endpoint],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
+    try:
+        assert proc.stdout is not None
+        banner = proc.stdout.readline() + proc.stdout.readline()
+        assert endpoint in banner, banner  # bound and serving
+        yield port
+    finally:
+        proc.terminate()
+        out, _ = proc.communicate(timeout=10)
+        assert "Traceback" not in out, out

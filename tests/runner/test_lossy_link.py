@@ -1,0 +1,52 @@
+"""``uavtool fly`` over a lossy, reordering UDP link to a ``uavtool sitl`` process: the mission
+completes and the route matches the clean flight's, because late telemetry is dropped before
+the mission sees it (it would otherwise see the vehicle jump back in time)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from tests.link.proxy import Impairment, LossyProxy
+from tests.link.sitl_process import sitl_udpin
+from uavtool.mission import Status
+from uavtool.recording import summarize
+from uavtool.runner.fly import FlyConfig, fly
+from uavtool.runner.summary import format_summary
+
+SPEEDUP = 10.0
+ROUTE_TOLERANCE = 0.05
+
+
+@pytest.fixture(scope="module")
+def clean_route_m() -> float:
+    """The same mission and vehicle without a network: the lockstep flight."""
+    summary = fly(FlyConfig(no_record=True))
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    return summary.route_length_m
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("loss", [0.05, 0.20])
+def test_mission_completes_over_a_lossy_reordering_link(
+    tmp_path: Path, clean_route_m: float, loss: float
+) -> None:
+    # 10 % of the datagrams that get through are held up to 200 ms of vehicle time, so later
+    # ones overtake them.
+    impairment = Impairment(loss=loss, delayed=0.10, max_delay_s=0.2)
+    rec = tmp_path / "lossy.mcap"
+    with (
+        sitl_udpin(speedup=SPEEDUP) as port,
+        LossyProxy(port, impairment, seed=19, time_scale=SPEEDUP) as proxy,
+    ):
+        summary = fly(FlyConfig(connect=f"udpout:127.0.0.1:{proxy.port}", record=rec))
+    assert proxy.lost > 0 and proxy.held > 0
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == "red"
+    assert summary.route_length_m == pytest.approx(clean_route_m, rel=ROUTE_TOLERANCE)
+    dropped = dict(summary.stale_dropped)
+    assert dropped.get("GLOBAL_POSITION_INT", 0) > 0  # reordering happened and was caught
+    assert "stale messages dropped" in format_summary(summary)
+    outcome = summarize(rec).outcome
+    assert outcome is not None and int(outcome["stale_dropped"]) == sum(dropped.values())
