@@ -60,18 +60,18 @@ def test_show_and_random_and_validate(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (("scene", "render", "paper", "--pos", "1,2", "-o", "x.png"), "--pos '1,2': expected 3"),
+        (("scene", "render", "paper", "--pos", "1,2", "-o", "x.png"), "--pos=1,2: expected E,N,U"),
         (
             ("scene", "render", "paper", "--pos", "0,0,45", "--size", "big", "-o", "x.png"),
             "--size 'big'",
         ),
         (
             ("scene", "render", "paper", "--pos", "0,0,45", "--fov", "0", "-o", "x.png"),
-            "horizontal FOV",
+            "--fov=0: expected a finite number in [1, 170]",
         ),
         (
             ("scene", "render", "paper", "--pos", "0,0,45", "--pitch", "120", "-o", "x.png"),
-            "--pitch 120",
+            "--pitch=120: expected a finite number in [-90, 90]",
         ),
         (("scene", "render", "paper", "--pos", "0,0,45", "-o", "x.jpg"), "output must be a .png"),
         (
@@ -80,7 +80,7 @@ def test_show_and_random_and_validate(tmp_path: Path) -> None:
         ),
         (
             ("scene", "random", "--seed", "1", "--buildings", "0", "-o", "x.yaml"),
-            "--buildings must be in",
+            "--buildings=0: expected an integer ≥ 1",
         ),
         (("scene", "validate", "BAD"), "BAD.yaml:3: buildings[0].color: expected [r, g, b]"),
     ],

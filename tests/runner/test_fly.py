@@ -87,7 +87,7 @@ def test_link_lost_for_good_ends_the_mission(tmp_path: Path) -> None:
         (["--connect", "bogus:1:2"], "connection 'bogus:1:2'"),
         (["--connect", "tcp:127.0.0.1:1", "--timeout", "0.5"], "cannot connect"),
         (["--set", "mission.nope=1"], "unknown parameter 'mission.nope'"),
-        (["--set", "mission.look_fill=abc"], "is not a valid float"),
+        (["--set", "mission.look_fill=abc"], "look_fill=abc: expected a finite number in (0, 1]"),
         (["--camera", "webcam"], "--camera 'webcam'"),
         (["--param", "WPNAV_SPEED"], "expected NAME=VALUE"),
     ],

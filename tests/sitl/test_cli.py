@@ -34,6 +34,20 @@ def test_help_has_an_example() -> None:
         (["--params", "/nonexistent.parm"], "/nonexistent.parm: cannot read"),
         (["--speedup", "0"], "speedup must be > 0"),
         (["--wind", "x,y"], "--wind 'x,y'"),
+        (["--wind", "1e300,0"], "speed must be 0..50 m/s"),
+        (["--wind", "5,nan"], "direction must be finite"),
+        (["--duration", "-1"], "--duration -1"),
+        (["--duration", "nan"], "--duration nan"),
+        (["--home", "0,0,1e308,0"], "altitude must be"),
+        (["--home", "0,0,0,inf"], "heading must be finite"),
+        (["--speedup", "1e-30"], "SIM_SPEEDUP: 1e-30 out of range"),
+        (["--speedup", "inf"], "SIM_SPEEDUP"),
+        (["--param", "SIM_GPS_NOISE=1e30"], "SIM_GPS_NOISE: 1e+30 out of range 0..100"),
+        (["--param", "LAND_SPEED=-32768"], "LAND_SPEED: -32768 out of range 30..200"),
+        (["--param", "SIM_BATT_VOLTAGE=-3.4e38"], "SIM_BATT_VOLTAGE"),
+        (["--param", "NOPE=1"], "unknown parameter 'NOPE'"),
+        (["--param", "RTL_ALT"], "expected NAME=VALUE"),
+        (["--link-outage", "5:inf"], "link outage 5:inf"),
     ],
 )
 def test_bad_options_exit_2_with_one_line(args: list[str], message: str) -> None:
@@ -41,6 +55,7 @@ def test_bad_options_exit_2_with_one_line(args: list[str], message: str) -> None
     assert result.exit_code == 2
     assert message in result.output
     assert "Traceback" not in result.output
+    assert len(result.output.strip().splitlines()) == 1
 
 
 def test_shell_session_with_mavutil() -> None:

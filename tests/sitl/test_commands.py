@@ -148,19 +148,6 @@ def test_reposition_honours_altitude_frame(client: Client, vehicle: Sitl, frame:
     client.wait_until(lambda c: dist_m(c) < 0.3, what="reach target")
 
 
-def test_reposition_outside_geofence_denied(client: Client, vehicle: Sitl) -> None:
-    client.takeoff(5)
-    home = vehicle.config.home
-    far = GeoPoint(home.lat_deg + 0.01, home.lon_deg, 0)  # ~1.1 km
-    ack = client.command_int(
-        M.MAV_CMD_DO_REPOSITION, M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT, far.lat_e7, far.lon_e7, 10
-    )
-    assert ack.result == M.MAV_RESULT_DENIED
-    assert "Fence" in client.wait_for("STATUSTEXT").text
-    ack = client.command(M.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, 500)
-    assert ack.result != ACCEPTED
-
-
 def test_get_home_position_and_request_message(client: Client, vehicle: Sitl) -> None:
     assert client.command(M.MAV_CMD_GET_HOME_POSITION).result == ACCEPTED
     home = client.wait_for("HOME_POSITION")

@@ -122,6 +122,7 @@ def test_param_file_loaded_at_start(tmp_path: Path) -> None:
     [
         ("RTL_ALT\n", "copter.parm:1: expected 'NAME VALUE'"),
         ("\nBOGUS 1\n", "copter.parm:2: unknown parameter 'BOGUS'"),
+        ("LAND_SPEED -32768\n", "copter.parm:1: LAND_SPEED: -32768 out of range 30..200"),
     ],
 )
 def test_bad_param_file_names_file_and_line(tmp_path: Path, text: str, message: str) -> None:

@@ -163,4 +163,4 @@ def test_bad_input_is_a_one_line_error(tmp_path: Path) -> None:
     result = CliRunner().invoke(cli, ["vision", "vectorize", str(bogus)])
     assert result.exit_code == 2
     assert result.output.strip().count("\n") == 0
-    assert "bogus.png: not an image" in result.output
+    assert "bogus.png: not a decodable image" in result.output

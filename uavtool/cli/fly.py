@@ -7,6 +7,10 @@ from pathlib import Path
 
 import click
 
+from uavtool.checks import NON_NEGATIVE, POSITIVE, Range, coerce
+from uavtool.cli.options import SEED, Number, Numbers
+from uavtool.errors import InputError
+
 EXIT_CODES: dict[str, int] = {
     "completed": 0,
     "aborted": 1,
@@ -17,6 +21,10 @@ EXIT_CODES: dict[str, int] = {
     "crashed": 5,
 }
 """``uavtool fly``'s exit code for each mission status (2 is bad input, as for every command)."""
+
+_SECONDS = Range(0.0, 86_400.0, lo_open=True)
+_WIND = Numbers(",", (("SPEED", Range(0.0, 50.0)), ("DIR", Range(-360.0, 360.0))), example="5,270")
+_OUTAGE = Numbers(":", (("START", NON_NEGATIVE), ("DURATION", POSITIVE)), example="60:10")
 
 
 @click.command()
@@ -70,15 +78,20 @@ EXIT_CODES: dict[str, int] = {
     metavar="KEY=VALUE",
     help="Set a mission parameter (e.g. mission.look_fill=0.6, vectorize.rdp_epsilon_px=2).",
 )
-@click.option("--seed", default=0, show_default=True, type=int, help="SITL wind/noise seed.")
+@click.option("--seed", default=0, show_default=True, type=SEED, help="SITL wind/noise seed.")
 @click.option("--noise", is_flag=True, help="Add seeded sensor noise to simulated photos.")
 @click.option(
-    "--wind", default=None, metavar="SPEED,DIR", help="Built-in SITL wind (m/s, from deg)."
+    "--wind",
+    default=None,
+    type=_WIND,
+    metavar="SPEED,DIR",
+    help="Built-in SITL wind (0-50 m/s, from deg).",
 )
 @click.option(
     "--link-outage",
     "outages",
     multiple=True,
+    type=_OUTAGE,
     metavar="START:DURATION",
     help="Fault injection (built-in SITL): cut the link for DURATION s at sim time START.",
 )
@@ -86,7 +99,7 @@ EXIT_CODES: dict[str, int] = {
     "--timeout",
     default=30.0,
     show_default=True,
-    type=float,
+    type=Number(_SECONDS),
     help="Seconds to wait for the vehicle to connect and report its home (vehicle seconds for "
     "the built-in one).",
 )
@@ -111,8 +124,8 @@ def fly(
     settings: tuple[str, ...],
     seed: int,
     noise: bool,
-    wind: str | None,
-    outages: tuple[str, ...],
+    wind: tuple[float, float] | None,
+    outages: tuple[tuple[float, float], ...],
     timeout: float,
     rerun_target: str | None,
     quiet: bool,
@@ -135,7 +148,6 @@ def fly(
     from uavtool.runner.fly import fly as fly_mission
     from uavtool.runner.params import parse_param
     from uavtool.runner.summary import format_progress, format_summary
-    from uavtool.sitl.config import parse_outage, parse_wind
 
     if record is not None and no_record:
         raise click.UsageError("--record and --no-record exclude each other")
@@ -143,7 +155,6 @@ def fly(
     if visit_all:
         overrides["mission.visit_all"] = "true"
     params = with_overrides(Params(), overrides)
-    wind_pair = parse_wind(wind) if wind is not None else (0.0, 0.0)
     config = FlyConfig(
         connect=connect,
         scene=scene,
@@ -156,8 +167,8 @@ def fly(
         vehicle_params=tuple(parse_param(p) for p in vehicle_params),
         seed=seed,
         noise=noise,
-        wind=wind_pair,
-        link_outages_s=tuple(parse_outage(o) for o in outages),
+        wind=wind if wind is not None else (0.0, 0.0),
+        link_outages_s=outages,
         connect_timeout_s=timeout,
         rerun=rerun_target,
     )
@@ -182,11 +193,7 @@ def _speedup(text: str | None, *, live: bool) -> float | None:
     if text.strip().lower() == "max":
         return None
     try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not value > 0 or value == float("inf"):
-        raise click.BadParameter(
-            f"{text!r}: expected a positive number or 'max'", param_hint="--speedup"
-        )
-    return value
+        speedup: float = coerce(text, float, name="--speedup", bounds=POSITIVE)
+    except InputError:
+        raise InputError(f"--speedup={text}: expected a positive number or 'max'") from None
+    return speedup

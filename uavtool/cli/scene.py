@@ -7,21 +7,16 @@ from typing import TYPE_CHECKING
 
 import click
 
+from uavtool.checks import Range
+from uavtool.cli.options import SEED, Number, Numbers
 from uavtool.errors import InputError
 
 if TYPE_CHECKING:
     from uavtool.world.hard import HardSceneInfo
     from uavtool.world.scene import Scene
 
-
-def _floats(text: str, n: int, option: str, example: str) -> tuple[float, ...]:
-    try:
-        values = tuple(float(p) for p in text.split(","))
-    except ValueError:
-        values = ()
-    if len(values) != n:
-        raise InputError(f"{option} {text!r}: expected {n} comma-separated numbers, e.g. {example}")
-    return values
+_EXTENT = Range(-100_000.0, 100_000.0)  # a camera within 100 km of home
+_POS = Numbers(",", (("E", _EXTENT), ("N", _EXTENT), ("U", _EXTENT)), example="10,-30,3")
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -84,28 +79,43 @@ def validate(scene_ref: str) -> None:
 @scene.command()
 @click.argument("scene_ref", metavar="SCENE")
 @click.option(
-    "--pos", required=True, metavar="E,N,U", help="Camera position, metres east,north,up of home."
+    "--pos",
+    required=True,
+    type=_POS,
+    metavar="E,N,U",
+    help="Camera position, metres east,north,up of home.",
 )
 @click.option(
-    "--yaw", default=0.0, show_default=True, help="Camera heading, degrees clockwise from north."
+    "--yaw",
+    default=0.0,
+    show_default=True,
+    type=Number(Range(-360.0, 360.0)),
+    help="Camera heading, degrees clockwise from north.",
 )
 @click.option(
     "--pitch",
     default=-90.0,
     show_default=True,
+    type=Number(Range(-90.0, 90.0)),
     help="Gimbal pitch, degrees (-90 nadir, 0 forward).",
 )
 @click.option(
     "--size", default="640x480", show_default=True, metavar="WxH", help="Image size in pixels."
 )
-@click.option("--fov", default=60.0, show_default=True, help="Horizontal field of view, degrees.")
-@click.option("--noise-seed", default=None, type=int, help="Add seeded sensor noise.")
+@click.option(
+    "--fov",
+    default=60.0,
+    show_default=True,
+    type=Number(Range(1.0, 170.0)),
+    help="Horizontal field of view, degrees.",
+)
+@click.option("--noise-seed", default=None, type=SEED, help="Add seeded sensor noise.")
 @click.option(
     "-o", "--output", required=True, type=click.Path(path_type=Path), help="PNG file to write."
 )
 def render(
     scene_ref: str,
-    pos: str,
+    pos: tuple[float, float, float],
     yaw: float,
     pitch: float,
     size: str,
@@ -125,15 +135,12 @@ def render(
     from uavtool.world import render as render_frame
     from uavtool.world.images import write_png
 
-    e, n, u = _floats(pos, 3, "--pos", "10,-30,3")
-    if not -90.0 <= pitch <= 90.0:
-        raise InputError(f"--pitch {pitch}: must be in [-90, 90] degrees")
     width, height = _size(size)
     intrinsics = Intrinsics.from_hfov(width_px=width, height_px=height, hfov_deg=fov)
     s = load_scene(scene_ref)
     write_png(
         output,
-        render_frame(s, CameraPose((e, n, u), yaw, pitch), intrinsics, noise_seed=noise_seed),
+        render_frame(s, CameraPose(pos, yaw, pitch), intrinsics, noise_seed=noise_seed),
     )
 
 
@@ -161,16 +168,20 @@ def show(scene_ref: str, size: str, output: Path) -> None:
 
 @scene.command("random")
 @click.option(
-    "--seed", required=True, type=int, help="Random seed; the same seed gives the same file."
+    "--seed", required=True, type=SEED, help="Random seed; the same seed gives the same file."
 )
 @click.option(
     "--buildings",
     default=None,
-    type=int,
+    type=Number(Range(1), integer=True),
     help="Number of buildings.  [default: 8; with --hard 5-8, drawn from the seed]",
 )
 @click.option(
-    "--margin", default=4.0, show_default=True, help="Minimum gap between buildings, metres."
+    "--margin",
+    default=4.0,
+    show_default=True,
+    type=Number(),
+    help="Minimum gap between buildings, metres.",
 )
 @click.option(
     "--hard",
@@ -181,7 +192,7 @@ def show(scene_ref: str, size: str, output: Path) -> None:
 @click.option(
     "--spread",
     default=None,
-    type=float,
+    type=Number(),
     help="With --hard: half-side of the square around home the buildings stand in, "
     "metres.  [default: 35]",
 )

@@ -53,6 +53,13 @@ def _interrupt(_signum: int, _frame: object) -> None:
     help="Parameter file (NAME VALUE per line, as MAVProxy saves).",
 )
 @click.option(
+    "--param",
+    "param_texts",
+    multiple=True,
+    metavar="NAME=VALUE",
+    help="Set a vehicle parameter at start (repeatable; after --params), e.g. RTL_ALT=3000.",
+)
+@click.option(
     "--duration", default=None, type=float, help="Stop after this many simulated seconds."
 )
 @click.option(
@@ -73,6 +80,7 @@ def sitl(
     seed: int,
     signing_key: str | None,
     params_file: Path | None,
+    param_texts: tuple[str, ...],
     duration: float | None,
     outages: tuple[str, ...],
 ) -> None:
@@ -86,7 +94,13 @@ def sitl(
       mavproxy.py --master tcp:127.0.0.1:5760
     """
     from uavtool.sitl import Sitl, SitlConfig, parse_home, parse_signing_key
-    from uavtool.sitl.config import DEFAULT_ENDPOINTS, parse_outage, parse_wind
+    from uavtool.sitl.config import (
+        DEFAULT_ENDPOINTS,
+        parse_duration,
+        parse_outage,
+        parse_param,
+        parse_wind,
+    )
     from uavtool.sitl.params import load_param_file
 
     kwargs: dict[str, object] = {}
@@ -109,8 +123,10 @@ def sitl(
         kwargs["wind_speed_ms"], kwargs["wind_dir_deg"] = parse_wind(wind)
     if signing_key is not None:
         kwargs["signing_key"] = parse_signing_key(signing_key)
-    if params_file is not None:
-        kwargs["params"] = tuple(load_param_file(params_file).items())
+    duration = parse_duration(duration)
+    params = load_param_file(params_file) if params_file is not None else {}
+    params.update(parse_param(text) for text in param_texts)
+    kwargs["params"] = tuple(params.items())
     config = SitlConfig(
         endpoints=endpoints or DEFAULT_ENDPOINTS,
         speedup=speedup,

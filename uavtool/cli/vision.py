@@ -6,9 +6,10 @@ from pathlib import Path
 
 import click
 
+from uavtool.cli.options import Number
 from uavtool.errors import FailureError
 
-_IMAGE = click.Path(exists=True, dir_okay=False, path_type=Path)
+_IMAGE = click.Path(path_type=Path)  # read (and checked) by uavtool.images
 _OUT = click.Path(dir_okay=False, writable=True, path_type=Path)
 
 
@@ -26,9 +27,17 @@ def vision() -> None:
 @click.argument("frame", type=_IMAGE)
 @click.option("-o", "--out", type=_OUT, help="Write the shapes as JSON here.")
 @click.option("--overlay", type=_OUT, help="Write the frame with the vectors drawn over it (PNG).")
-@click.option("--epsilon", type=float, default=None, help="RDP tolerance in pixels (default 1.5).")
 @click.option(
-    "--spacing", type=float, default=None, help="Border point spacing in pixels (default 2)."
+    "--epsilon",
+    type=Number(),
+    default=None,
+    help="RDP tolerance in pixels (default 1.5).",
+)
+@click.option(
+    "--spacing",
+    type=Number(),
+    default=None,
+    help="Border point spacing in pixels (default 2).",
 )
 def vectorize_cmd(
     frame: Path,
@@ -73,7 +82,12 @@ def vectorize_cmd(
 @vision.command("match")
 @click.argument("target", type=_IMAGE)
 @click.argument("frame", type=_IMAGE)
-@click.option("--threshold", type=float, default=None, help="Match score threshold (default 0.8).")
+@click.option(
+    "--threshold",
+    type=Number(),
+    default=None,
+    help="Match score threshold (default 0.8).",
+)
 @click.option("--allow-mirror", is_flag=True, help="Let a mirror image of the target match.")
 def match_cmd(target: Path, frame: Path, threshold: float | None, allow_mirror: bool) -> None:
     """Score every shape of FRAME against the target bitmap TARGET (a picture from above).
@@ -116,7 +130,7 @@ def match_cmd(target: Path, frame: Path, threshold: float | None, allow_mirror: 
 @click.argument("right", type=_IMAGE)
 @click.option(
     "--poses",
-    type=click.Path(exists=True, dir_okay=False, path_type=Path),
+    type=click.Path(dir_okay=False, path_type=Path),
     required=True,
     help="JSON file with each photo's camera pose and intrinsics (see below).",
 )

@@ -10,14 +10,33 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import json
-import typing
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from types import MappingProxyType
+from typing import Any, ClassVar
 
+from uavtool.checks import (
+    DN,
+    FRACTION,
+    NON_NEGATIVE,
+    POSITIVE,
+    Range,
+    check_fields,
+    coerce,
+    field_hint,
+)
 from uavtool.errors import InputError
 from uavtool.nav import ViewpointParams
 from uavtool.vision import ModelParams, RecognizeParams, VectorizeParams
+
+# Ranges shared by several fields; the upper bounds keep every value sendable as MAVLink's
+# float32 and far beyond any sensible flight.
+_LENGTH_M = Range(0.0, 10_000.0, lo_open=True)
+_GAP_M = Range(0.0, 10_000.0)
+_FILL = Range(0.0, 1.0, lo_open=True)
+_SPEED_M_S = Range(0.0, 100.0, lo_open=True)
+_WAIT_S = Range(0.0, 86_400.0)
+_TIMEOUT_S = Range(0.0, 86_400.0, lo_open=True)
 
 
 @dataclass(frozen=True, slots=True)
@@ -108,30 +127,48 @@ class MissionParams:
     land_timeout_s: float = 300.0
     """Time allowed for the return and landing before the mission stops watching."""
 
+    RANGES: ClassVar[Mapping[str, Range]] = MappingProxyType(
+        {
+            "overview_alt_m": _LENGTH_M,
+            "overview_climb_m": _LENGTH_M,
+            "search_radius_m": _LENGTH_M,
+            "assumed_roof_m": _GAP_M,
+            "roof_match_px": POSITIVE,
+            "look_fill": _FILL,
+            "top_fill": _FILL,
+            "min_above_roof_m": _LENGTH_M,
+            "diagonal_open_beneath": NON_NEGATIVE,
+            "roof_gap_px": NON_NEGATIVE,
+            "roof_colour_tolerance_dn": DN,
+            "match_hue_tolerance_deg": Range(0.0, 180.0),
+            "min_poi_area_px": NON_NEGATIVE,
+            "max_looks": Range(1, 100),
+            "recheck_min_score": FRACTION,
+            "recheck_offcentre": NON_NEGATIVE,
+            "recheck_climb_m": _GAP_M,
+            "arrive_radius_m": _LENGTH_M,
+            "arrive_speed_m_s": _SPEED_M_S,
+            "heading_tolerance_deg": Range(0.0, 180.0, lo_open=True),
+            "gimbal_tolerance_deg": Range(0.0, 90.0, lo_open=True),
+            "cruise_speed_m_s": _SPEED_M_S,
+            "climb_speed_m_s": _SPEED_M_S,
+            "move_slack_s": _WAIT_S,
+            "retry_wait_s": _WAIT_S,
+            "arm_wait_s": _WAIT_S,
+            "command_retries": Range(0, 100),
+            "link_lost_abort_s": _TIMEOUT_S,
+            "land_timeout_s": _TIMEOUT_S,
+        }
+    )
+    """Allowed values of each field (floats must also be finite)."""
+
     def __post_init__(self) -> None:
-        for name in (
-            "overview_alt_m",
-            "overview_climb_m",
-            "arrive_radius_m",
-            "cruise_speed_m_s",
-            "roof_match_px",
-            "min_above_roof_m",
-            "search_radius_m",
-        ):
-            if not getattr(self, name) > 0:
-                raise InputError(f"mission.{name} must be positive, got {getattr(self, name)}")
-        for name in ("look_fill", "top_fill"):
-            if not 0.0 < getattr(self, name) <= 1.0:
-                raise InputError(f"mission.{name} must be in (0, 1], got {getattr(self, name)}")
-        if not 0.0 <= self.assumed_roof_m < self.overview_alt_m:
+        check_fields(self, self.RANGES, group="mission")
+        if not self.assumed_roof_m < self.overview_alt_m:
             raise InputError(
-                "mission.assumed_roof_m must be ≥ 0 and below mission.overview_alt_m, "
+                "mission.assumed_roof_m must be below mission.overview_alt_m, "
                 f"got {self.assumed_roof_m}"
             )
-        if self.max_looks < 1:
-            raise InputError(f"mission.max_looks must be ≥ 1, got {self.max_looks}")
-        if self.command_retries < 0:
-            raise InputError(f"mission.command_retries must be ≥ 0, got {self.command_retries}")
 
 
 @dataclass(frozen=True, slots=True)
@@ -158,6 +195,8 @@ def to_dict(params: Params) -> dict[str, Any]:
 
 def from_dict(data: dict[str, Any], *, source: str = "parameters") -> Params:
     """The inverse of :func:`to_dict`; unknown keys are errors listing the valid ones."""
+    if not isinstance(data, dict):
+        raise InputError(f"{source}: expected a mapping of parameter groups")
     return _apply(Params(), _flatten(data), source=source)
 
 
@@ -218,9 +257,13 @@ def _apply(params: Params, pairs: dict[str, Any], *, source: str) -> Params:
         if key not in known:
             raise InputError(f"{source}: unknown parameter {key!r}; {_suggest(key, known)}")
         group, name = key.split(".", 1)
-        sub = getattr(params, group)
-        hint = typing.get_type_hints(type(sub))[name]
-        grouped.setdefault(group, {})[name] = _convert(raw, hint, key, source)
+        cls = type(getattr(params, group))
+        ranges: Mapping[str, Range] = getattr(cls, "RANGES", {})
+        try:
+            value = coerce(raw, field_hint(cls, name), name=key, bounds=ranges.get(name, Range()))
+        except InputError as exc:
+            raise InputError(f"{source}: {exc}") from None
+        grouped.setdefault(group, {})[name] = value
     changed: dict[str, Any] = {}
     for group, values in grouped.items():
         try:
@@ -228,30 +271,3 @@ def _apply(params: Params, pairs: dict[str, Any], *, source: str) -> Params:
         except InputError as exc:
             raise InputError(f"{source}: {exc}") from None
     return dataclasses.replace(params, **changed)
-
-
-def _convert(raw: Any, hint: Any, key: str, source: str) -> Any:
-    if not isinstance(raw, str):  # from a parsed file: JSON types, lists for tuples
-        return _to_tuples(raw)
-    try:
-        if hint is bool:
-            if raw.lower() not in ("true", "false", "1", "0", "yes", "no"):
-                raise ValueError(raw)
-            return raw.lower() in ("true", "1", "yes")
-        if hint is int:
-            return int(raw)
-        if hint is float:
-            return float(raw)
-        return _to_tuples(json.loads(raw))
-    except ValueError:
-        raise InputError(f"{source}: {key}={raw!r} is not a valid {_name(hint)}") from None
-
-
-def _to_tuples(value: Any) -> Any:
-    if isinstance(value, list):
-        return tuple(_to_tuples(v) for v in value)
-    return value
-
-
-def _name(hint: Any) -> str:
-    return getattr(hint, "__name__", str(hint))

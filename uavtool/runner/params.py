@@ -3,26 +3,38 @@ parameter protocol: PARAM_SET, confirmed by the PARAM_VALUE echo."""
 
 from __future__ import annotations
 
+import struct
+
+from uavtool.checks import Range, coerce
 from uavtool.errors import ParamError
 from uavtool.link import VehicleLink
 from uavtool.mavlink.dialect import mavlink as M
 
 _TRIES = 3
 _WAIT_S = 1.0
+_NAME_LEN = 16  # PARAM_SET.param_id
+_FLOAT32 = Range(-3.4028234663852886e38, 3.4028234663852886e38)
 
 
 def parse_param(text: str) -> tuple[str, float]:
+    """``NAME=VALUE`` → (NAME upper-cased, VALUE); the value must fit PARAM_SET's float32.
+
+    Whether the value is in the parameter's range is the vehicle's call (see
+    :func:`set_vehicle_params`).
+    """
     name, sep, value = text.partition("=")
-    if not sep or not name.strip():
+    name = name.strip().upper()
+    if not sep or not name:
         raise ParamError(f"--param {text!r}: expected NAME=VALUE, e.g. WPNAV_SPEED=800")
-    try:
-        return name.strip().upper(), float(value)
-    except ValueError:
-        raise ParamError(f"--param {text!r}: {value!r} is not a number") from None
+    if len(name) > _NAME_LEN or not name.isascii():
+        raise ParamError(f"--param {name!r}: a parameter name is at most 16 ASCII characters")
+    number: float = coerce(value, float, name=f"--param {name}", bounds=_FLOAT32, error=ParamError)
+    return name, number
 
 
 def set_vehicle_params(link: VehicleLink, params: tuple[tuple[str, float], ...]) -> None:
-    """Set each parameter and wait for the vehicle to echo it; ParamError if it never does."""
+    """Set each parameter and wait for the vehicle to echo it; ParamError if it never does,
+    or if it echoes another value (it refused this one and kept its own)."""
     for name, value in params:
         for _ in range(_TRIES):
             link.send(
@@ -48,3 +60,12 @@ def set_vehicle_params(link: VehicleLink, params: tuple[tuple[str, float], ...])
             break
         else:
             raise ParamError(f"--param {name}: the vehicle did not confirm it (unknown parameter?)")
+        kept = float(echoed[-1].param_value)
+        if kept != _as_float32(value):
+            raise ParamError(f"--param {name}={value:g}: the vehicle refused it and kept {kept:g}")
+
+
+def _as_float32(value: float) -> float:
+    """``value`` as PARAM_SET carries it."""
+    (out,) = struct.unpack("<f", struct.pack("<f", value))
+    return float(out)

@@ -198,7 +198,8 @@ class AutoMission:
         if cmd == mavlink.MAV_CMD_DO_CHANGE_SPEED:
             ap.change_speed(int(item.param1), item.param2)
         elif cmd == mavlink.MAV_CMD_CONDITION_YAW:
-            ap.condition_yaw(item.param1, item.param2, int(item.param3), bool(item.param4))
+            direction = -1 if item.param3 < 0 else 1
+            ap.condition_yaw(item.param1, item.param2, direction, bool(item.param4))
         elif cmd == mavlink.MAV_CMD_DO_MOUNT_CONTROL:
             ap.set_gimbal(pitch_deg=item.param1, yaw_deg=item.param3)
         elif cmd == mavlink.MAV_CMD_DO_GIMBAL_MANAGER_PITCHYAW:

@@ -15,7 +15,9 @@ from collections.abc import Sequence
 from uavtool.geo import GeoPoint, enu_from_geo, geo_from_enu, wrap_180
 from uavtool.mavlink.dialect import mavlink
 from uavtool.sitl.auto import AutoMission
+from uavtool.sitl.battery import Battery
 from uavtool.sitl.crash import Collisions
+from uavtool.sitl.fence import Fence
 from uavtool.sitl.obstacles import Prism
 from uavtool.sitl.params import ParamStore
 from uavtool.sitl.physics import Multicopter, State, Target
@@ -70,8 +72,9 @@ class Autopilot:
         self._rtl_alt = 0.0
         self.land_ne = (0.0, 0.0)
         self._velocity_deadline_ns = 0
-        self.battery_used_mah = 0.0
+        self.battery = Battery(params)
         self.collisions = Collisions(obstacles, body_radius_m)
+        self.fence = Fence(params)
         self.apply_params()
 
     # ------------------------------------------------------------------ params
@@ -129,7 +132,7 @@ class Autopilot:
         if not force and self.params["ARMING_CHECK"] != 0:
             if self.mode not in ARMABLE_MODES:
                 return failed(f"Arm: Mode not armable ({self.mode.name})")
-            if self.battery_voltage() < self.params["BATT_LOW_VOLT"]:
+            if self.battery.voltage() < self.params["BATT_LOW_VOLT"]:
                 return failed("PreArm: Battery below minimum arming voltage")
         self.armed = True
         self.vehicle.motors_on = True
@@ -198,7 +201,7 @@ class Autopilot:
             return failed("Takeoff: already flying")
         if not 0.0 < alt_m < math.inf:
             return denied(f"Takeoff: altitude must be above 0 m, got {alt_m:g}")
-        fence = self.fence_check((self.state.pos_ned_m[0], self.state.pos_ned_m[1], -alt_m))
+        fence = self.fence.check_target((self.state.pos_ned_m[0], self.state.pos_ned_m[1], -alt_m))
         if fence is not None:
             return fence
         blocked = self.collisions.takeoff_obstacle(self.state.pos_ned_m, alt_m)
@@ -211,17 +214,6 @@ class Autopilot:
         n, e, _ = self.state.pos_ned_m
         self.taking_off = True
         self.vehicle.set_target(Target(pos_ned_m=(n, e, -alt_m)))
-
-    def fence_check(self, pos_ned_m: tuple[float, float, float]) -> Result | None:
-        """DENIED if ``pos_ned_m`` lies outside the geofence (when FENCE_ENABLE)."""
-        if not self.params["FENCE_ENABLE"]:
-            return None
-        alt = -pos_ned_m[2]
-        if alt > self.params["FENCE_ALT_MAX"]:
-            return denied(f"Fence: altitude {alt:.0f} m above FENCE_ALT_MAX")
-        if math.hypot(pos_ned_m[0], pos_ned_m[1]) > self.params["FENCE_RADIUS"]:
-            return denied("Fence: target outside FENCE_RADIUS")
-        return None
 
     def guided_position(
         self,
@@ -238,7 +230,9 @@ class Autopilot:
             return failed("Guided: vehicle is not flying")
         if not all(math.isfinite(v) for v in pos_ned_m):
             return denied("Guided: target position is not finite")
-        fence = self.fence_check(pos_ned_m)
+        if pos_ned_m[2] > 0.0:
+            return denied(f"Guided: target {-pos_ned_m[2]:.0f} m is below ground")
+        fence = self.fence.check_target(pos_ned_m)
         if fence is not None:
             return fence
         yaw = yaw_deg if yaw_deg is not None else self.vehicle.target.yaw_deg
@@ -344,7 +338,8 @@ class Autopilot:
             if reason is not None:
                 self.crash(reason)
         self._update_gimbal(dt_s)
-        self._update_battery(dt_s)
+        self.battery.drain(self.battery_current_a(), dt_s)
+        self._check_fence()
         self._check_failsafes()
         self._check_landed()
 
@@ -395,6 +390,9 @@ class Autopilot:
             self.vehicle.limits.speed_xy_ms = speed
         if self._rtl_stage == "climb":
             alt = max(-d, rtl_alt)
+            safe_alt = self.fence.safe_alt_max_m()
+            if safe_alt is not None:  # return under the fence, descending first if above it
+                alt = min(alt, safe_alt)
             self._rtl_alt = alt
             if self.vehicle.target.pos_ned_m != (n, e, -alt):
                 self.vehicle.set_target(Target(pos_ned_m=(n, e, -alt)))
@@ -422,28 +420,8 @@ class Autopilot:
             target_yaw = wrap_180(g.target_yaw_deg - self.state.yaw_deg)
         g.yaw_deg += max(-step, min(step, wrap_180(target_yaw - g.yaw_deg)))
 
-    def battery_voltage(self) -> float:
-        full = self.params["SIM_BATT_VOLTAGE"]
-        capacity = max(self.params["BATT_CAPACITY"], 1.0)
-        remaining = max(0.0, 1.0 - self.battery_used_mah / capacity)
-        return full * (0.786 + 0.214 * remaining)  # 4S: 16.8 V full … 13.2 V empty
-
     def battery_current_a(self) -> float:
-        if not self.armed:
-            return 0.3
-        s = self.vehicle.state
-        return (
-            12.0
-            + 3.0 * math.hypot(s.accel_ned_mss[0], s.accel_ned_mss[1])
-            + 4.0 * max(0.0, -s.vel_ned_ms[2])
-        )
-
-    def battery_remaining_pct(self) -> int:
-        capacity = max(self.params["BATT_CAPACITY"], 1.0)
-        return max(0, min(100, round(100.0 * (1.0 - self.battery_used_mah / capacity))))
-
-    def _update_battery(self, dt_s: float) -> None:
-        self.battery_used_mah += self.battery_current_a() * dt_s * 1000.0 / 3600.0
+        return Battery.current_a(armed=self.armed, state=self.vehicle.state)
 
     def _check_failsafes(self) -> None:
         p = self.params
@@ -460,12 +438,25 @@ class Autopilot:
             self._failsafe_action(
                 Mode.LAND if action in (4, 5) else Mode.RTL, keep_auto=action == 2
             )
-        if self.armed and not self.failsafe_battery and self.battery_voltage() < p["BATT_LOW_VOLT"]:
+        if self.armed and not self.failsafe_battery and self.battery.voltage() < p["BATT_LOW_VOLT"]:
             self.failsafe_battery = True
             self.say(mavlink.MAV_SEVERITY_CRITICAL, "Battery 1 is low")
             act = int(p["BATT_FS_LOW_ACT"])
             if act:
-                self._failsafe_action(Mode.LAND if act == 1 else Mode.RTL, keep_auto=False)
+                mode = Mode.LAND if act in (1, 4) else Mode.RTL  # 3, 4: SmartRTL → RTL, LAND
+                self._failsafe_action(mode, keep_auto=False)
+
+    def _check_fence(self) -> None:
+        breach = self.fence.check(self.state.pos_ned_m)
+        if breach is None or not self.armed:
+            return
+        self.say(mavlink.MAV_SEVERITY_NOTICE, breach.text)
+        if breach.mode is None:
+            return
+        if self.on_ground and not self.taking_off:
+            self.disarm(force=True, reason="Fence: disarming on the ground")
+        else:
+            self.set_mode(breach.mode)
 
     def _failsafe_action(self, mode: Mode, *, keep_auto: bool) -> None:
         if self.on_ground:

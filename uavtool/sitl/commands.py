@@ -13,6 +13,14 @@ from typing import TYPE_CHECKING
 
 from uavtool.geo import GeoPoint
 from uavtool.mavlink.dialect import mavlink as M
+from uavtool.sitl.args import (
+    MSG_ID_MAX,
+    UINT8_MAX,
+    UINT16_MAX,
+    UINT32_MAX,
+    lat_lon_ok,
+    whole,
+)
 from uavtool.sitl.autopilot import FORCE_MAGIC
 from uavtool.sitl.state import (
     ACCEPTED,
@@ -51,7 +59,7 @@ Handler = Callable[["GcsSession", CommandArgs], Result]
 
 
 def _arm_disarm(session: GcsSession, cmd: CommandArgs) -> Result:
-    force = round(cmd.p(2)) == FORCE_MAGIC
+    force = cmd.p(2) == FORCE_MAGIC
     if cmd.p(1) == 1.0:
         return session.ap.arm(force=force)
     if cmd.p(1) == 0.0:
@@ -74,17 +82,29 @@ def _rtl(session: GcsSession, cmd: CommandArgs) -> Result:
 
 
 def _set_mode(session: GcsSession, cmd: CommandArgs) -> Result:
-    if not int(cmd.p(1)) & M.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED:
+    base_mode, custom_mode = whole(cmd.p(1), 0, UINT8_MAX), whole(cmd.p(2), 0, UINT32_MAX)
+    if base_mode is None or custom_mode is None:
+        return denied(f"Set mode: bad mode {cmd.p(1):g}, {cmd.p(2):g}")
+    if not base_mode & M.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED:
         return denied("Set mode: only custom (ArduCopter) modes are supported")
-    return session.set_mode_number(int(cmd.p(2)))
+    return session.set_mode_number(custom_mode)
 
 
 def _condition_yaw(session: GcsSession, cmd: CommandArgs) -> Result:
-    return session.ap.condition_yaw(cmd.p(1), cmd.p(2), int(cmd.p(3)), cmd.p(4) != 0.0)
+    # ArduCopter's checks: angle 0…360, param4 0 (absolute) or 1 (relative).
+    if not 0.0 <= cmd.p(1) <= 360.0:
+        return denied(f"Yaw: angle {cmd.p(1):g} not in 0-360")
+    if cmd.p(4) not in (0.0, 1.0):
+        return denied(f"Yaw: param4 {cmd.p(4):g} must be 0 (absolute) or 1")
+    direction = -1 if cmd.p(3) < 0 else 1  # NaN: clockwise
+    return session.ap.condition_yaw(cmd.p(1), cmd.p(2), direction, cmd.p(4) == 1.0)
 
 
 def _change_speed(session: GcsSession, cmd: CommandArgs) -> Result:
-    return session.ap.change_speed(int(cmd.p(1)), cmd.p(2))
+    speed_type = whole(cmd.p(1), 0, 3)
+    if speed_type is None:
+        return denied(f"Change speed: unknown speed type {cmd.p(1):g}")
+    return session.ap.change_speed(speed_type, cmd.p(2))
 
 
 def _reposition(session: GcsSession, cmd: CommandArgs) -> Result:
@@ -99,14 +119,19 @@ def _reposition(session: GcsSession, cmd: CommandArgs) -> Result:
         alt_rel = cmd.p(7) - ap.home.alt_amsl_m
     else:
         return denied(f"Reposition: unsupported frame {frame}")
-    if not (math.isfinite(lat) and math.isfinite(lon) and math.isfinite(alt_rel)):
-        return denied("Reposition: position must be finite")
+    if not (lat_lon_ok(lat, lon) and math.isfinite(alt_rel)):
+        return denied("Reposition: no such position")
+    flags = whole(cmd.p(2), 0, UINT32_MAX)
+    if flags is None:
+        return denied(f"Reposition: bad flags {cmd.p(2):g}")
     n, e, _ = ap.ned_of(GeoPoint(lat, lon, ap.home.alt_amsl_m))
     if cmd.p(1) > 0:
-        ap.change_speed(1, cmd.p(1))
+        speed = ap.change_speed(1, cmd.p(1))
+        if not speed.ok:
+            return speed
     # param4 (yaw) is ignored, as ArduCopter does: clients disagree on its unit (MAVSDK
     # sends radians, the spec says degrees); yaw is set with CONDITION_YAW or a target.
-    change_mode = bool(int(cmd.p(2)) & M.MAV_DO_REPOSITION_FLAGS_CHANGE_MODE)
+    change_mode = bool(flags & M.MAV_DO_REPOSITION_FLAGS_CHANGE_MODE)
     return ap.guided_position((n, e, -alt_rel), switch_mode=change_mode)
 
 
@@ -116,25 +141,32 @@ def _mount_control(session: GcsSession, cmd: CommandArgs) -> Result:
 
 
 def _gimbal_pitchyaw(session: GcsSession, cmd: CommandArgs) -> Result:
-    device = int(cmd.p(7))
-    if device not in (0, 1):
-        return denied(f"Gimbal: no gimbal device {device}")
-    flags = int(cmd.p(5)) if math.isfinite(cmd.p(5)) else 0
+    if cmd.p(7) not in (0.0, 1.0):
+        return denied(f"Gimbal: no gimbal device {cmd.p(7):g}")
+    flags = whole(cmd.p(5), 0, UINT32_MAX) or 0
     locked = bool(flags & M.GIMBAL_MANAGER_FLAGS_YAW_LOCK)
     return session.ap.set_gimbal(pitch_deg=cmd.p(1), yaw_deg=cmd.p(2), yaw_locked=locked)
 
 
 def _gimbal_configure(session: GcsSession, cmd: CommandArgs) -> Result:
-    sysid = int(cmd.p(1))
-    compid = int(cmd.p(2))
-    if sysid == -2:  # "the sender takes control"
+    # param1/2: the primary controller's sysid/compid: 0-255, -1 leave, -2 the sender, -3 none.
+    sysid, compid = whole(cmd.p(1), -3, UINT8_MAX), whole(cmd.p(2), -3, UINT8_MAX)
+    if sysid is None or compid is None:
+        return denied(f"Gimbal: bad controller {cmd.p(1):g}/{cmd.p(2):g}")
+    if sysid == -1:
+        return ACCEPTED
+    if sysid == -2:
         sysid, compid = cmd.source
-    session.ap.gimbal_owner = (max(sysid, 0), max(compid, 0))
+    elif sysid == -3:
+        sysid, compid = 0, 0
+    session.ap.gimbal_owner = (sysid, max(compid, 0))
     return ACCEPTED
 
 
 def _request_message(session: GcsSession, cmd: CommandArgs) -> Result:
-    msg_id = int(cmd.p(1))
+    msg_id = whole(cmd.p(1), 0, MSG_ID_MAX)
+    if msg_id is None:
+        return denied(f"Request message: no message id {cmd.p(1):g}")
     msg = session.telemetry.build(msg_id)
     if msg is None:
         return failed(f"Request message: message {msg_id} is not available")
@@ -148,7 +180,11 @@ def _request_autopilot_version(session: GcsSession, cmd: CommandArgs) -> Result:
 
 
 def _set_message_interval(session: GcsSession, cmd: CommandArgs) -> Result:
-    msg_id = int(cmd.p(1))
+    msg_id = whole(cmd.p(1), 0, UINT16_MAX)
+    if msg_id is None:
+        return denied(f"Set message interval: no message id {cmd.p(1):g}")
+    if not (math.isfinite(cmd.p(2)) and cmd.p(2) >= -1):
+        return denied(f"Set message interval: bad interval {cmd.p(2):g} us")
     if session.telemetry.builders.get(msg_id) is None:
         return failed(f"Set message interval: message {msg_id} is not streamed")
     session.streams.set_interval(msg_id, cmd.p(2), session.ap.now_ns)
@@ -156,7 +192,9 @@ def _set_message_interval(session: GcsSession, cmd: CommandArgs) -> Result:
 
 
 def _get_message_interval(session: GcsSession, cmd: CommandArgs) -> Result:
-    msg_id = int(cmd.p(1))
+    msg_id = whole(cmd.p(1), 0, UINT16_MAX)  # MESSAGE_INTERVAL carries it as a uint16
+    if msg_id is None:
+        return denied(f"Get message interval: no message id {cmd.p(1):g}")
     interval_ns = session.streams.interval_ns.get(msg_id)
     interval_us = -1 if interval_ns is None else interval_ns // 1000
     session.defer(M.MAVLink_message_interval_message(msg_id, interval_us))
@@ -172,7 +210,9 @@ def _mission_start(session: GcsSession, cmd: CommandArgs) -> Result:
     ap = session.ap
     if not ap.armed:
         return failed("Mission start: vehicle not armed")
-    first = int(cmd.p(1))
+    first = whole(cmd.p(1), 0, UINT16_MAX)
+    if first is None:
+        return denied(f"Mission start: no item {cmd.p(1):g}")
     if first > 0 and not ap.mission.set_current(first):
         return denied(f"Mission start: no item {first}")
     if ap.mode == Mode.AUTO:
@@ -182,9 +222,9 @@ def _mission_start(session: GcsSession, cmd: CommandArgs) -> Result:
 
 
 def _set_mission_current(session: GcsSession, cmd: CommandArgs) -> Result:
-    seq = int(cmd.p(1))
-    if not session.ap.mission.set_current(seq):
-        return denied(f"Set mission current: no item {seq}")
+    seq = whole(cmd.p(1), 0, UINT16_MAX)
+    if seq is None or not session.ap.mission.set_current(seq):
+        return denied(f"Set mission current: no item {cmd.p(1):g}")
     return ACCEPTED
 
 

@@ -5,13 +5,18 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from uavtool.errors import InputError
+from uavtool.errors import InputError, ParamError
 from uavtool.geo import GeoPoint
+from uavtool.sitl.args import lat_lon_ok
 from uavtool.sitl.obstacles import Prism
+from uavtool.sitl.params import check
 
 DEFAULT_ENDPOINTS = ("tcpin:127.0.0.1:5760", "udpout:127.0.0.1:14550")
 # ArduPilot SITL's default home: Canberra Model Aircraft Club field.
 DEFAULT_HOME = (-35.363261, 149.165230, 584.0, 353.0)
+WIND_RANGE_MS = (0.0, 50.0)  # SIM_WIND_SPD's range
+HOME_ALT_RANGE_M = (-1000.0, 10000.0)
+"""Home altitudes above mean sea level the vehicle accepts (the Dead Sea to above Everest)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -47,10 +52,18 @@ class SitlConfig:
 
     def __post_init__(self) -> None:
         for start_s, duration_s in self.link_outages_s:
-            if start_s < 0 or duration_s <= 0:
+            if not (0 <= start_s < math.inf and 0 < duration_s < math.inf):
                 raise InputError(
                     f"link outage {start_s:g}:{duration_s:g}: start must be ≥ 0, duration > 0"
                 )
+        home = self.home
+        if not lat_lon_ok(home.lat_deg, home.lon_deg):
+            raise InputError(f"home {home.lat_deg:g},{home.lon_deg:g}: no such position")
+        if not HOME_ALT_RANGE_M[0] <= home.alt_amsl_m <= HOME_ALT_RANGE_M[1]:
+            low, high = HOME_ALT_RANGE_M
+            raise InputError(f"home altitude {home.alt_amsl_m:g} m: not in {low:g}..{high:g} m")
+        if not math.isfinite(self.home_heading_deg):
+            raise InputError(f"home heading must be finite, got {self.home_heading_deg}")
         if not 1 <= self.sysid + self.instance <= 254:
             raise InputError(f"sysid {self.sysid} + instance {self.instance} must be in 1-254")
         if self.instance < 0:
@@ -59,8 +72,19 @@ class SitlConfig:
             raise InputError(f"speedup must be > 0, got {self.speedup}")
         if self.signing_key is not None and len(self.signing_key) != 32:
             raise InputError("signing key must be 32 bytes (64 hex digits)")
-        if self.wind_speed_ms < 0:
-            raise InputError(f"wind speed must be ≥ 0, got {self.wind_speed_ms}")
+        if not math.isfinite(self.wind_dir_deg):
+            raise InputError(f"wind direction must be finite, got {self.wind_dir_deg}")
+        # The vehicle's parameters, with ArduCopter's ranges (ParamError names the value).
+        for what, name, value in (
+            ("speedup", "SIM_SPEEDUP", self.speedup),
+            ("wind speed", "SIM_WIND_SPD", self.wind_speed_ms),
+        ):
+            try:
+                check(name, value)
+            except ParamError as exc:
+                raise ParamError(f"{what} {value:g}: {exc}") from None
+        for name, value in self.params:
+            check(name, value)
         if not 0.0 < self.body_radius_m < math.inf:
             raise InputError(f"body radius must be > 0 m, got {self.body_radius_m}")
 
@@ -74,8 +98,13 @@ def parse_home(text: str) -> tuple[GeoPoint, float]:
         lat, lon, alt, hdg = (float(p) for p in parts)
     except ValueError:
         raise InputError(f"--home {text!r}: all four values must be numbers") from None
-    if not (-90 <= lat <= 90 and -180 <= lon <= 180):
+    if not lat_lon_ok(lat, lon):
         raise InputError(f"--home {text!r}: latitude/longitude out of range")
+    if not HOME_ALT_RANGE_M[0] <= alt <= HOME_ALT_RANGE_M[1]:
+        low, high = HOME_ALT_RANGE_M
+        raise InputError(f"--home {text!r}: altitude must be {low:g}..{high:g} m")
+    if not math.isfinite(hdg):
+        raise InputError(f"--home {text!r}: heading must be finite")
     return GeoPoint(lat, lon, alt), hdg % 360.0
 
 
@@ -95,7 +124,36 @@ def parse_wind(text: str) -> tuple[float, float]:
         speed_ms, from_deg = (float(v) for v in text.split(","))
     except ValueError:
         raise InputError(f"--wind {text!r}: expected SPEED,DIR, e.g. 5,270") from None
-    return speed_ms, from_deg
+    low, high = WIND_RANGE_MS
+    if not low <= speed_ms <= high:
+        raise InputError(f"--wind {text!r}: speed must be {low:g}..{high:g} m/s")
+    if not math.isfinite(from_deg):
+        raise InputError(f"--wind {text!r}: direction must be finite")
+    return speed_ms, from_deg % 360.0
+
+
+def parse_param(text: str) -> tuple[str, float]:
+    """``NAME=VALUE`` → (name, value), checked against the parameter's range."""
+    name, sep, raw = text.partition("=")
+    if not sep or not name.strip():
+        raise ParamError(f"--param {text!r}: expected NAME=VALUE, e.g. WPNAV_SPEED=800")
+    try:
+        value = float(raw)
+    except ValueError:
+        raise ParamError(f"--param {text!r}: {raw!r} is not a number") from None
+    name = name.strip().upper()
+    try:
+        check(name, value)
+    except ParamError as exc:
+        raise ParamError(f"--param {text!r}: {exc}") from None
+    return name, value
+
+
+def parse_duration(seconds: float | None) -> float | None:
+    """``--duration``: None (run until stopped) or a finite number of seconds > 0."""
+    if seconds is not None and not 0 < seconds < math.inf:
+        raise InputError(f"--duration {seconds:g}: expected a number of seconds > 0")
+    return seconds
 
 
 def parse_outage(text: str) -> tuple[float, float]:

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 from uavtool.errors import ParamError
 from uavtool.geo import GeoPoint
 from uavtool.mavlink.dialect import mavlink as M
+from uavtool.sitl.args import lat_lon_ok
 from uavtool.sitl.commands import HANDLERS, CommandArgs
 from uavtool.sitl.mission_protocol import MissionProtocol
 from uavtool.sitl.state import (
@@ -25,6 +26,7 @@ from uavtool.sitl.state import (
     Mode,
     Result,
     denied,
+    failed,
 )
 from uavtool.sitl.telemetry import DATA_STREAMS, Streams
 
@@ -94,21 +96,20 @@ class GcsSession:
 
     def handle(self, frame: Frame) -> None:
         msg = frame.msg
+        signing = self.sitl.signing
         if (
-            self.sitl.signing_key is not None
-            and not frame.signed
+            signing is not None
+            and not signing.verify(frame.raw)
             and msg.get_msgId() not in _UNSIGNED_OK
         ):
             self.rejected_unsigned += 1
             return
+        self.link.heard_ns = self.ap.now_ns
         handler = self._handlers.get(msg.get_type())
         if handler is None or not self._addressed_to_us(msg):
             return
         self.last_source = (msg.get_srcSystem(), msg.get_srcComponent())
-        try:
-            handler(msg)
-        except (ValueError, OverflowError, TypeError) as exc:  # garbage values in a valid frame
-            log.debug("ignored %s from %s: %s", msg.get_type(), self.link.name, exc)
+        handler(msg)  # an exception is the server's to log, count and isolate
 
     def _addressed_to_us(self, msg: Any) -> bool:
         target = getattr(msg, "target_system", 0)
@@ -150,7 +151,11 @@ class GcsSession:
     def _run_command(self, cmd: CommandArgs) -> None:
         handler = HANDLERS.get(cmd.command)
         self._deferred = []
-        result = Result(M.MAV_RESULT_UNSUPPORTED) if handler is None else handler(self, cmd)
+        try:
+            result = Result(M.MAV_RESULT_UNSUPPORTED) if handler is None else handler(self, cmd)
+        except Exception:  # refuse this request; the vehicle and other links go on
+            self.sitl.fault(self.link, f"command {cmd.command}")
+            result, self._deferred = failed(f"Command {cmd.command}: internal error"), []
         sysid, compid = cmd.source
         self.send(M.MAVLink_command_ack_message(cmd.command, result.code, 0, 0, sysid, compid))
         if result.reason:
@@ -207,6 +212,8 @@ class GcsSession:
             self.sitl.set_param(name, msg.param_value)
         except ParamError as exc:
             self.statustext(M.MAV_SEVERITY_WARNING, str(exc))
+            if name in self.ap.params:  # as ArduPilot: answer with the value it kept
+                self.send(self._param_value(name))
             return
         self.sitl.broadcast(self._param_value(name))
 
@@ -242,7 +249,13 @@ class GcsSession:
         else:
             self.statustext(M.MAV_SEVERITY_WARNING, f"Guided: unsupported frame {frame}")
             return
-        n, e, _ = ap.ned_of(GeoPoint(msg.lat_int / 1e7, msg.lon_int / 1e7, ap.home.alt_amsl_m))
+        lat, lon = msg.lat_int / 1e7, msg.lon_int / 1e7
+        if not lat_lon_ok(lat, lon):
+            if not mask & _TM_POS:
+                self.statustext(M.MAV_SEVERITY_WARNING, "Guided: no such position")
+                return
+            lat, lon = ap.home.lat_deg, ap.home.lon_deg  # ignored: a velocity or yaw target
+        n, e, _ = ap.ned_of(GeoPoint(lat, lon, ap.home.alt_amsl_m))
         self._apply_target(mask, (n, e, -alt_rel), (msg.vx, msg.vy, msg.vz), msg.yaw)
 
     def _apply_target(

@@ -9,16 +9,27 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import logging
 import socket
+import struct
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 from uavtool.errors import LinkError
+from uavtool.mavlink.fields import misfit
 from uavtool.mavlink.framing import Frame, FrameParser, new_encoder
+
+log = logging.getLogger(__name__)
 
 _KINDS = ("tcpin", "udpin", "udpout", "tcp")
 _TCP_BACKLOG_LIMIT = 4 << 20  # bytes queued for a slow TCP client before we drop it
+MAX_UDP_PEERS = 16
+"""Peers one ``udpin`` endpoint serves at once; datagrams from more are dropped until one
+expires (ArduPilot has a fixed number of MAVLink channels; routers bound their tables)."""
+UDP_PEER_TIMEOUT_NS = 10_000_000_000
+"""A ``udpin`` peer heard from for this long (vehicle time) is forgotten, as MAVLink routers
+expire their UDP routes; ground stations send a HEARTBEAT every second."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -62,7 +73,11 @@ FrameTap = Callable[[str, "Link", bytes], None]  # (direction "in"/"out", link, 
 
 
 class Link:
-    """One MAVLink peer: parses what it sends us and packs what we send it."""
+    """One MAVLink peer: parses what it sends us and packs what we send it.
+
+    Frames are parsed without the signing key: the vehicle's
+    :class:`~uavtool.sitl.signing.SigningStreams` judges signatures for all its links at once.
+    """
 
     def __init__(
         self,
@@ -77,7 +92,7 @@ class Link:
     ) -> None:
         self.name = name
         self._send_bytes = send_bytes
-        self.parser = FrameParser(signing_key=signing_key)
+        self.parser = FrameParser()
         self.encoder = new_encoder(
             sysid=sysid, compid=compid, signing_key=signing_key, link_id=link_id
         )
@@ -85,12 +100,22 @@ class Link:
         self.closed = False
         self.session: Any = None  # the GcsSession serving this link
         self.frames_sent = 0
+        self.unsendable = 0  # messages refused because a value did not fit its field
+        self.faults = 0  # unexpected errors while serving this peer
+        self.heard_ns: int | None = None  # vehicle time of the last frame accepted from it
 
     def send(self, msg: Any) -> None:
-        """Pack ``msg`` with this link's sequence numbers and send it."""
+        """Pack ``msg`` with this link's sequence numbers and send it. A message with a value
+        its field cannot carry is not sent (logged and counted): one bad value must not take
+        the vehicle down."""
         if self.closed:
             return
-        buf = msg.pack(self.encoder)
+        try:
+            buf = msg.pack(self.encoder)
+        except (struct.error, OverflowError, ValueError, TypeError) as exc:
+            self.unsendable += 1
+            log.error("%s: %s not sent: %s", self.name, msg.get_type(), misfit(msg) or exc)
+            return
         self.encoder.seq = (self.encoder.seq + 1) & 0xFF
         self.frames_sent += 1
         if self.tap is not None:
@@ -216,6 +241,7 @@ class UdpSocket(_Socketed):
         self.endpoint = endpoint
         self._make_link = make_link
         self.links: dict[tuple[str, int], Link] = {}
+        self.peers_refused = 0  # datagrams dropped because MAX_UDP_PEERS were being served
         if endpoint.kind == "udpin":
             self.sock = _open(endpoint, socket.SOCK_DGRAM)
         else:
@@ -256,10 +282,26 @@ class UdpSocket(_Socketed):
                 addr = (self.endpoint.host, self.endpoint.port)
             link = self.links.get(addr)
             if link is None:
+                if len(self.links) >= MAX_UDP_PEERS:
+                    self.peers_refused += 1
+                    continue
                 link = self._make_link(f"udp:{addr[0]}:{addr[1]}", self._sender(addr))
                 self.links[addr] = link
             out.append((link, data))
         return out
+
+    def expire(self, now_ns: int) -> list[Link]:
+        """Forget ``udpin`` peers that are closed, sent nothing we accepted, or went silent
+        for ``UDP_PEER_TIMEOUT_NS``; return their links. The ``udpout`` peer is configured
+        and stays."""
+        if self.endpoint.kind != "udpin":
+            return []
+        gone = [
+            addr
+            for addr, link in self.links.items()
+            if link.closed or link.heard_ns is None or now_ns - link.heard_ns > UDP_PEER_TIMEOUT_NS
+        ]
+        return [self.links.pop(addr) for addr in gone]
 
 
 def _open(endpoint: Endpoint, kind: int) -> socket.socket:

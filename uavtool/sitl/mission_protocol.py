@@ -11,8 +11,9 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from uavtool.mavlink.dialect import mavlink as M
+from uavtool.sitl.args import UINT16_MAX, whole
 from uavtool.sitl.auto import NAV_COMMANDS, SUPPORTED_COMMANDS
-from uavtool.sitl.state import MissionItem
+from uavtool.sitl.state import AMSL_FRAMES, MissionItem
 
 if TYPE_CHECKING:
     from uavtool.sitl.gcs import GcsSession
@@ -25,6 +26,9 @@ _INT_FRAME = {
     M.MAV_FRAME_GLOBAL_RELATIVE_ALT: M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
 }
 _FLOAT_FRAME = {v: k for k, v in _INT_FRAME.items()}
+_AMSL = AMSL_FRAMES
+_ALTITUDE_COMMANDS = frozenset({M.MAV_CMD_NAV_WAYPOINT, M.MAV_CMD_NAV_TAKEOFF})
+_INT32_MAX = 2**31 - 1
 _FRAMES = frozenset(
     {
         M.MAV_FRAME_GLOBAL,
@@ -34,6 +38,13 @@ _FRAMES = frozenset(
         M.MAV_FRAME_MISSION,
     }
 )
+
+
+def _e7(value: float) -> int | None:
+    """A MISSION_ITEM float x/y as MISSION_ITEM_INT stores it (×1e7), None if it cannot be."""
+    if not math.isfinite(value) or abs(value) * 1e7 > _INT32_MAX:
+        return None
+    return round(value * 1e7)
 
 
 class MissionProtocol:
@@ -117,37 +128,34 @@ class MissionProtocol:
         if msg.seq > expected:
             self._request_next()
             return
-        x, y = (msg.x, msg.y) if is_int else (round(msg.x * 1e7), round(msg.y * 1e7))
+        x, y = (msg.x, msg.y) if is_int else (_e7(msg.x), _e7(msg.y))
         frame = msg.frame
         if not is_int:  # the float frames map to their _INT twins
             frame = _INT_FRAME.get(frame, frame)
-        if msg.seq > 0 and msg.command not in SUPPORTED_COMMANDS:
-            self._ack(M.MAV_MISSION_UNSUPPORTED)
-            self._upload = None
-            return
-        if msg.seq > 0 and msg.command in NAV_COMMANDS and not math.isfinite(msg.z):
-            self._ack(M.MAV_MISSION_INVALID_PARAM7)
-            self._upload = None
-            return
-        if msg.seq > 0 and frame not in _FRAMES:
-            self._ack(M.MAV_MISSION_UNSUPPORTED_FRAME)
-            self._upload = None
-            return
-        item = MissionItem(
-            msg.seq,
-            frame,
-            msg.command,
-            msg.current,
-            msg.autocontinue,
-            msg.param1,
-            msg.param2,
-            msg.param3,
-            msg.param4,
-            x,
-            y,
-            msg.z,
-        )
-        self._upload.append(item if msg.seq > 0 else self.home_item())
+        if msg.seq == 0:  # item 0 is home, whatever was sent
+            self._upload.append(self.home_item())
+        else:
+            error = self._item_error(msg, frame, x, y)
+            if error is not None or x is None or y is None:
+                self._ack(int(M.MAV_MISSION_ERROR) if error is None else error)
+                self._upload = None
+                return
+            self._upload.append(
+                MissionItem(
+                    msg.seq,
+                    frame,
+                    msg.command,
+                    msg.current,
+                    msg.autocontinue,
+                    msg.param1,
+                    msg.param2,
+                    msg.param3,
+                    msg.param4,
+                    x,
+                    y,
+                    msg.z,
+                )
+            )
         self._retries = 0
         if len(self._upload) < self._upload_count:
             self._request_next()
@@ -155,6 +163,32 @@ class MissionProtocol:
         self._mission.replace(self._upload)
         self._ack(M.MAV_MISSION_ACCEPTED)
         self._upload = None
+
+    def _item_error(self, msg: Any, frame: int, x: int | None, y: int | None) -> int | None:
+        """The MAV_MISSION_RESULT refusing item ``msg`` (seq ≥ 1), or None if it can be flown."""
+        cmd, p1, p4 = msg.command, msg.param1, msg.param4
+        if cmd not in SUPPORTED_COMMANDS:
+            return int(M.MAV_MISSION_UNSUPPORTED)
+        if frame not in _FRAMES:
+            return int(M.MAV_MISSION_UNSUPPORTED_FRAME)
+        if x is None or (frame != M.MAV_FRAME_MISSION and abs(x) > 90 * 10**7):
+            return int(M.MAV_MISSION_INVALID_PARAM5_X)
+        if y is None or (frame != M.MAV_FRAME_MISSION and abs(y) > 180 * 10**7):
+            return int(M.MAV_MISSION_INVALID_PARAM6_Y)
+        if cmd in NAV_COMMANDS and not math.isfinite(msg.z):
+            return int(M.MAV_MISSION_INVALID_PARAM7)
+        alt_m = msg.z - self.session.ap.home.alt_amsl_m if frame in _AMSL else msg.z
+        if cmd in _ALTITUDE_COMMANDS and alt_m < 0.0:  # a target below ground
+            return int(M.MAV_MISSION_INVALID_PARAM7)
+        if cmd == M.MAV_CMD_NAV_WAYPOINT and not 0.0 <= p1 <= UINT16_MAX:  # hold time, s
+            return int(M.MAV_MISSION_INVALID_PARAM1)
+        if cmd == M.MAV_CMD_DO_CHANGE_SPEED and (
+            whole(p1, 0, 3) is None or not math.isfinite(msg.param2)
+        ):
+            return int(M.MAV_MISSION_INVALID_PARAM1)
+        if cmd == M.MAV_CMD_CONDITION_YAW and not (0.0 <= p1 <= 360.0 and p4 in (0.0, 1.0)):
+            return int(M.MAV_MISSION_INVALID_PARAM1)
+        return None
 
     def tick(self, now_ns: int) -> None:
         if self._upload is None or now_ns < self._next_request_ns:

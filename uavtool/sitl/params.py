@@ -1,8 +1,9 @@
 """The vehicle's parameters: ArduCopter names, defaults, MAVLink types, and parameter files.
 
 Values are stored the way they travel: REAL32 parameters are rounded to float32, integer
-parameters are whole numbers clamped to their type's range, so a PARAM_SET echoes exactly
-what a later PARAM_REQUEST_READ returns.
+parameters are whole numbers, so a PARAM_SET echoes exactly what a later PARAM_REQUEST_READ
+returns. A value outside the parameter's ArduCopter range (or not finite) is refused whole:
+ArduPilot's parameter protocol answers such a PARAM_SET with the value it kept.
 """
 
 from __future__ import annotations
@@ -21,61 +22,71 @@ _INT16 = mavlink.MAV_PARAM_TYPE_INT16
 _INT32 = mavlink.MAV_PARAM_TYPE_INT32
 _REAL32 = mavlink.MAV_PARAM_TYPE_REAL32
 
+_FLOAT32_MAX = 3.4028234663852886e38
 _INT_RANGES = {_INT8: (-128, 127), _INT16: (-32768, 32767), _INT32: (-(2**31), 2**31 - 1)}
 
 
 @dataclass(frozen=True, slots=True)
 class ParamSpec:
+    """One parameter: ArduCopter's name, default, MAVLink type and documented ``@Range``."""
+
     name: str
     default: float
     mav_type: int
+    low: float
+    high: float
     doc: str
 
 
-# Units follow ArduPilot: cm, cm/s, cm/s², centidegrees where ArduCopter uses them.
+_I32_MAX = 2**31 - 1
+P = ParamSpec
+# Units follow ArduPilot: cm, cm/s, cm/s², centidegrees where ArduCopter uses them. Ranges are
+# ArduCopter's @Range (or its @Values' span); the SIM_ ones keep the simulation finite and
+# its telemetry inside its fields (SYS_STATUS carries the voltage as uint16 millivolts).
 PARAM_SPECS: tuple[ParamSpec, ...] = (
-    ParamSpec("SYSID_THISMAV", 1, _INT16, "MAVLink system id of this vehicle"),
-    ParamSpec("SYSID_MYGCS", 255, _INT16, "system id of the ground station"),
-    ParamSpec("FS_GCS_ENABLE", 0, _INT8, "GCS failsafe: 0 off, 1 RTL, 5 LAND"),
-    ParamSpec("FS_GCS_TIMEOUT", 5.0, _REAL32, "GCS heartbeat timeout, s"),
-    ParamSpec("ARMING_CHECK", 1, _INT32, "pre-arm checks bitmask (1 = all, 0 = none)"),
-    ParamSpec("DISARM_DELAY", 10, _INT8, "auto-disarm delay on the ground, s (0 off)"),
-    ParamSpec("RTL_ALT", 1500, _INT32, "RTL return altitude, cm above home"),
-    ParamSpec("RTL_SPEED", 0, _INT16, "RTL horizontal speed, cm/s (0 = WPNAV_SPEED)"),
-    ParamSpec("RTL_LOIT_TIME", 0, _INT32, "RTL loiter time above home before landing, ms"),
-    ParamSpec("LAND_SPEED", 50, _INT16, "final landing descent rate, cm/s"),
-    ParamSpec(
-        "LAND_SPEED_HIGH", 0, _INT16, "landing descent above 10 m, cm/s (0 = WPNAV_SPEED_DN)"
-    ),
-    ParamSpec("WPNAV_SPEED", 1000, _REAL32, "horizontal waypoint speed, cm/s"),
-    ParamSpec("WPNAV_SPEED_UP", 250, _REAL32, "climb rate, cm/s"),
-    ParamSpec("WPNAV_SPEED_DN", 150, _REAL32, "descent rate, cm/s"),
-    ParamSpec("WPNAV_ACCEL", 250, _REAL32, "horizontal acceleration, cm/s²"),
-    ParamSpec("WPNAV_ACCEL_Z", 100, _REAL32, "vertical acceleration, cm/s²"),
-    ParamSpec("WPNAV_RADIUS", 200, _REAL32, "waypoint reached radius, cm"),
-    ParamSpec("PILOT_SPEED_UP", 250, _INT16, "maximum pilot climb rate, cm/s"),
-    ParamSpec("PILOT_SPEED_DN", 0, _INT16, "maximum pilot descent rate, cm/s (0 = PILOT_SPEED_UP)"),
-    ParamSpec("ATC_SLEW_YAW", 6000, _REAL32, "maximum yaw slew rate, cdeg/s"),
-    ParamSpec("ANGLE_MAX", 3000, _INT16, "maximum lean angle, cdeg"),
-    ParamSpec("FENCE_ENABLE", 1, _INT8, "geofence on (1) or off (0)"),
-    ParamSpec("FENCE_ALT_MAX", 100.0, _REAL32, "geofence maximum altitude above home, m"),
-    ParamSpec("FENCE_RADIUS", 300.0, _REAL32, "geofence radius around home, m"),
-    ParamSpec("BATT_CAPACITY", 5000, _INT32, "battery capacity, mAh"),
-    ParamSpec("BATT_LOW_VOLT", 14.0, _REAL32, "low-battery voltage, V"),
-    ParamSpec("BATT_FS_LOW_ACT", 2, _INT8, "low-battery action: 0 none, 1 LAND, 2 RTL"),
-    ParamSpec("SIM_SPEEDUP", 1.0, _REAL32, "simulation speed-up over wall time"),
-    ParamSpec("SIM_WIND_SPD", 0.0, _REAL32, "wind speed, m/s"),
-    ParamSpec("SIM_WIND_DIR", 0.0, _REAL32, "wind direction it blows from, deg"),
-    ParamSpec("SIM_WIND_TURB", 0.0, _REAL32, "wind turbulence, m/s (seeded)"),
-    ParamSpec("SIM_GPS_NOISE", 0.0, _REAL32, "GPS position noise, m (seeded)"),
-    ParamSpec("SIM_BARO_RND", 0.0, _REAL32, "barometer altitude noise, m (seeded)"),
-    ParamSpec("SIM_BATT_VOLTAGE", 16.8, _REAL32, "full battery voltage, V"),
-    ParamSpec("SIM_RATE_HZ", 50, _INT16, "physics steps per simulated second (read at start)"),
-    ParamSpec("MNT1_TYPE", 1, _INT8, "mount type (1 = servo gimbal present)"),
-    ParamSpec("MNT1_PITCH_MIN", -90, _INT16, "gimbal minimum pitch, deg"),
-    ParamSpec("MNT1_PITCH_MAX", 0, _INT16, "gimbal maximum pitch, deg"),
-    ParamSpec("MNT1_YAW_MIN", -180, _INT16, "gimbal minimum yaw, deg"),
-    ParamSpec("MNT1_YAW_MAX", 180, _INT16, "gimbal maximum yaw, deg"),
+    P("SYSID_THISMAV", 1, _INT16, 1, 255, "MAVLink system id of this vehicle"),
+    P("SYSID_MYGCS", 255, _INT16, 1, 255, "system id of the ground station"),
+    P("FS_GCS_ENABLE", 0, _INT8, 0, 7, "GCS failsafe: 0 off, 1 RTL, 5 LAND"),
+    P("FS_GCS_TIMEOUT", 5.0, _REAL32, 2, 120, "GCS heartbeat timeout, s"),
+    P("ARMING_CHECK", 1, _INT32, 0, _I32_MAX, "pre-arm checks bitmask (1 = all, 0 = none)"),
+    P("DISARM_DELAY", 10, _INT8, 0, 127, "auto-disarm delay on the ground, s (0 off)"),
+    P("RTL_ALT", 1500, _INT32, 30, 300000, "RTL return altitude, cm above home"),
+    P("RTL_SPEED", 0, _INT16, 0, 2000, "RTL horizontal speed, cm/s (0 = WPNAV_SPEED)"),
+    P("RTL_LOIT_TIME", 0, _INT32, 0, 60000, "RTL loiter time above home before landing, ms"),
+    P("LAND_SPEED", 50, _INT16, 30, 200, "final landing descent rate, cm/s"),
+    P("LAND_SPEED_HIGH", 0, _INT16, 0, 2500, "descent above 10 m, cm/s (0 = WPNAV_SPEED_DN)"),
+    P("WPNAV_SPEED", 1000, _REAL32, 10, 2000, "horizontal waypoint speed, cm/s"),
+    P("WPNAV_SPEED_UP", 250, _REAL32, 10, 1000, "climb rate, cm/s"),
+    P("WPNAV_SPEED_DN", 150, _REAL32, 10, 500, "descent rate, cm/s"),
+    P("WPNAV_ACCEL", 250, _REAL32, 50, 500, "horizontal acceleration, cm/s²"),
+    P("WPNAV_ACCEL_Z", 100, _REAL32, 50, 500, "vertical acceleration, cm/s²"),
+    P("WPNAV_RADIUS", 200, _REAL32, 5, 1000, "waypoint reached radius, cm"),
+    P("PILOT_SPEED_UP", 250, _INT16, 50, 500, "maximum pilot climb rate, cm/s"),
+    P("PILOT_SPEED_DN", 0, _INT16, 0, 500, "maximum pilot descent, cm/s (0 = PILOT_SPEED_UP)"),
+    P("ATC_SLEW_YAW", 6000, _REAL32, 500, 18000, "maximum yaw slew rate, cdeg/s"),
+    P("ANGLE_MAX", 3000, _INT16, 1000, 8000, "maximum lean angle, cdeg"),
+    P("FENCE_ENABLE", 0, _INT8, 0, 1, "geofence on (1) or off (0)"),
+    P("FENCE_ALT_MAX", 100.0, _REAL32, 10, 1000, "geofence maximum altitude above home, m"),
+    P("FENCE_RADIUS", 300.0, _REAL32, 30, 10000, "geofence radius around home, m"),
+    P("BATT_CAPACITY", 5000, _INT32, 0, _I32_MAX, "battery capacity, mAh"),
+    P("BATT_LOW_VOLT", 14.0, _REAL32, 0, 60, "low-battery voltage, V"),
+    P("BATT_FS_LOW_ACT", 2, _INT8, 0, 4, "low-battery action: 0 none, 1 LAND, 2-4 RTL"),
+    P("SIM_SPEEDUP", 1.0, _REAL32, 0.01, 1e9, "simulation speed-up over wall time"),
+    P("SIM_WIND_SPD", 0.0, _REAL32, 0, 50, "wind speed, m/s"),
+    P("SIM_WIND_DIR", 0.0, _REAL32, 0, 360, "wind direction it blows from, deg"),
+    P("SIM_WIND_TURB", 0.0, _REAL32, 0, 20, "wind turbulence, m/s (seeded)"),
+    P("SIM_GPS_NOISE", 0.0, _REAL32, 0, 100, "GPS position noise, m (seeded)"),
+    P("SIM_BARO_RND", 0.0, _REAL32, 0, 100, "barometer altitude noise, m (seeded)"),
+    P("SIM_BATT_VOLTAGE", 16.8, _REAL32, 0, 60, "full battery voltage, V"),
+    P("SIM_RATE_HZ", 50, _INT16, 10, 1000, "physics steps per simulated second (read at start)"),
+    P("MNT1_TYPE", 1, _INT8, 0, 12, "mount type (1 = servo gimbal present)"),
+    P("MNT1_PITCH_MIN", -90, _INT16, -90, 90, "gimbal minimum pitch, deg"),
+    P("MNT1_PITCH_MAX", 0, _INT16, -90, 90, "gimbal maximum pitch, deg"),
+    P("MNT1_YAW_MIN", -180, _INT16, -180, 180, "gimbal minimum yaw, deg"),
+    P("MNT1_YAW_MAX", 180, _INT16, -180, 180, "gimbal maximum yaw, deg"),
+    P("FENCE_TYPE", 7, _INT8, 0, 15, "fence types: 1 max altitude, 2 circle, 4 polygon, 8 min alt"),
+    P("FENCE_ACTION", 1, _INT8, 0, 5, "on a breach: 0 report, 1 RTL or LAND, 2 LAND, 3-5 RTL/LAND"),
+    P("FENCE_MARGIN", 2.0, _REAL32, 1, 10, "distance inside the fence RTL keeps to, m"),
 )
 
 _SPECS_BY_NAME = {spec.name: spec for spec in PARAM_SPECS}
@@ -84,6 +95,8 @@ _SPECS_BY_NAME = {spec.name: spec for spec in PARAM_SPECS}
 def coerce(mav_type: int, value: float) -> float:
     """``value`` as the parameter type stores it (float32 rounding, integer clamping)."""
     if mav_type == _REAL32:
+        if abs(value) > _FLOAT32_MAX:  # struct refuses to round these
+            return math.copysign(math.inf, value)
         return float(struct.unpack("<f", struct.pack("<f", value))[0])
     low, high = _INT_RANGES[mav_type]
     return float(min(max(round(value), low), high))
@@ -120,15 +133,27 @@ class ParamStore:
         return _SPECS_BY_NAME[name].mav_type
 
     def set(self, name: str, value: float) -> float:
-        """Set ``name`` and return the stored value; raises ParamError for an unknown name."""
-        spec = _SPECS_BY_NAME.get(name)
-        if spec is None:
-            raise ParamError(f"unknown parameter {name!r}")
-        if not math.isfinite(value):
-            raise ParamError(f"parameter {name}: value must be finite, got {value}")
-        stored = coerce(spec.mav_type, value)
+        """Set ``name`` and return the stored value; raises ParamError (naming the range) for
+        an unknown name or a value outside ArduCopter's range, leaving the table unchanged."""
+        stored = check(name, value)
         self._values[name] = stored
         return stored
+
+
+def check(name: str, value: float) -> float:
+    """``value`` as parameter ``name`` would store it; ParamError if unknown or out of range."""
+    spec = _SPECS_BY_NAME.get(name)
+    if spec is None:
+        raise ParamError(f"unknown parameter {name!r}")
+    if not math.isfinite(value):
+        raise ParamError(f"{name}: value must be finite, got {value}")
+    if spec.mav_type == _REAL32:
+        inside = coerce(_REAL32, spec.low) <= coerce(_REAL32, value) <= coerce(_REAL32, spec.high)
+    else:
+        inside = spec.low <= round(value) <= spec.high
+    if not inside:
+        raise ParamError(f"{name}: {value:g} out of range {spec.low:g}..{spec.high:g}")
+    return coerce(spec.mav_type, value)
 
 
 _LINE = re.compile(r"^\s*([A-Za-z0-9_]+)\s*[,\s]\s*([-+0-9.eE]+)\s*(?:#.*)?$")
@@ -158,4 +183,8 @@ def load_param_file(path: Path) -> dict[str, float]:
             values[name] = float(raw)
         except ValueError:
             raise ParamError(f"{path}:{lineno}: {name}: not a number: {raw!r}") from None
+        try:
+            check(name, values[name])
+        except ParamError as exc:
+            raise ParamError(f"{path}:{lineno}: {exc}") from None
     return values

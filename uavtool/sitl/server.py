@@ -30,11 +30,15 @@ from uavtool.sitl.links import (
     parse_endpoint,
 )
 from uavtool.sitl.params import ParamStore
+from uavtool.sitl.signing import SigningStreams
 from uavtool.sitl.telemetry import Telemetry
 
 log = logging.getLogger(__name__)
 _NS = 1_000_000_000
 _MAX_LAG_S = 0.25  # at real-time-ish speed-ups, drop lag beyond this instead of bursting
+MAX_LINK_FAULTS = 10
+"""Unexpected errors serving one peer before its link is dropped (each is logged and counted;
+the request that raised it is refused)."""
 
 
 class Sitl:
@@ -56,7 +60,7 @@ class Sitl:
         params.set("SYSID_THISMAV", self.sysid)
         params.set("SIM_SPEEDUP", config.speedup)
         params.set("SIM_WIND_SPD", config.wind_speed_ms)
-        params.set("SIM_WIND_DIR", config.wind_dir_deg)
+        params.set("SIM_WIND_DIR", config.wind_dir_deg % 360.0)
         for name, value in config.params:
             params.set(name, value)
         self.speedup = params["SIM_SPEEDUP"]
@@ -77,7 +81,16 @@ class Sitl:
                 int(time.time() * 1e6) if config.start_unix_us is None else config.start_unix_us
             ),
         )
+        self.signing = (
+            None
+            if config.signing_key is None
+            else SigningStreams(
+                config.signing_key,
+                unix_us=lambda: self.telemetry.start_unix_us + self.now_ns // 1000,
+            )
+        )
         self.sessions: list[GcsSession] = []
+        self.faults = 0  # unexpected errors while serving peers, all links together
         self._selector = selectors.DefaultSelector()
         self._sockets: list[_Socketed] = []
         self._link_counter = 0
@@ -158,10 +171,23 @@ class Sitl:
         if self.link_down:
             return
         for frame in link.receive(data):
+            if link.closed:
+                return
             try:
                 link.session.handle(frame)
             except Exception:  # a bug must not let one peer take the vehicle down
-                log.exception("error handling %s from %s", frame.msg.get_type(), link.name)
+                self.fault(link, frame.msg.get_type())
+
+    def fault(self, link: Link, what: str) -> None:
+        """Log and count the exception being handled while serving ``link``'s peer (for
+        ``what``); drop the link after ``MAX_LINK_FAULTS``. The vehicle and its other links
+        go on."""
+        self.faults += 1
+        link.faults += 1
+        log.exception("fault %d on %s while handling %s", link.faults, link.name, what)
+        if link.faults >= MAX_LINK_FAULTS and not link.closed:
+            log.error("%s: dropped after %d faults", link.name, link.faults)
+            link.closed = True
 
     # ------------------------------------------------------------------ parameters
     def set_param(self, name: str, value: float) -> float:
@@ -222,7 +248,11 @@ class Sitl:
         while mission.reached:
             self.broadcast(M.MAVLink_mission_item_reached_message(mission.reached.pop(0)))
         for session in self.sessions:
-            session.tick(now)
+            try:
+                session.tick(now)
+            except Exception:  # its telemetry cannot be built or sent: drop that link only
+                self.fault(session.link, "telemetry")
+                session.link.closed = True
 
     def poll(self, timeout_s: float) -> None:
         """Serve sockets for up to ``timeout_s`` (0: only what is already waiting)."""
@@ -242,12 +272,21 @@ class Sitl:
         return [s for s in self._sockets if isinstance(s, TcpConnection)]
 
     def _reap(self) -> None:
-        for sock in self._tcp_connections():
-            if sock.link.closed:
+        """Close dropped TCP connections and forget expired UDP peers, with their sessions."""
+        for sock in list(self._sockets):
+            if isinstance(sock, TcpConnection) and sock.link.closed:
                 self._selector.unregister(sock.sock)
                 sock.close()
                 self._sockets.remove(sock)
-                self.sessions.remove(sock.link.session)
+                self._forget(sock.link)
+            elif isinstance(sock, UdpSocket):
+                for link in sock.expire(self.now_ns):
+                    link.closed = True
+                    self._forget(link)
+
+    def _forget(self, link: Link) -> None:
+        if link.session in self.sessions:
+            self.sessions.remove(link.session)
 
     def run(self, *, duration_s: float | None = None) -> None:
         """Run in this thread until ``stop()`` (or for ``duration_s`` of sim time)."""

@@ -153,14 +153,24 @@ class Telemetry:
         enabled = _SENSORS if ap.armed else _SENSORS & ~M.MAV_SYS_STATUS_SENSOR_MOTOR_OUTPUTS
         # After a crash the pre-arm checks fail (arming is refused until a restart).
         health = _SENSORS & ~M.MAV_SYS_STATUS_PREARM_CHECK if ap.crashed else _SENSORS
+        present = _SENSORS
+        # The fence as ArduCopter reports it: present when configured, enabled with
+        # FENCE_ENABLE, healthy unless breached (MAVProxy says "fence breach" without it).
+        fence = ap.fence
+        if fence.present:
+            present |= M.MAV_SYS_STATUS_GEOFENCE
+        if fence.enabled:
+            enabled |= M.MAV_SYS_STATUS_GEOFENCE
+        if fence.healthy:
+            health |= M.MAV_SYS_STATUS_GEOFENCE
         return M.MAVLink_sys_status_message(
-            _SENSORS,
+            present,
             enabled,
             health,
             150,
-            round(ap.battery_voltage() * 1000),
+            round(ap.battery.voltage() * 1000),
             round(ap.battery_current_a() * 100),
-            ap.battery_remaining_pct(),
+            ap.battery.remaining_pct(),
             0,
             0,
             0,
@@ -246,7 +256,7 @@ class Telemetry:
 
     def battery_status(self) -> Any:
         ap = self.ap
-        cell_mv = round(ap.battery_voltage() * 1000 / 4)
+        cell_mv = round(ap.battery.voltage() * 1000 / 4)
         cells = [cell_mv] * 4 + [65535] * 6
         return M.MAVLink_battery_status_message(
             0,
@@ -255,9 +265,9 @@ class Telemetry:
             2500,
             cells,
             round(ap.battery_current_a() * 100),
-            round(ap.battery_used_mah),
+            round(ap.battery.used_mah),
             -1,
-            ap.battery_remaining_pct(),
+            ap.battery.remaining_pct(),
         )
 
     def extended_sys_state(self) -> Any:

@@ -9,9 +9,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
-import numpy as np
 
 from uavtool.camera import Intrinsics
+from uavtool.images import read_image
 from uavtool.vision.errors import ImageError, ModelInputError, ShapeFileError
 from uavtool.vision.io import shapes_to_json, views_from_json
 from uavtool.vision.model3d import Model, View, build_model, central_shape, model_glb, same_colour
@@ -22,20 +22,24 @@ from uavtool.vision.shapes import Shape
 from uavtool.vision.vectorize import U8Array, vectorize
 
 
-def read_image(path: Path) -> U8Array:
-    """An image file as RGB ``(h, w, 3) uint8``; raises :class:`ImageError`."""
-    if not path.is_file():
-        raise ImageError(f"{path}: no such image file")
-    bgr = cv2.imread(str(path), cv2.IMREAD_COLOR)
-    if bgr is None:
-        raise ImageError(f"{path}: not an image OpenCV can read (PNG, JPEG, ...)")
-    return np.ascontiguousarray(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB))
-
-
 def write_image(path: Path, rgb: U8Array) -> None:
     """Write an RGB image (format from the file extension)."""
-    if not cv2.imwrite(str(path), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)):
+    try:
+        ok = cv2.imwrite(str(path), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+    except cv2.error:  # no encoder for the extension
+        ok = False
+    if not ok:
         raise ImageError(f"{path}: cannot write an image there (check the extension)")
+
+
+def _write(path: Path, data: str | bytes) -> None:
+    try:
+        if isinstance(data, str):
+            path.write_text(data)
+        else:
+            path.write_bytes(data)
+    except OSError as exc:
+        raise ImageError(f"{path}: cannot write: {exc.strerror or exc}") from None
 
 
 def vectorize_file(
@@ -49,7 +53,7 @@ def vectorize_file(
     rgb = read_image(frame)
     shapes = vectorize(rgb, params)
     if out is not None:
-        out.write_text(shapes_to_json(shapes, width_px=rgb.shape[1], height_px=rgb.shape[0]))
+        _write(out, shapes_to_json(shapes, width_px=rgb.shape[1], height_px=rgb.shape[0]))
     if overlay is not None:
         write_image(overlay, draw_overlay(rgb, shapes))
     return shapes
@@ -133,9 +137,11 @@ def model_files(
     right photos, every shape of its colour is the object.
     """
     try:
-        text = poses.read_text()
+        text = poses.read_text(encoding="utf-8")
     except OSError as exc:
-        raise ShapeFileError(f"{poses}: cannot read: {exc.strerror}") from None
+        raise ShapeFileError(f"{poses}: cannot read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise ShapeFileError(f"{poses}: not a JSON text file") from None
     cams, ground = views_from_json(text, source=str(poses))
     images = {"top": top, "front": front, "right": right}
     shapes: dict[str, tuple[Shape, ...]] = {}
@@ -159,7 +165,7 @@ def model_files(
     }
     p = params if params is not None else ModelParams(ground_z_m=ground)
     model = build_model(views["top"], views["front"], views["right"], p)
-    out.write_bytes(model_glb(model))
+    _write(out, model_glb(model))
     return model
 
 

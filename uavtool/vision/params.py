@@ -6,8 +6,12 @@ every field can be overridden, e.g. ``replace(VectorizeParams(), rdp_epsilon_px=
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, fields
+from types import MappingProxyType
+from typing import ClassVar
 
+from uavtool.checks import DN, FRACTION, NON_NEGATIVE, POSITIVE, Range, check_fields
 from uavtool.vision.errors import VisionParamError
 
 
@@ -63,22 +67,31 @@ class VectorizeParams:
     """Outlines follow the centres of the border pixels; each edge is then moved outward by
     this much so the polygon follows the pixel edges and its area matches the pixel count."""
 
+    RANGES: ClassVar[Mapping[str, Range]] = MappingProxyType(
+        {
+            "palette_rgb": DN,
+            "hue_tolerance_deg": Range(0.0, 90.0, lo_open=True),
+            "min_saturation": DN,
+            "min_value": DN,
+            "denoise_px": Range(0, 255),
+            "roof_value_tolerance": DN,
+            "point_spacing_px": POSITIVE,
+            "rdp_epsilon_px": NON_NEGATIVE,
+            "min_edge_px": POSITIVE,
+            "straight_tolerance_px": NON_NEGATIVE,
+            "min_area_px": POSITIVE,
+            "min_hole_area_px": NON_NEGATIVE,
+            "edge_offset_px": NON_NEGATIVE,
+        }
+    )
+    """Allowed values of each field (floats must also be finite)."""
+
     def __post_init__(self) -> None:
-        _check_positive(self, "point_spacing_px", "min_area_px", "min_edge_px")
-        _check_non_negative(
-            self, "rdp_epsilon_px", "min_hole_area_px", "edge_offset_px", "straight_tolerance_px"
-        )
-        if not 0.0 < self.hue_tolerance_deg <= 90.0:
+        check_fields(self, self.RANGES, group="vectorize", error=VisionParamError)
+        if self.denoise_px > 1 and self.denoise_px % 2 == 0:
             raise VisionParamError(
-                f"vision.hue_tolerance_deg must be in (0, 90], got {self.hue_tolerance_deg}"
+                f"vectorize.denoise_px must be 0, 1 or odd, got {self.denoise_px}"
             )
-        if not 0 <= self.min_saturation <= 255 or not 0 <= self.min_value <= 255:
-            raise VisionParamError("vision.min_saturation and vision.min_value must be in [0, 255]")
-        if self.denoise_px < 0 or (self.denoise_px > 1 and self.denoise_px % 2 == 0):
-            raise VisionParamError(f"vision.denoise_px must be 0 or odd, got {self.denoise_px}")
-        for colour in self.palette_rgb:
-            if len(colour) != 3 or not all(0 <= c <= 255 for c in colour):
-                raise VisionParamError(f"vision.palette_rgb: {colour} is not an RGB triple 0–255")
 
 
 @dataclass(frozen=True, slots=True)
@@ -119,13 +132,22 @@ class RecognizeParams:
     noise alone. For a reference that is its own mirror image (a rectangle, a T) the rule
     then only refuses a candidate clearly more like the mirror image."""
 
+    RANGES: ClassVar[Mapping[str, Range]] = MappingProxyType(
+        {
+            "angle_scale_deg": POSITIVE,
+            "length_scale": POSITIVE,
+            "merge_cost": NON_NEGATIVE,
+            "max_merge": Range(1, 100),
+            "hole_penalty": NON_NEGATIVE,
+            "threshold": FRACTION,
+            "mirror_margin": NON_NEGATIVE,
+            "mirror_tolerance": NON_NEGATIVE,
+        }
+    )
+    """Allowed values of each field (floats must also be finite)."""
+
     def __post_init__(self) -> None:
-        _check_positive(self, "angle_scale_deg", "length_scale")
-        _check_non_negative(self, "merge_cost", "hole_penalty", "mirror_margin", "mirror_tolerance")
-        if self.max_merge < 1:
-            raise VisionParamError(f"vision.max_merge must be ≥ 1, got {self.max_merge}")
-        if not 0.0 <= self.threshold <= 1.0:
-            raise VisionParamError(f"vision.threshold must be in [0, 1], got {self.threshold}")
+        check_fields(self, self.RANGES, group="recognize", error=VisionParamError)
 
 
 @dataclass(frozen=True, slots=True)
@@ -147,24 +169,19 @@ class ModelParams:
     allow_border_cut: bool = False
     """Accept silhouettes that touch the image border (the model is then truncated)."""
 
+    RANGES: ClassVar[Mapping[str, Range]] = MappingProxyType(
+        {
+            "max_iterations": Range(1, 10_000),
+            "tolerance_m": POSITIVE,
+            "max_top_tilt_deg": Range(0.0, 90.0, lo_open=True),
+            "max_side_tilt_deg": Range(0.0, 90.0, lo_open=True),
+            "min_view_separation_deg": Range(0.0, 180.0),
+        }
+    )
+    """Allowed values of each field (floats must also be finite)."""
+
     def __post_init__(self) -> None:
-        _check_positive(self, "tolerance_m", "max_top_tilt_deg", "max_side_tilt_deg")
-        if self.max_iterations < 1:
-            raise VisionParamError(f"vision.max_iterations must be ≥ 1, got {self.max_iterations}")
-
-
-def _check_positive(obj: object, *names: str) -> None:
-    for name in names:
-        value = getattr(obj, name)
-        if not value > 0:
-            raise VisionParamError(f"vision.{name} must be positive, got {value}")
-
-
-def _check_non_negative(obj: object, *names: str) -> None:
-    for name in names:
-        value = getattr(obj, name)
-        if not value >= 0:
-            raise VisionParamError(f"vision.{name} must be ≥ 0, got {value}")
+        check_fields(self, self.RANGES, group="model", error=VisionParamError)
 
 
 def field_names(cls: type) -> tuple[str, ...]:

@@ -14,10 +14,10 @@ from collections.abc import Callable
 
 from uavtool.geo import GeoPoint
 from uavtool.world.errors import SceneError
+from uavtool.world.limits import MAX_BUILDINGS
 from uavtool.world.polygon import normalise_ring
 from uavtool.world.scene import Block, Building, Scene, scene_from_dict, scene_to_dict
 
-MAX_BUILDINGS = 200
 _SHAPES = ("rectangle", "L", "T", "U", "cross", "convex", "concave")
 
 Ring = list[tuple[float, float]]
@@ -32,8 +32,8 @@ def generate_scene(*, seed: int, buildings: int, margin_m: float = 4.0) -> Scene
     """
     if not 1 <= buildings <= MAX_BUILDINGS:
         raise SceneError(f"--buildings must be in 1..{MAX_BUILDINGS}, got {buildings}")
-    if margin_m < 0.0:
-        raise SceneError(f"margin must be >= 0, got {margin_m}")
+    if not 0.0 <= margin_m <= 50.0:
+        raise SceneError(f"margin must be 0..50 m, got {margin_m}")
     rng = random.Random(seed)
     half_side_m = 7.0 * math.sqrt(buildings) + 6.0
     placed: list[tuple[float, float, float]] = []  # centre east, north, bounding radius

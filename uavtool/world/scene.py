@@ -25,8 +25,7 @@ from __future__ import annotations
 import difflib
 import json
 import math
-import tomllib
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -36,14 +35,15 @@ import shapely
 import yaml
 
 from uavtool.geo import GeoPoint
+from uavtool.world import limits
 from uavtool.world.errors import SceneError
 from uavtool.world.polygon import normalise_ring, signed_area
+from uavtool.world.scene_file import KeyPath, format_path, parse_text
 
 FORMAT_VERSION = 1
 _MIN_AREA_M2 = 1e-4
 _OVERLAP_M2 = 1e-6
 
-KeyPath = tuple[str | int, ...]
 RGB = tuple[int, int, int]
 
 DEFAULT_GROUND_RGB: RGB = (128, 128, 128)
@@ -156,19 +156,13 @@ def dump_scene(scene: Scene, *, suffix: str = ".yaml") -> str:
 # --------------------------------------------------------------------------- from dict
 
 
-def _format_path(path: KeyPath) -> str:
-    out = ""
-    for part in path:
-        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else part)
-    return out
-
-
 class _Reader:
     """Type-checked access to parsed data; every failure names the source, line and key path."""
 
     def __init__(self, source: str, lines: Mapping[KeyPath, int]) -> None:
         self.source = source
         self.lines = lines
+        self.vertices = 0  # footprint vertices read so far, against MAX_SCENE_VERTICES
 
     def fail(self, path: KeyPath, message: str) -> NoReturn:
         line = None
@@ -177,7 +171,7 @@ class _Reader:
             if line is not None:
                 break
         where = f"{self.source}:{line}" if line is not None else self.source
-        key = _format_path(path)
+        key = format_path(path)
         raise SceneError(f"{where}: {key}: {message}" if key else f"{where}: {message}")
 
     def mapping(
@@ -199,19 +193,26 @@ class _Reader:
     def number(self, value: object, path: KeyPath) -> float:
         if isinstance(value, bool) or not isinstance(value, int | float):
             self.fail(path, f"expected a number, got {_kind(value)}")
-        out = float(value)
+        try:
+            out = float(value)
+        except OverflowError:
+            out = math.inf
         if not math.isfinite(out):
-            self.fail(path, f"expected a finite number, got {value}")
+            self.fail(path, f"expected a finite number, got {_clip(str(value))}")
         return out
 
     def text(self, value: object, path: KeyPath) -> str:
         if not isinstance(value, str):
             self.fail(path, f"expected a string, got {_kind(value)}")
+        if len(value) > limits.MAX_TEXT_CHARS:
+            self.fail(path, f"longer than {limits.MAX_TEXT_CHARS} characters")
         return value
 
-    def sequence(self, value: object, path: KeyPath) -> list[Any]:
+    def sequence(self, value: object, path: KeyPath, *, most: int | None = None) -> list[Any]:
         if not isinstance(value, list | tuple):
             self.fail(path, f"expected a list, got {_kind(value)}")
+        if most is not None and len(value) > most:
+            self.fail(path, f"at most {most} items allowed, got {len(value)}")
         return list(value)
 
     def color(self, value: object, path: KeyPath) -> RGB:
@@ -220,12 +221,16 @@ class _Reader:
             isinstance(c, int) and not isinstance(c, bool) and 0 <= c <= 255 for c in items
         )
         if not ok:
-            self.fail(path, f"expected [r, g, b] with integers 0-255, got {value!r}")
+            self.fail(path, f"expected [r, g, b] with integers 0-255, got {_clip(repr(value))}")
         return (items[0], items[1], items[2])
 
 
 def _kind(value: object) -> str:
     return "nothing" if value is None else type(value).__name__
+
+
+def _clip(text: str, limit: int = 60) -> str:
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def scene_from_dict(data: object, *, source: str = "<scene>") -> Scene:
@@ -266,7 +271,7 @@ def _scene_from(data: object, r: _Reader, *, default_name: str) -> Scene:
     sky_rgb = r.color(sky.get("color", list(DEFAULT_SKY_RGB)), ("sky", "color"))
     lighting = _lighting_from(top.get("lighting", {}), r)
 
-    raw_buildings = r.sequence(top["buildings"], ("buildings",))
+    raw_buildings = r.sequence(top["buildings"], ("buildings",), most=limits.MAX_BUILDINGS)
     if not raw_buildings:
         r.fail(("buildings",), "a scene needs at least one building")
     buildings = tuple(_building_from(b, ("buildings", i), r) for i, b in enumerate(raw_buildings))
@@ -314,27 +319,38 @@ def _building_from(value: object, path: KeyPath, r: _Reader) -> Building:
     if not name.strip() or any(c in name for c in "\n\r\t"):
         r.fail((*path, "name"), f"building name must be a non-empty single line, got {name!r}")
     color = r.color(d["color"], (*path, "color"))
-    raw_blocks = r.sequence(d["blocks"], (*path, "blocks"))
+    raw_blocks = r.sequence(d["blocks"], (*path, "blocks"), most=limits.MAX_BLOCKS)
     if not raw_blocks:
         r.fail((*path, "blocks"), "a building needs at least one block")
     blocks = tuple(_block_from(b, (*path, "blocks", i), r) for i, b in enumerate(raw_blocks))
-    for i in range(len(blocks)):
-        for j in range(i):
-            if _blocks_overlap(blocks[i], blocks[j]):
-                r.fail((*path, "blocks", i), f"overlaps blocks[{j}] of the same building")
+
+    def stacked(i: int, j: int) -> bool:  # one above the other: no overlap in space
+        a, b = blocks[i], blocks[j]
+        return min(a.top_m, b.top_m) - max(a.base_m, b.base_m) <= 0.0
+
+    clash = _first_overlap([shapely.Polygon(b.footprint_enu_m) for b in blocks], skip=stacked)
+    if clash is not None:
+        i, j = clash
+        r.fail((*path, "blocks", i), f"overlaps blocks[{j}] of the same building")
     return Building(name, color, blocks)
 
 
 def _block_from(value: object, path: KeyPath, r: _Reader) -> Block:
     d = r.mapping(value, path, ("footprint", "top_m"), ("base_m",))
     fp_path: KeyPath = (*path, "footprint")
-    raw = r.sequence(d["footprint"], fp_path)
+    raw = r.sequence(d["footprint"], fp_path, most=limits.MAX_FOOTPRINT_VERTICES)
+    r.vertices += len(raw)
+    if r.vertices > limits.MAX_SCENE_VERTICES:
+        r.fail(fp_path, f"the scene has more than {limits.MAX_SCENE_VERTICES} footprint vertices")
     pts: list[tuple[float, float]] = []
     for k, p in enumerate(raw):
         xy = r.sequence(p, (*fp_path, k))
         if len(xy) != 2:
-            r.fail((*fp_path, k), f"expected [east_m, north_m], got {p!r}")
-        pts.append((r.number(xy[0], (*fp_path, k, 0)), r.number(xy[1], (*fp_path, k, 1))))
+            r.fail((*fp_path, k), f"expected [east_m, north_m], got {_clip(repr(p))}")
+        x_m, y_m = r.number(xy[0], (*fp_path, k, 0)), r.number(xy[1], (*fp_path, k, 1))
+        if max(abs(x_m), abs(y_m)) > limits.MAX_EXTENT_M:
+            r.fail((*fp_path, k), f"more than {limits.MAX_EXTENT_M:g} m from home")
+        pts.append((x_m, y_m))
     if len(pts) > 1 and pts[0] == pts[-1]:
         pts.pop()
     if len(pts) < 3:
@@ -353,14 +369,24 @@ def _block_from(value: object, path: KeyPath, r: _Reader) -> Block:
         r.fail((*path, "base_m"), f"base must be >= 0, got {base}")
     if top <= base:
         r.fail((*path, "top_m"), f"top ({top}) must be above base ({base})")
+    if top > limits.MAX_HEIGHT_M:
+        r.fail((*path, "top_m"), f"at most {limits.MAX_HEIGHT_M:g} m, got {top}")
     return Block(ring, base, top)
 
 
-def _blocks_overlap(a: Block, b: Block) -> bool:
-    if min(a.top_m, b.top_m) - max(a.base_m, b.base_m) <= 0.0:
-        return False
-    inter = shapely.Polygon(a.footprint_enu_m).intersection(shapely.Polygon(b.footprint_enu_m))
-    return bool(inter.area > _OVERLAP_M2)
+def _first_overlap(
+    shapes: Sequence[shapely.Geometry], *, skip: Callable[[int, int], bool] | None = None
+) -> tuple[int, int] | None:
+    """The first pair ``(i, j)``, ``j < i``, in that order, whose shapes share more than a
+    touch; pairs ``skip`` excuses do not count. A spatial index keeps this near-linear."""
+    tree = shapely.STRtree(shapes)
+    near_i, near_j = tree.query(shapes, predicate="intersects")
+    for i, j in sorted((int(i), int(j)) for i, j in zip(near_i, near_j, strict=True) if j < i):
+        if skip is not None and skip(i, j):
+            continue
+        if shapes[i].intersection(shapes[j]).area > _OVERLAP_M2:
+            return i, j
+    return None
 
 
 def _check_buildings_apart(buildings: Sequence[Building], r: _Reader) -> None:
@@ -368,13 +394,13 @@ def _check_buildings_apart(buildings: Sequence[Building], r: _Reader) -> None:
         shapely.unary_union([shapely.Polygon(blk.footprint_enu_m) for blk in b.blocks])
         for b in buildings
     ]
-    for i in range(len(shapes)):
-        for j in range(i):
-            if shapes[i].intersection(shapes[j]).area > _OVERLAP_M2:
-                r.fail(
-                    ("buildings", i),
-                    f"building {buildings[i].name!r} overlaps building {buildings[j].name!r}",
-                )
+    clash = _first_overlap(shapes)
+    if clash is not None:
+        i, j = clash
+        r.fail(
+            ("buildings", i),
+            f"building {buildings[i].name!r} overlaps building {buildings[j].name!r}",
+        )
 
 
 # --------------------------------------------------------------------------- files
@@ -400,9 +426,13 @@ def load_scene(name_or_path: str | Path) -> Scene:
         known = ", ".join(builtin_scene_names())
         raise SceneError(f"{path}: no such scene file (built-in scenes: {known})")
     try:
+        if path.stat().st_size > limits.MAX_FILE_BYTES:
+            raise SceneError(f"{path}: larger than {limits.MAX_FILE_BYTES >> 10} KiB, not a scene")
         text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SceneError(f"{path}: cannot read scene file: {exc}") from exc
+    except OSError as exc:
+        raise SceneError(f"{path}: cannot read scene file: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"{path}: not UTF-8 text (byte {exc.start})") from None
     return _parse(text, source=str(path), suffix=path.suffix.lower())
 
 
@@ -412,48 +442,5 @@ def parse_scene(text: str, *, source: str, suffix: str = ".yaml") -> Scene:
 
 
 def _parse(text: str, *, source: str, suffix: str) -> Scene:
-    lines: dict[KeyPath, int] = {}
-    data: object
-    if suffix == ".toml":
-        try:
-            data = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            raise SceneError(f"{source}: invalid TOML: {exc}") from exc
-    elif suffix == ".json":
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise SceneError(f"{source}:{exc.lineno}: invalid JSON: {exc.msg}") from exc
-    else:
-        data = _load_yaml(text, source, lines)
+    data, lines = parse_text(text, source=source, suffix=suffix)
     return _scene_from(data, _Reader(source, lines), default_name=Path(source).stem)
-
-
-def _load_yaml(text: str, source: str, lines: dict[KeyPath, int]) -> object:
-    loader = yaml.SafeLoader(text)
-    try:
-        node = loader.get_single_node()
-        if node is None:
-            raise SceneError(f"{source}: empty scene file")
-        _record_lines(node, (), lines)
-        return loader.construct_document(node)
-    except yaml.MarkedYAMLError as exc:
-        line = exc.problem_mark.line + 1 if exc.problem_mark is not None else "?"
-        raise SceneError(f"{source}:{line}: invalid YAML: {exc.problem}") from exc
-    except yaml.YAMLError as exc:
-        raise SceneError(f"{source}: invalid YAML: {exc}") from exc
-    finally:
-        loader.dispose()
-
-
-def _record_lines(node: yaml.Node, path: KeyPath, lines: dict[KeyPath, int]) -> None:
-    lines[path] = node.start_mark.line + 1
-    if isinstance(node, yaml.MappingNode):
-        for key_node, value_node in node.value:
-            key = str(key_node.value)
-            lines[(*path, key)] = key_node.start_mark.line + 1
-            _record_lines(value_node, (*path, key), lines)
-            lines[(*path, key)] = key_node.start_mark.line + 1
-    elif isinstance(node, yaml.SequenceNode):
-        for i, item in enumerate(node.value):
-            _record_lines(item, (*path, i), lines)

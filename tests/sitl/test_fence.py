@@ -1,0 +1,145 @@
+"""The geofence holds on the vehicle's position, in every mode, and says so in SYS_STATUS."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from tests.sitl.pilot import Pilot
+from uavtool.geo import GeoPoint
+from uavtool.mavlink import mavlink as M
+
+GEOFENCE = M.MAV_SYS_STATUS_GEOFENCE
+RTL, LAND = 6, 9
+
+
+def _fenced(alt_max_m: float = 20.0, radius_m: float = 50.0, action: int = 1) -> Pilot:
+    pilot = Pilot()
+    for name, value in (
+        ("FENCE_ENABLE", 1),
+        ("FENCE_ALT_MAX", alt_max_m),
+        ("FENCE_RADIUS", radius_m),
+        ("FENCE_ACTION", action),
+    ):
+        assert pilot.set_param(name, value).param_value == value
+    return pilot
+
+
+def _local_target(
+    *, pos: tuple[float, float, float] = (0, 0, 0), vel: tuple[float, float, float] = (0, 0, 0)
+) -> object:
+    mask = 0b110111111000 if vel == (0, 0, 0) else 0b110111000111
+    return M.MAVLink_set_position_target_local_ned_message(
+        0, 1, 1, M.MAV_FRAME_LOCAL_NED, mask, *pos, *vel, 0, 0, 0, 0, 0
+    )
+
+
+@pytest.mark.parametrize(("action", "mode"), [(1, RTL), (2, LAND)])
+def test_a_velocity_climb_stops_at_the_fence_and_triggers_its_action(
+    action: int, mode: int
+) -> None:
+    pilot = _fenced(action=action)
+    pilot.takeoff(5)
+    peak = 0.0
+    for _ in range(60):  # climb at full speed for 30 s: a stream a target check never sees
+        pilot.send(_local_target(vel=(0, 0, -5)))
+        pilot.run(0.5)
+        peak = max(peak, pilot.alt_m())
+    assert "Fence breached: Max Alt" in pilot.statustexts()
+    assert pilot.mode() == mode
+    assert peak < 22.0  # it stopped just past FENCE_ALT_MAX (20 m), not at 80 m
+    assert pilot.alt_m() < 20.0
+
+
+def _upload(pilot: Pilot, items: list[tuple[int, int, int, int, float]]) -> None:
+    """(command, frame, lat_e7, lon_e7, alt) per item after home; answers MISSION_REQUEST_INT."""
+    pilot.send(M.MAVLink_mission_count_message(1, 1, len(items) + 1, 0))
+    for seq in range(len(items) + 1):
+        request = pilot.of_type("MISSION_REQUEST_INT")[-1]
+        assert request.seq == seq
+        cmd, frame, x, y, z = (M.MAV_CMD_NAV_WAYPOINT, 0, 0, 0, 0.0) if seq == 0 else items[seq - 1]
+        pilot.send(
+            M.MAVLink_mission_item_int_message(1, 1, seq, frame, cmd, 0, 1, 0, 0, 0, 0, x, y, z, 0)
+        )
+    assert pilot.of_type("MISSION_ACK")[-1].type == M.MAV_MISSION_ACCEPTED
+
+
+def test_an_auto_mission_far_and_high_stops_at_the_fence() -> None:
+    pilot = _fenced(alt_max_m=30.0, radius_m=50.0)
+    home = pilot.sitl.config.home
+    far = GeoPoint(home.lat_deg + 0.018, home.lon_deg, 0)  # 2 km north, 500 m up
+    rel = M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
+    _upload(
+        pilot,
+        [(M.MAV_CMD_NAV_TAKEOFF, rel, 0, 0, 10.0), (16, rel, far.lat_e7, far.lon_e7, 500.0)],
+    )
+    assert pilot.set_mode("GUIDED").result == M.MAV_RESULT_ACCEPTED
+    assert pilot.command(M.MAV_CMD_COMPONENT_ARM_DISARM, 1).result == M.MAV_RESULT_ACCEPTED
+    assert pilot.set_mode("AUTO").result == M.MAV_RESULT_ACCEPTED
+    farthest_m = highest_m = 0.0
+    for _ in range(120):
+        pilot.run(0.5)
+        n, e, d = pilot.sitl.autopilot.state.pos_ned_m
+        farthest_m, highest_m = max(farthest_m, math.hypot(n, e)), max(highest_m, -d)
+    assert any(t.startswith("Fence breached") for t in pilot.statustexts())
+    assert pilot.mode() == RTL
+    # It turned back at the 50 m circle and under the 30 m ceiling, not 2 km away at 500 m.
+    assert farthest_m < 70.0
+    assert highest_m < 32.0
+    pilot.run_until(lambda p: not p.armed, 120, "landing at home")
+
+
+def test_targets_below_ground_are_refused() -> None:
+    pilot = Pilot()
+    pilot.takeoff(10)
+    target_before = pilot.sitl.autopilot.vehicle.target
+    pilot.send(_local_target(pos=(0, 0, 50)))  # 50 m below home
+    assert "below ground" in pilot.statustexts()[-1]
+    pilot.send(
+        M.MAVLink_set_position_target_global_int_message(
+            0, 1, 1, M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT, 0b110111111000,
+            pilot.sitl.config.home.lat_e7, pilot.sitl.config.home.lon_e7, -1e9,
+            0, 0, 0, 0, 0, 0, 0, 0,
+        )
+    )  # fmt: skip
+    assert "below ground" in pilot.statustexts()[-1]
+    assert pilot.sitl.autopilot.vehicle.target == target_before
+    home = pilot.sitl.config.home
+    ack = pilot.command(
+        M.MAV_CMD_DO_REPOSITION, -1, 0, 0, math.nan, home.lat_deg, home.lon_deg, -50
+    )
+    assert ack.result == M.MAV_RESULT_DENIED
+    rel = M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
+    pilot.send(M.MAVLink_mission_count_message(1, 1, 2, 0))
+    pilot.send(M.MAVLink_mission_item_int_message(1, 1, 0, 0, 16, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0))
+    pilot.send(M.MAVLink_mission_item_int_message(1, 1, 1, rel, 16, 0, 1, 0, 0, 0, 0, 0, 0, -5, 0))
+    assert pilot.of_type("MISSION_ACK")[-1].type == M.MAV_MISSION_INVALID_PARAM7
+
+
+def test_reposition_outside_the_fence_is_denied() -> None:
+    pilot = _fenced(alt_max_m=100.0, radius_m=300.0)
+    pilot.takeoff(5)
+    home = pilot.sitl.config.home
+    ack = pilot.command(M.MAV_CMD_DO_REPOSITION, -1, 1, 0, 0, home.lat_deg + 0.01, home.lon_deg, 10)
+    assert ack.result == M.MAV_RESULT_DENIED
+    assert "Fence" in pilot.statustexts()[-1]
+    assert pilot.command(M.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, 500).result != 0
+
+
+def test_sys_status_reports_the_fence_as_arducopter_does() -> None:
+    pilot = Pilot()
+    pilot.run(1.5)
+    status = pilot.latest["SYS_STATUS"]
+    assert status.onboard_control_sensors_present & GEOFENCE
+    assert status.onboard_control_sensors_health & GEOFENCE  # not breached: no "fence breach"
+    assert not status.onboard_control_sensors_enabled & GEOFENCE  # FENCE_ENABLE 0 by default
+    pilot = _fenced(action=0)  # report only: the breach shows in SYS_STATUS
+    pilot.takeoff(5)
+    for _ in range(24):
+        pilot.send(_local_target(vel=(0, 0, -5)))
+        pilot.run(0.5)
+    status = pilot.latest["SYS_STATUS"]
+    assert status.onboard_control_sensors_enabled & GEOFENCE
+    assert not status.onboard_control_sensors_health & GEOFENCE
+    assert pilot.mode() == 4  # still GUIDED: FENCE_ACTION 0 only reports
