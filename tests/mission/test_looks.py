@@ -144,5 +144,7 @@ def test_other_hues_and_matches_get_one_look(paper_flight: Flown) -> None:
 def test_look_parameters_are_settable_and_checked() -> None:
     params = with_overrides(Params(), {"mission.max_looks": "1", "mission.recheck_climb_m": "5"})
     assert params.mission.max_looks == 1 and params.mission.recheck_climb_m == 5.0
-    with pytest.raises(InputError, match=r"mission\.max_looks=0: expected an integer in \[1, 100\]"):
+    with pytest.raises(
+        InputError, match=r"mission\.max_looks=0: expected an integer in \[1, 100\]"
+    ):
         scenes.with_mission(max_looks=0)

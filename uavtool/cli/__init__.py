@@ -27,6 +27,7 @@ _COMMANDS: tuple[tuple[str, str], ...] = (
     ("uavtool.cli.scene", "scene"),
     ("uavtool.cli.vision", "vision"),
     ("uavtool.cli.view", "view"),
+    ("uavtool.cli.sweep", "sweep"),
 )
 
 

@@ -53,6 +53,13 @@ from uavtool.errors import FailureError, InputError
     "first difference). --out keeps the new recording.",
 )
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar.")
+@click.option(
+    "--scheduler",
+    default=None,
+    metavar="ADDRESS",
+    help="Many recordings: use this Dask scheduler (default: a local cluster).",
+)
+@click.option("--workers", type=int, default=None, help="Many recordings: local worker processes.")
 def replay(
     recording: Path,
     check: bool,
@@ -63,6 +70,8 @@ def replay(
     update_golden: bool,
     refly: bool,
     quiet: bool,
+    scheduler: str | None,
+    workers: int | None,
 ) -> None:
     """Feed RECORDING's observations to a fresh mission and compare every output.
 
@@ -72,7 +81,25 @@ def replay(
       uavtool replay recordings/golden/paper.mcap --set recognize.threshold=0.9
       uavtool replay flight.mcap --set vectorize.rdp_epsilon_px=3 --out replayed.mcap
       uavtool replay --refly recordings/golden/paper.mcap   # vehicle, renderer and mission
+      uavtool replay --check recordings/golden --out check.parquet  # a folder or a glob, on Dask
     """
+    from uavtool.cli.replay_batch import is_batch, replay_batch
+
+    if is_batch(recording):  # a folder or a glob: many recordings on Dask, one table
+        if refly or update_golden:
+            raise click.UsageError("--refly and --update-golden take one recording")
+        replay_batch(
+            recording,
+            check=check,
+            settings=settings,
+            params_file=params_file,
+            vision_only=vision_only,
+            out=out,
+            scheduler=scheduler,
+            workers=workers,
+            quiet=quiet,
+        )
+        return
     from uavtool.mission.params import parse_settings, with_overrides
     from uavtool.recording.files import refuse_same_file
     from uavtool.replay import load_flight, reanalyse_frames

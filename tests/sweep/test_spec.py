@@ -1,0 +1,104 @@
+"""Sweep specs: what a spec expands to, and bad specs named by their key path (exit 2)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from uavtool.cli import cli
+from uavtool.sweep import SpecError, load_spec, plan_flights
+from uavtool.sweep.plan import dimension_keys
+
+
+def write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "spec.toml"
+    path.write_text(text)
+    return path
+
+
+def test_scenes_grid_and_draws_multiply(tmp_path: Path) -> None:
+    spec = load_spec(
+        write(
+            tmp_path,
+            """
+            [scenes]
+            builtin = ["paper", "arch"]
+            hard = { seeds = { first = 5, count = 3 }, max_buildings = 6 }
+            [grid]
+            seed = [0, 1]
+            "set.recognize.threshold" = { from = 0.7, to = 0.8, step = 0.05 }
+            [random]
+            draws = 2
+            wind_speed_ms = { uniform = [0, 8] }
+            param.WPNAV_SPEED = { choice = [500, 800] }
+            """,
+        )
+    )
+    flights = plan_flights(spec)
+    assert len(flights) == (2 + 3) * (2 * 3) * 2
+    assert [f.index for f in flights] == list(range(len(flights)))
+    assert flights[0].label == "paper" and flights[-1].label == "hard:7"
+    assert flights[0].settings() == {"recognize.threshold": "0.7"}
+    assert flights[0].vehicle_params()[0][0] == "WPNAV_SPEED"
+    assert "set.recognize.threshold" in dimension_keys(spec)
+    # Draws depend on the spec alone, and on each flight's own place in it: the same again,
+    # and a scene added before leaves the other scenes' draws as they were.
+    assert [f.inputs for f in plan_flights(spec)] == [f.inputs for f in flights]
+    more = plan_flights(load_spec(tmp_path / "spec.toml", ['scenes.builtin=["dense", "paper"]']))
+    for label in ("paper", "hard:5"):
+        assert [(f.inputs, f.key) for f in more if f.label == label] == [
+            (f.inputs, f.key) for f in flights if f.label == label
+        ]
+
+
+def test_a_changed_input_is_a_new_flight_key(tmp_path: Path) -> None:
+    a = plan_flights(load_spec(write(tmp_path, "[grid]\nseed = [1]\n")))[0]
+    b = plan_flights(load_spec(write(tmp_path, "[grid]\nseed = [2]\n")))[0]
+    assert a.stem.startswith("000000-paper-") and a.key != b.key
+
+
+@pytest.mark.parametrize(
+    ("text", "overrides", "where"),
+    [
+        ('[grid]\nwind_speed_ms = [0, "fast"]\n', [], "grid.wind_speed_ms[1]: expected a number"),
+        ('[grid]\n"set.recognize.treshold" = [0.7]\n', [], "grid.set.recognize.treshold: "),
+        ("[grid]\nset.recognize.threshold = [2]\n", [], "grid.set.recognize.threshold[0]"),
+        ("[grid]\nparam.NOPE = [1]\n", [], "grid.param.NOPE: the built-in vehicle has no"),
+        ("[grid]\naltitude = [1]\n", [], "grid.altitude: unknown flight input"),
+        ('[scenes]\nbuiltin = ["nowhere"]\n', [], "scenes.builtin[0]: no built-in scene"),
+        ('[scenes]\nfiles = ["missing.yaml"]\n', [], "scenes.files[0]: "),
+        (
+            "[scenes.hard]\nseeds = [1]\nmirror_decoy_p = 2.0\n",
+            [],
+            "scenes.hard[0]: mirror_decoy_p",
+        ),
+        ("[scenes.hard]\nseeds = [1]\ncolour = 2\n", [], "scenes.hard[0].colour: unknown key"),
+        ("[random]\nwind_from_deg = { gaussian = [0, 1] }\n", [], "random.wind_from_deg: expected"),
+        ("[random]\nseed = { uniform = [0, 9] }\n", [], "random.seed: drew"),
+        ('[sweep]\nformat = "xlsx"\n', [], "sweep.format: expected 'parquet' or 'csv'"),
+        ("[grid\nseed = 1\n", [], "not valid TOML"),
+        ("", ["grid.seed=[-1]"], "grid.seed[0]: expected a whole number ≥ 0"),
+        ("[grid]\nseed = [1]\n[random]\nseed = 3\n", [], "random.seed: already a grid dimension"),
+    ],
+)
+def test_a_bad_spec_exits_2_naming_the_key_path(
+    tmp_path: Path, text: str, overrides: list[str], where: str
+) -> None:
+    path = write(tmp_path, text)
+    args = ["sweep", str(path), "--out", str(tmp_path / "out")]
+    for o in overrides:
+        args += ["-o", o]
+    result = CliRunner().invoke(cli, args)
+    assert result.exit_code == 2, result.output
+    assert f"{path}: {where}" in result.output or where in result.output
+    assert "Traceback" not in result.output
+    assert not (tmp_path / "out").exists()
+
+
+def test_spec_error_carries_the_key_path(tmp_path: Path) -> None:
+    with pytest.raises(SpecError) as info:
+        load_spec(write(tmp_path, "[grid]\nnoise = [1]\n"))
+    assert info.value.key_path == "grid.noise[0]"
+    assert info.value.exit_code == 2

@@ -1,0 +1,84 @@
+"""``uavtool replay DIR_OR_GLOB``: the batch half of ``uavtool replay`` (many recordings on
+Dask, one table row each). Not a command of its own: ``uavtool.cli.replay`` hands over here
+when its argument is a folder or a glob."""
+
+from __future__ import annotations
+
+import sys
+from datetime import UTC, datetime
+from pathlib import Path
+
+import click
+
+_GLOB = set("*?[")
+
+
+def is_batch(recording: Path) -> bool:
+    """A folder or a glob pattern: many recordings."""
+    return recording.is_dir() or bool(_GLOB & set(str(recording)))
+
+
+def replay_batch(
+    pattern: Path,
+    *,
+    check: bool,
+    settings: tuple[str, ...],
+    params_file: Path | None,
+    vision_only: bool,
+    out: Path | None,
+    scheduler: str | None,
+    workers: int | None,
+    quiet: bool,
+) -> None:
+    """Replay every recording; write the table (``--out``, ``.parquet`` or ``.csv``) and its
+    summary beside it; exit 1 under ``--check`` unless every one is identical."""
+    from uavtool.cli.replay import _params_file
+    from uavtool.mission.params import parse_settings
+    from uavtool.sweep.progress import format_progress
+    from uavtool.sweep.replay import (
+        IDENTICAL,
+        find_recordings,
+        format_replay_summary,
+        replay_many,
+        write_replay_table,
+    )
+
+    paths = find_recordings(str(pattern))
+    overrides: dict[str, object] = _params_file(params_file) if params_file is not None else {}
+    overrides.update(parse_settings(settings))
+    table = out if out is not None else _default_table()
+    if table.suffix not in (".parquet", ".csv"):
+        raise click.BadParameter(
+            f"{table}: with many recordings, --out names the table: .parquet or .csv",
+            param_hint="--out",
+        )
+
+    def draw(text: str) -> None:
+        if not quiet and sys.stderr.isatty():
+            click.echo(f"\r\x1b[2K{text}", nl=False, err=True)
+
+    batch = replay_many(
+        paths,
+        overrides=overrides,
+        vision_only=vision_only,
+        scheduler=scheduler,
+        workers=workers,
+        progress=lambda p: draw(format_progress(p, noun="recordings")),
+    )
+    if not quiet and sys.stderr.isatty():
+        click.echo(err=True)
+    write_replay_table(batch, table)
+    text = format_replay_summary(batch, total=len(paths), changed_params=bool(overrides))
+    table.with_suffix(".txt").write_text(text + "\n", encoding="utf-8")
+    click.echo(text)
+    click.echo(f"table          {table}")
+    if batch.interrupted:
+        sys.exit(130)
+    whole = all(r.get("result") == IDENTICAL and r.get("status_before") for r in batch.rows)
+    if check and not vision_only and not whole:
+        sys.exit(1)
+
+
+def _default_table() -> Path:
+    stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
+    return Path("replays") / f"{stamp}.parquet"

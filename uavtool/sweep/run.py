@@ -1,0 +1,168 @@
+"""A sweep from spec to table: plan the flights, skip those already whole (``--resume``), fly
+the rest as Dask tasks, and write the table, the summary and the plots.
+
+Dask does the scheduling, the retries (a task that raised outside its flight is re-run
+``retries`` times; a task whose worker died is re-run elsewhere by the scheduler) and the
+completion order; the table is sorted by flight, so it does not depend on either.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from uavtool.sweep.cluster import open_client
+from uavtool.sweep.errors import OutputExistsError
+from uavtool.sweep.layout import SweepLayout
+from uavtool.sweep.plan import FlightSpec, dimension_keys, plan_flights
+from uavtool.sweep.plots import PlotsUnavailableError, write_plots
+from uavtool.sweep.progress import Progress, ProgressCallback
+from uavtool.sweep.spec import SweepSpec, TableFormat
+from uavtool.sweep.summary import Summary, format_summary, summarise
+from uavtool.sweep.table import to_table, write_table
+from uavtool.sweep.task import ERROR, error_columns, input_row, run_flight
+
+
+@dataclass(frozen=True, slots=True)
+class SweepResult:
+    root: Path
+    table: Path
+    rows: tuple[dict[str, Any], ...]
+    """In flight order; fewer than planned when interrupted."""
+    flown: int
+    resumed: int
+    interrupted: bool
+    summary: Summary
+    summary_text: str
+    plots: tuple[Path, ...]
+    plots_note: str
+    """Why there are no plots (matplotlib missing), or empty."""
+
+
+def run_sweep(
+    spec: SweepSpec,
+    *,
+    exit_codes: Mapping[str, int],
+    out: Path | None = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    resume: bool = False,
+    plots: bool = True,
+    progress: ProgressCallback | None = None,
+) -> SweepResult:
+    """Fly every flight of ``spec``. ``exit_codes`` maps a mission status to the exit code
+    ``uavtool fly`` gives it (a table column). Raises SpecError, OutputExistsError, or
+    InputError for an unreachable scheduler; Ctrl-C returns what was done (``interrupted``)."""
+    flights = plan_flights(spec)
+    input_keys = dimension_keys(spec)
+    layout = SweepLayout(out if out is not None else spec.out)
+    if layout.holds_sweep() and not resume:
+        raise OutputExistsError(
+            f"{layout.root} already holds a sweep: add --resume to continue it, or choose "
+            "another --out"
+        )
+    layout.root.mkdir(parents=True, exist_ok=True)
+    layout.remove_partials()
+    layout.spec.write_text(spec.text, encoding="utf-8")
+    rows: dict[int, dict[str, Any]] = {}
+    if resume:
+        rows = {f.index: r for f in flights if (r := layout.finished_row(f)) is not None}
+    todo = [f for f in flights if f.index not in rows]
+    resumed = len(rows)
+    interrupted = False
+    if todo:
+        try:
+            _fly_all(todo, rows, layout, spec, input_keys, exit_codes, scheduler, workers, progress)
+        except KeyboardInterrupt:
+            interrupted = True
+        layout.remove_partials()  # the workers are gone: what they left half-written
+    return _finish(spec, layout, flights, rows, input_keys, resumed, interrupted, plots)
+
+
+def _fly_all(
+    todo: list[FlightSpec],
+    rows: dict[int, dict[str, Any]],
+    layout: SweepLayout,
+    spec: SweepSpec,
+    input_keys: tuple[str, ...],
+    exit_codes: Mapping[str, int],
+    scheduler: str | None,
+    workers: int | None,
+    progress: ProgressCallback | None,
+) -> None:
+    from distributed import as_completed  # noqa: PLC0415
+
+    total, skipped = len(todo) + len(rows), len(rows)
+    report = progress or (lambda _p: None)
+    report(Progress(0, total, skipped))
+    with open_client(scheduler, workers=workers) as client:
+        t0 = time.perf_counter()
+        futures = {
+            client.submit(
+                run_flight,
+                flight,
+                str(layout.root.resolve()),
+                input_keys=input_keys,
+                exit_codes=dict(exit_codes),
+                key=f"flight-{flight.stem}",
+                retries=spec.retries,
+            ): flight
+            for flight in todo
+        }
+        done = errors = 0
+        try:
+            for future in as_completed(futures):
+                flight = futures.pop(future)
+                try:
+                    row = future.result()
+                except Exception as exc:  # out of retries: a row with the error
+                    row = input_row(flight, input_keys) | error_columns(exc)
+                rows[flight.index] = row
+                done += 1
+                errors += row.get("status") == ERROR
+                report(Progress(done, total, skipped, errors, time.perf_counter() - t0))
+        finally:
+            client.cancel(list(futures))
+
+
+def _finish(
+    spec: SweepSpec,
+    layout: SweepLayout,
+    flights: list[FlightSpec],
+    rows: dict[int, dict[str, Any]],
+    input_keys: tuple[str, ...],
+    resumed: int,
+    interrupted: bool,
+    plots: bool,
+) -> SweepResult:
+    ordered = tuple(rows[i] for i in sorted(rows))
+    extension = "csv" if spec.table_format is TableFormat.CSV else "parquet"
+    table = layout.table(extension)
+    write_table(to_table(ordered, input_keys), table)
+    summary = summarise(ordered, input_keys=input_keys, planned=len(flights))
+    text = format_summary(summary)
+    layout.summary.write_text(text + "\n", encoding="utf-8")
+    layout.summary_json.write_text(json.dumps(summary.to_json(), indent=1) + "\n")
+    written: tuple[Path, ...] = ()
+    note = ""
+    if plots:
+        try:
+            written = write_plots(summary, layout.plots)
+        except PlotsUnavailableError as exc:
+            note = str(exc)
+    return SweepResult(
+        root=layout.root,
+        table=table,
+        rows=ordered,
+        flown=len(ordered) - resumed,
+        resumed=resumed,
+        interrupted=interrupted,
+        summary=summary,
+        summary_text=text,
+        plots=written,
+        plots_note=note,
+    )

@@ -1,0 +1,122 @@
+"""One flight as a Dask task: fly it in lockstep on the built-in vehicle, judge it against the
+scene, and leave its recording and result row in the sweep's folder (each renamed into place
+whole). A flight that raises is a row with its error; only trouble outside the flight (a full
+disk) escapes, for Dask to retry."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import time
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from uavtool.errors import UavtoolError
+from uavtool.sweep.layout import SweepLayout, part_path, write_atomic
+from uavtool.sweep.plan import FlightSpec
+from uavtool.sweep.scenes import load_source_scene
+
+ERROR = "error"
+"""The status of a flight that raised."""
+
+
+def run_flight(
+    flight: FlightSpec,
+    root: str,
+    *,
+    input_keys: tuple[str, ...],
+    exit_codes: Mapping[str, int],
+) -> dict[str, Any]:
+    """Fly ``flight`` into the sweep folder ``root``; its result row (JSON types only)."""
+    layout = SweepLayout(Path(root))
+    recording = layout.recording(flight)
+    recording.parent.mkdir(parents=True, exist_ok=True)
+    part = part_path(recording)
+    wall0 = time.perf_counter()
+    row = input_row(flight, input_keys)
+    try:
+        row.update(_fly(flight, part, row, exit_codes))
+    except Exception as exc:  # a flight that raises is a row, not a lost sweep
+        row.update(error_columns(exc))
+    row["wall_s"] = time.perf_counter() - wall0
+    row["worker"] = _worker_name()
+    if part.exists():
+        row["recording"] = layout.relative(recording)
+        row["recording_bytes"] = part.stat().st_size
+    # The row first: a recording in place always has its row (resume trusts the pair).
+    write_atomic(layout.row(flight), json.dumps(row, sort_keys=True).encode())
+    if part.exists():
+        part.replace(recording)
+    return row
+
+
+def input_row(flight: FlightSpec, input_keys: tuple[str, ...]) -> dict[str, Any]:
+    row: dict[str, Any] = {"flight": flight.index, "key": flight.key, "scene": flight.label}
+    for key in input_keys:
+        value = flight.value(key)
+        row[key] = json.dumps(value) if isinstance(value, (list, tuple)) else value
+    return row | {"recording": None, "recording_bytes": None}
+
+
+def error_columns(exc: BaseException) -> dict[str, Any]:
+    code = exc.exit_code if isinstance(exc, UavtoolError) else 1
+    return {"status": ERROR, "exit_code": code, "error": f"{type(exc).__name__}: {exc}"}
+
+
+def _fly(
+    flight: FlightSpec, record: Path, row: dict[str, Any], exit_codes: Mapping[str, int]
+) -> dict[str, Any]:
+    from uavtool.mission.params import Params, with_overrides  # noqa: PLC0415
+    from uavtool.runner.fly import FlyConfig, fly  # noqa: PLC0415
+    from uavtool.sweep.scores import recognition_scores  # noqa: PLC0415
+
+    scene = load_source_scene(flight.scene, flight.scene_seed)
+    heading = flight.value("home_heading_deg")
+    if heading is not None:
+        scene = dataclasses.replace(scene, home_heading_deg=float(heading))
+    row["home_heading_deg"] = scene.home_heading_deg
+    config = FlyConfig(
+        scene=scene,
+        record=record,
+        params=with_overrides(Params(), flight.settings()),
+        vehicle_params=flight.vehicle_params(),
+        seed=int(flight.value("seed")),
+        noise=bool(flight.value("noise")),
+        wind=(float(flight.value("wind_speed_ms")), float(flight.value("wind_from_deg"))),
+        link_outages_s=flight.link_outages_s(),
+    )
+    s = fly(config)
+    o, e = s.outcome, s.evaluation
+    scores = recognition_scores(record, scene)
+    return {
+        "status": o.status.value,
+        "exit_code": exit_codes.get(o.status.value),
+        "reason": o.reason,
+        "error": None,
+        "target_building": scene.target,
+        "matched_building": e.matched_building or None,
+        "correct": bool(e.matched_building) and e.matched_building == scene.target,
+        "match_score": o.match_score if o.matched_poi >= 0 else None,
+        "target_score": scores.target,
+        "other_score": scores.other,
+        "margin": scores.margin,
+        "model_built": o.model_built,
+        "iou": e.model_iou,
+        "tunnel_kept": e.tunnel_kept,
+        "clearance_m": s.clearance_m,
+        "closest_building": s.clearance_building or None,
+        "flight_time_s": s.flight_time_s,
+        "vehicle_time_s": s.vehicle_time_s,
+        "route_length_m": s.route_length_m,
+        "frames": s.frames,
+    }
+
+
+def _worker_name() -> str:
+    try:
+        from distributed import get_worker  # noqa: PLC0415
+
+        return str(get_worker().name)
+    except (ImportError, ValueError):
+        return "in-process"
