@@ -229,6 +229,8 @@ def summarise(name: str, results: list[Result]) -> dict[str, Any]:
         "none_seeds": [r.seed for r in results if not r.matched],
         "crash_seeds": [r.seed for r in crashes],
         "no_model_seeds": [r.seed for r in correct if not r.model],
+        "below_margin_seeds": [r.seed for r in results if r.clearance_m < SAFETY_MARGIN_M],
+        "tunnel_lost_seeds": [r.seed for r in tunnels if not r.tunnel],
         "statuses": _count(r.status.split(":")[0] for r in results),
     }
 
@@ -268,7 +270,15 @@ def report(rows: list[dict[str, Any]]) -> None:
     line("wall time, all flights (s)", [f"{r['wall_s']:.0f}" for r in rows])
     for r in rows:
         print(f"\n  {r['name']}: outcomes {r['statuses']}")
-        for key in ("wrong_seeds", "mirror_seeds", "none_seeds", "crash_seeds", "no_model_seeds"):
+        for key in (
+            "wrong_seeds",
+            "mirror_seeds",
+            "none_seeds",
+            "crash_seeds",
+            "no_model_seeds",
+            "below_margin_seeds",
+            "tunnel_lost_seeds",
+        ):
             if r[key]:
                 print(
                     f"    {key.replace('_', ' ')}: {r[key][:40]}{' …' if len(r[key]) > 40 else ''}"

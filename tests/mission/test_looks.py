@@ -16,6 +16,7 @@ from uavtool.mission import GoTo, Params, Photo, Plan, Recognition, Shapes, Stat
 from uavtool.mission.analysis import nadir_shapes
 from uavtool.mission.params import with_overrides
 from uavtool.world import Scene, building_footprint, render
+from uavtool.world.hard import generate_hard_scene_with_info
 
 K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
 
@@ -148,3 +149,24 @@ def test_look_parameters_are_settable_and_checked() -> None:
         InputError, match=r"mission\.max_looks=0: expected an integer in \[1, 100\]"
     ):
         scenes.with_mission(max_looks=0)
+
+
+def test_a_roof_of_unknown_height_is_looked_at_again_from_closer() -> None:
+    """Hard scene 89: the target, a stepped T 40 m out, is cut by the border of the lower
+    overview photo, so its roof height is unknown and assumed the tallest expected (25 m):
+    its looks are taken from so high that it scores just below the threshold. Two photos of
+    it give its roof's height, and the next look, from the altitude that fits it, matches."""
+    scene, info = generate_hard_scene_with_info(seed=89)
+    flown = fly(scene)
+    flight = flown.flight
+    assert flight.outcome.status is Status.COMPLETED, flight.outcome.reason
+    (plan,) = flight.of_type(Plan)
+    target = building_footprint(scene.building(info.target))
+    poi = plan.pois[flight.outcome.matched_poi]
+    assert not poi.roof_measured
+    looks = _looks(flight, poi.index)
+    assert len(looks) >= 2 and not looks[0][1].matched and looks[-1][1].matched
+    alts = [photo.pose.pos_enu_m[2] for photo, _ in looks]
+    assert alts[-1] < min(alts[:-1]) - 5.0  # the matching look is the closer one
+    x, y, _ = looks[-1][0].pose.pos_enu_m  # the matching look is taken over the target
+    assert target.distance(shapely.Point(x, y)) < 1.0

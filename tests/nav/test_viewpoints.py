@@ -261,7 +261,7 @@ def test_diagonal_looks_across_the_corner_between_front_and_right() -> None:
     that direction (its diagonal, 10·cos45° + 8·cos45°)."""
     front, right = plan([])
     assert isinstance(front, Viewpoint) and isinstance(right, Viewpoint)
-    diag = plan_diagonal(BOX, front, right, [], K, P)
+    diag = plan_diagonal(BOX, front.pos_enu_m, right.pos_enu_m, [], K, P)
     assert isinstance(diag, Viewpoint), diag
     assert diag.name == "diagonal" and diag.heading_deg == pytest.approx(315.0)
     across = (10.0 + 8.0) / math.sqrt(2.0)
@@ -276,11 +276,13 @@ def test_diagonal_blocked_goes_behind_both_cameras() -> None:
     front, right = plan([])
     assert isinstance(front, Viewpoint) and isinstance(right, Viewpoint)
     wall = square(9.0, -9.0, 1.0)  # between the box's south-east corner and that camera
-    diag = plan_diagonal(BOX, front, right, [wall], K, P)
+    diag = plan_diagonal(BOX, front.pos_enu_m, right.pos_enu_m, [wall], K, P)
     assert isinstance(diag, Viewpoint), diag
     assert diag.fallback == "behind the front and right cameras"
     assert diag.heading_deg == pytest.approx(135.0)  # from the north-west, looking south-east
     boxed = [square(x, y, 3.0) for x in (-17.0, 17.0) for y in (-17.0, 17.0)]  # every diagonal
-    failure = plan_diagonal(BOX, front, right, boxed, K, ViewpointParams(max_distance_m=30.0))
+    failure = plan_diagonal(
+        BOX, front.pos_enu_m, right.pos_enu_m, boxed, K, ViewpointParams(max_distance_m=30.0)
+    )
     assert isinstance(failure, ViewpointFailure)
     assert failure.reason.startswith("diagonal: between the front and right cameras: ")

@@ -31,3 +31,22 @@ def test_colour_tolerance_joins_noisy_roofs_and_keeps_other_colours_apart() -> N
     assert out[1] is c and out[2] is d  # untouched shapes keep their own colours
     assert merge_touching((a, b, c, d), gap_px=6.0) == (a, b, c, d)  # exact colours only
     assert len(merge_touching((a, b), gap_px=6.0, colour_tolerance_dn=2.0)) == 2
+
+
+def test_a_wall_strip_is_no_courtyard() -> None:
+    """From above, the wall around a higher block shows as a thin strip of another colour
+    inside the lower roof: a hole thinner than the gap is filled; a courtyard is kept."""
+    ring = np.array([[0, 0], [200, 0], [200, 120], [0, 120]], dtype=np.float64)
+    strip = np.array([[40, 60], [160, 60], [160, 63], [40, 63]], dtype=np.float64)  # 3 px
+    yard = np.array([[60, 20], [140, 20], [140, 50], [60, 50]], dtype=np.float64)  # 30 px
+    roof = Shape.from_rings(colour_rgb=(197, 38, 38), polygon_px=ring, holes_px=(strip, yard))
+    (out,) = merge_touching((roof,), gap_px=6.0)
+    assert len(out.holes_px) == 1 and out.holes_px[0].min(axis=0).tolist() == [60.0, 20.0]
+    assert out.area_px == roof.area_px + 120 * 3
+    # the same for a strip left between two merged roofs
+    a = _rect(0, 0, 100, 50, (197, 38, 38))
+    b = _rect(103, 0, 150, 50, (197, 38, 38))
+    (merged,) = merge_touching((a, b), gap_px=6.0)
+    assert merged.holes_px == ()
+    plain = Shape.from_rings(colour_rgb=(197, 38, 38), polygon_px=ring)
+    assert merge_touching((plain,), gap_px=6.0) == (plain,)

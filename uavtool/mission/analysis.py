@@ -97,3 +97,25 @@ def roof_between(a: Shape, photo_a: Photo, b: Shape, photo_b: Photo) -> float | 
         intrinsics=photo_a.intrinsics,
     )
     return None if roof is None else max(roof, 0.0)
+
+
+_EDGE_PX = 1.0  # an outline this close to the frame's edge touches it
+
+
+def cut_edges(silhouette: tuple[Shape, ...], k: Intrinsics) -> set[str]:
+    """Which edges of the frame (``top``, ``bottom``, ``left``, ``right``) the silhouette's
+    outlines touch."""
+    edges: set[str] = set()
+    for shape in silhouette:
+        if not shape.cut_by_border:
+            continue
+        us, vs = shape.polygon_px[:, 0], shape.polygon_px[:, 1]
+        for edge, touches in (
+            ("left", float(us.min()) <= _EDGE_PX),
+            ("right", float(us.max()) >= k.width_px - 1 - _EDGE_PX),
+            ("top", float(vs.min()) <= _EDGE_PX),
+            ("bottom", float(vs.max()) >= k.height_px - 1 - _EDGE_PX),
+        ):
+            if touches:
+                edges.add(edge)
+    return edges

@@ -1,6 +1,6 @@
 """The photos for the model and the model: the top photo from an altitude that fits the
-building, the front and right photos from planned viewpoints (backing away while the building
-touches the border), a diagonal photo when the model is open underneath, and the model."""
+building, the front and right photos from planned viewpoints (:mod:`uavtool.mission.sides`),
+a diagonal photo when the model is open underneath, and the model."""
 
 from __future__ import annotations
 
@@ -11,7 +11,13 @@ from typing import TYPE_CHECKING
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import DiagonalView, Level, ModelBuilt, Viewpoints
 from uavtool.mission.search import Found, photo_shapes
-from uavtool.mission.survey import Survey, obstacles_around, remeasured_obstacles
+from uavtool.mission.sides import SidePlan, side_view
+from uavtool.mission.survey import (
+    Survey,
+    beyond_the_frame,
+    obstacles_around,
+    remeasured_obstacles,
+)
 from uavtool.nav import (
     Viewpoint,
     ViewpointFailure,
@@ -21,7 +27,6 @@ from uavtool.nav import (
     plan_viewpoints,
     top_viewpoint,
 )
-from uavtool.nav.geometry import point_polygon_distance
 from uavtool.nav.heights import fit_altitude_m
 from uavtool.vision.errors import VisionError
 from uavtool.vision.model3d import (
@@ -31,14 +36,10 @@ from uavtool.vision.model3d import (
     central_shape,
     model_glb,
     open_beneath,
-    same_colour,
 )
 
 if TYPE_CHECKING:
     from uavtool.mission.mission import Mission, Wait
-
-# Hue window for "the same building" in the side photos (walls are shaded darker than roofs).
-_SIDE_HUE_TOLERANCE_DEG = 15.0
 
 
 def photograph_and_model(m: Mission, found: Found, seen: Survey, transit_m: float) -> Wait[None]:
@@ -96,17 +97,20 @@ def photograph_and_model(m: Mission, found: Found, seen: Survey, transit_m: floa
     m.viewpoints = Viewpoints(footprint, top, front, right)
     m.emit(m.viewpoints)
 
+    # Backing away must keep clear of the survey's cautious footprints too: a neighbour
+    # measured again may have been paired with the wrong roof.
+    sides = SidePlan(
+        rect, obstacles, obstacles + others, beyond_the_frame(seen), k, vp_params, transit_m
+    )
     views: dict[str, View] = {}
+    taken: dict[str, Viewpoint] = {}
     for vp in (front, right):
         if isinstance(vp, ViewpointFailure):
             m.event(Level.WARNING, f"{vp.name} viewpoint impossible: {vp.reason}")
             continue
         if vp.fallback:
             m.event(Level.INFO, f"{vp.name} viewpoint: {vp.fallback}")
-        # Backing away must keep clear of the survey's cautious footprints too: a neighbour
-        # measured again may have been paired with the wrong roof.
-        cautious = obstacles + others
-        views[vp.name] = yield from _side_view(m, vp, obj.colour_rgb, cautious, transit_m)
+        views[vp.name], taken[vp.name] = yield from side_view(m, sides, vp, obj.colour_rgb)
 
     missing = [name for name in ("front", "right") if name not in views]
     if missing:
@@ -120,16 +124,14 @@ def photograph_and_model(m: Mission, found: Found, seen: Survey, transit_m: floa
         m.no_model = str(exc)
         m.event(Level.ERROR, f"model not built: {exc}")
         return
-    if isinstance(front, Viewpoint) and isinstance(right, Viewpoint):
-        model = yield from _diagonal(
-            m,
-            model,
-            (top_view, views["front"], views["right"]),
-            plan_diagonal(rect, front, right, obstacles, k, vp_params),
-            colour_rgb=obj.colour_rgb,
-            cautious=obstacles + others,
-            transit_m=transit_m,
-        )
+    model = yield from _diagonal(
+        m,
+        model,
+        (top_view, views["front"], views["right"]),
+        sides,
+        (taken["front"].pos_enu_m, taken["right"].pos_enu_m),
+        obj.colour_rgb,
+    )
     mesh = model.mesh
     m.model = ModelBuilt(
         tuple(tuple(v) for v in mesh.vertices.tolist()),
@@ -150,19 +152,26 @@ def _diagonal(
     m: Mission,
     model: Model,
     views: tuple[View, View, View],
-    diagonal: Viewpoint | ViewpointFailure,
-    *,
+    sides: SidePlan,
+    cameras: tuple[tuple[float, float, float], tuple[float, float, float]],
     colour_rgb: tuple[int, int, int],
-    cautious: list[tuple[tuple[float, float], ...]],
-    transit_m: float,
 ) -> Wait[Model]:
-    """``model`` (from the top, front and right ``views``), carved by a photo from the
-    ``diagonal`` viewpoint when the side photos saw through under the building: two
-    square-on views cannot see through every part of an opening (the corner of an L-shaped
-    arch stands on no pillar, yet hides behind one from both sides)."""
+    """``model`` (from the top, front and right ``views``), carved by a photo from a diagonal
+    when the side photos saw through under the building: two square-on views cannot see
+    through every part of an opening (the corner of an L-shaped arch stands on no pillar,
+    yet hides behind one from both sides). ``cameras``: the viewpoints the front and right
+    photos were taken from."""
     share = open_beneath(model, ground_z_m=m.params.model.ground_z_m)
     if share < m.params.mission.diagonal_open_beneath:
         return model
+    diagonal = plan_diagonal(
+        sides.rect,
+        cameras[0],
+        cameras[1],
+        sides.obstacles + sides.unknown,
+        sides.intrinsics,
+        sides.params,
+    )
     m.emit(DiagonalView(share, diagonal))
     if isinstance(diagonal, ViewpointFailure):
         m.event(Level.INFO, f"the model is open under {share:.0%} of it; {diagonal.reason}")
@@ -171,61 +180,12 @@ def _diagonal(
         Level.INFO,
         f"the model is open under {share:.0%} of it: a diagonal photo, {diagonal.fallback}",
     )
-    view = yield from _side_view(m, diagonal, colour_rgb, cautious, transit_m)
+    view, _ = yield from side_view(m, sides, diagonal, colour_rgb, fresh=True)
     try:
         return build_model(*views, m.params.model, more=(view,))
     except VisionError as exc:
         m.event(Level.WARNING, f"diagonal photo not used: {exc}")
         return model
-
-
-def _side_view(
-    m: Mission,
-    vp: Viewpoint,
-    colour_rgb: tuple[int, int, int],
-    obstacles: list[tuple[tuple[float, float], ...]],
-    transit_m: float,
-) -> Wait[View]:
-    """A side photo from ``vp``; while the building touches the image border, the camera
-    backs away from it by half the planned distance and photographs it again (up to
-    ``max_looks`` photos), as long as that keeps the safety margin from every other
-    building."""
-    p = m.params.mission
-    margin_m = m.params.viewpoints.safety_margin_m
-    x, y, z = vp.pos_enu_m
-    h = math.radians(vp.heading_deg)
-    back_x, back_y = -math.sin(h), -math.cos(h)  # the camera looks along the heading
-    step_m = vp.distance_m * 0.5
-    yield from m.travel(
-        (x, y, transit_m), vp.heading_deg, transit_m, f"above the {vp.name} viewpoint"
-    )
-    for attempt in range(1, p.max_looks + 1):
-        yield from m.move((x, y, z), vp.heading_deg, f"{vp.name} viewpoint")
-        photo = yield from m.photo(vp.name if attempt == 1 else f"{vp.name}-{attempt}", 0.0)
-        shapes = photo_shapes(m, photo, nadir=False)
-        silhouette = same_colour(shapes, colour_rgb, hue_tolerance_deg=_SIDE_HUE_TOLERANCE_DEG)
-        if not any(s.cut_by_border for s in silhouette) or attempt == p.max_looks:
-            break
-        nx, ny = x + back_x * step_m, y + back_y * step_m
-        room_m = min((point_polygon_distance((nx, ny), o) for o in obstacles), default=math.inf)
-        if room_m < margin_m:
-            m.event(
-                Level.INFO,
-                f"{vp.name} photo: the building touches the border; no room to back away",
-            )
-            break
-        m.event(
-            Level.INFO,
-            f"{vp.name} photo: the building touches the image border; backing away {step_m:.1f} m",
-        )
-        x, y = nx, ny
-        # Up, across and down again: the way back may pass a building the plan did not know.
-        yield from m.move(
-            (photo.pose.pos_enu_m[0], photo.pose.pos_enu_m[1], transit_m), None, "climb"
-        )
-        yield from m.travel((x, y, z), vp.heading_deg, transit_m, f"{vp.name} viewpoint")
-    yield from m.move((x, y, transit_m), vp.heading_deg, f"climb from the {vp.name} viewpoint")
-    return View(silhouette, photo.pose, photo.intrinsics)
 
 
 def _below(photo: Photo) -> float:

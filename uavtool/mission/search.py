@@ -16,7 +16,7 @@ from uavtool.camera import Intrinsics
 from uavtool.mission.analysis import Judgement, judge, nadir_shapes, roof_between, side_shapes
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest, Recognition, Shapes, Status, Vec3
-from uavtool.nav import ground_point
+from uavtool.nav import ground_point, ground_polygon
 from uavtool.nav.heights import fit_altitude_m
 from uavtool.vision import Shape
 from uavtool.vision.model3d import central_shape
@@ -89,8 +89,28 @@ def search(
         yield from m.travel((x, y, alt), None, transit_m, f"point of interest {k}")
         m.visited.append(k)
         looks = [(yield from _look(m, k, 1, alt))]
+        roof_m = poi.roof_m
         for n in range(2, p.max_looks + 1):
-            again = _look_again(m, looks[-1], poi.roof_m, ceiling_m)
+            closer = None
+            if not poi.roof_measured:
+                before = [(overview_shapes[poi.shape_index], overview)] + [
+                    (look.shapes[look.judgement.candidate], look.photo)
+                    for look in looks[:-1]
+                    if look.judgement.candidate >= 0
+                ]
+                closer = _closer_look(m, looks[-1], before)
+            if closer is not None:
+                pos, roof_m = closer
+                m.event(
+                    Level.INFO,
+                    f"point of interest {k}: score {looks[-1].judgement.score:.3f} just below "
+                    f"the threshold; its roof measured {roof_m:.1f} m above home: looking "
+                    f"again from closer, at {pos[2]:.1f} m",
+                )
+                yield from m.travel(pos, None, transit_m, f"point of interest {k}, look {n}")
+                looks.append((yield from _look(m, k, n, pos[2])))
+                continue
+            again = _look_again(m, looks[-1], roof_m, ceiling_m)
             if again is None:
                 break
             pos, why = again
@@ -172,6 +192,54 @@ def _look(m: Mission, k: int, n: int, alt_m: float) -> Wait[_Look]:
         f"{'MATCH' if j.matched else 'no match'} (score {j.score:.3f}{why})",
     )
     return _Look(photo, shapes, j, alt_m)
+
+
+def _closer_look(
+    m: Mission, look: _Look, before: list[tuple[Shape, Photo]]
+) -> tuple[Vec3, float] | None:
+    """Where to look again from, lower, and the roof height measured, when the look was
+    taken high over a roof of unknown height (assumed the tallest expected) and its
+    candidate has the target's hue and scores just below the threshold: the candidate,
+    whole in the look and in an earlier photo of it (``before``: the overview's shape, the
+    earlier looks' candidates; the one furthest in altitude that tells), gives its roof's
+    height, and from it the altitude at which it fills the photo as a look should. None
+    when that is not clearly lower (by half ``recheck_climb_m``) or the height cannot be
+    told."""
+    p = m.params.mission
+    j, photo = look.judgement, look.photo
+    if j.matched or j.candidate < 0 or not (j.same_hue and j.judgeable):
+        return None
+    if j.score < p.recheck_min_score:
+        return None
+    shape = look.shapes[j.candidate]
+    alt = photo.pose.pos_enu_m[2]
+    heights = (
+        roof_between(seen, earlier, shape, photo)
+        for seen, earlier in sorted(before, key=lambda b: -abs(b[1].pose.pos_enu_m[2] - alt))
+    )
+    roof = next((h for h in heights if h is not None), None)
+    if roof is None or roof > p.assumed_roof_m:
+        return None
+    k = photo.intrinsics
+    ring = ground_polygon(shape.polygon_px, photo.pose, k, plane_z_m=min(roof, look.alt_m - 1))
+    extent = math.dist(*_farthest_pair(ring))
+    fit = fit_altitude_m(roof_m=roof, extent_m=extent, intrinsics=k, fill=p.look_fill)
+    lower = max(fit, roof + p.min_above_roof_m)
+    if lower > look.alt_m - p.recheck_climb_m / 2.0:
+        return None
+    u, v = shape.centroid_px
+    x, y = ground_point(u, v, photo.pose, k, plane_z_m=min(roof, look.alt_m - 1))
+    return (x, y, lower), roof
+
+
+def _farthest_pair(
+    ring: tuple[tuple[float, float], ...],
+) -> tuple[tuple[float, float], tuple[float, float]]:
+    return max(
+        ((a, b) for i, a in enumerate(ring) for b in ring[i + 1 :]),
+        key=lambda ab: math.dist(*ab),
+        default=((0.0, 0.0), (0.0, 0.0)),
+    )
 
 
 def _look_again(

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from uavtool.camera import Intrinsics
-from uavtool.mission.analysis import roof_between
+from uavtool.mission.analysis import cut_edges, roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
 from uavtool.mission.search import photo_shapes
@@ -158,6 +158,33 @@ def obstacles_around(
     """The survey's footprints of every building but the target (and its other roofs)."""
     own = same_building(m, seen, target)
     return [f for i, f in enumerate(seen.footprints) if i not in own]
+
+
+def beyond_the_frame(seen: Survey) -> list[tuple[tuple[float, float], ...]]:
+    """Where the buildings cut by the overview's border may go on: each one's footprint swept
+    out of the photo across every edge of the frame it touches, as far as any flight goes
+    (1 km)."""
+    photo = seen.photo
+    k = photo.intrinsics
+    centre = ground_point(k.cx_px, k.cy_px, photo.pose, k)
+    edges = {
+        "left": (0.0, k.cy_px),
+        "right": (k.width_px - 1.0, k.cy_px),
+        "top": (k.cx_px, 0.0),
+        "bottom": (k.cx_px, k.height_px - 1.0),
+    }
+    out = []
+    for shape, footprint in zip(seen.shapes, seen.footprints, strict=True):
+        if not shape.cut_by_border or len(footprint) < 3:
+            continue
+        swept = list(footprint)
+        for edge in cut_edges((shape,), k):
+            ex, ey = ground_point(*edges[edge], photo.pose, k)
+            n = math.hypot(ex - centre[0], ey - centre[1])
+            dx, dy = 1000.0 * (ex - centre[0]) / n, 1000.0 * (ey - centre[1]) / n
+            swept += [(x + dx, y + dy) for x, y in footprint]
+        out.append(tuple(convex_hull(swept)))
+    return out
 
 
 def remeasured_obstacles(

@@ -15,6 +15,7 @@ from uavtool.nav.viewpoints import (
     ViewpointFailure,
     ViewpointParams,
     plan_diagonal,
+    plan_towards,
     plan_viewpoints,
     top_viewpoint,
 )
@@ -30,6 +31,7 @@ __all__ = [
     "ground_polygon",
     "min_area_rect",
     "plan_diagonal",
+    "plan_towards",
     "plan_viewpoints",
     "poi_offset",
     "route_length_m",

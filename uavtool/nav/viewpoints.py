@@ -309,24 +309,46 @@ def plan_viewpoints(
     return front, right
 
 
+def plan_towards(
+    name: str,
+    target: Rect,
+    direction_en: tuple[float, float],
+    obstacles: Sequence[Sequence[tuple[float, float]]] | Sequence[Any],
+    intrinsics: Intrinsics,
+    params: ViewpointParams,
+    label: str,
+) -> Viewpoint | ViewpointFailure:
+    """A camera out from ``target``'s centre along ``direction_en`` (east, north; any
+    length), looking back at it, at the first distance where it keeps the safety margin and
+    sees every corner past the obstacles (``label`` becomes its ``fallback`` note)."""
+    n = math.hypot(*direction_en)
+    if not n > 0.0:
+        return ViewpointFailure(name, f"{name}: no direction to look from")
+    polys = [as_points(p, what=f"obstacles[{i}]") for i, p in enumerate(obstacles)]
+    u = (direction_en[0] / n, direction_en[1] / n)
+    found = _from_direction(name, target, u, name, label, polys, intrinsics, params)
+    return found if isinstance(found, Viewpoint) else ViewpointFailure(name, f"{name}: {found}")
+
+
 def plan_diagonal(
     target: Rect,
-    front: Viewpoint,
-    right: Viewpoint,
+    front_en: Sequence[float],
+    right_en: Sequence[float],
     obstacles: Sequence[Sequence[tuple[float, float]]] | Sequence[Any],
     intrinsics: Intrinsics,
     params: ViewpointParams | None = None,
 ) -> Viewpoint | ViewpointFailure:
     """A third side photo, looking at ``target`` across a corner: from halfway between the
-    front and right cameras' directions, else from behind both, else from the two other
-    diagonals. It sees under a building along lines the square-on photos cannot (the corner
-    of an L-shaped arch), so its silhouette carves what theirs leave standing."""
+    directions of the front and right cameras (where they stood, east and north), else from
+    behind both, else from the two other diagonals. It sees under a building along lines
+    the square-on photos cannot (the corner of an L-shaped arch), so its silhouette carves
+    what theirs leave standing."""
     params = params or ViewpointParams()
     polys = [as_points(p, what=f"obstacles[{i}]") for i, p in enumerate(obstacles)]
     cx, cy = target.center_en
     units = []
-    for vp in (front, right):
-        ex, ey = vp.pos_enu_m[0] - cx, vp.pos_enu_m[1] - cy
+    for camera in (front_en, right_en):
+        ex, ey = camera[0] - cx, camera[1] - cy
         n = math.hypot(ex, ey) or 1.0
         units.append((ex / n, ey / n))
     (fx, fy), (rx, ry) = units

@@ -1,6 +1,7 @@
 """Joining the roofs of one building: seen from above, a building whose blocks have different
 heights shows one roof per block, split by a thin strip of wall. Same-coloured shapes closer
-than a gap are merged into one outline (a morphological closing of the polygons). "Same
+than a gap are merged into one outline (a morphological closing of the polygons; what is
+left of the wall strips between them, holes thinner than the gap, is filled too). "Same
 colour" may allow a few levels per channel: a shape's colour is sampled from a few pixels,
 so sensor noise gives two roofs of one building slightly different colours."""
 
@@ -16,10 +17,12 @@ def merge_touching(
     shapes: tuple[Shape, ...], *, gap_px: float, colour_tolerance_dn: float = 0.0
 ) -> tuple[Shape, ...]:
     """Shapes of one colour less than ``gap_px`` apart become one shape (union closed by
-    ``gap_px / 2``, mitred so corners stay sharp); others are returned unchanged, in order.
+    ``gap_px / 2``, mitred so corners stay sharp); others are returned in order, without
+    their holes thinner than the gap (the wall strip around a higher block is a hole in
+    the roof of the lower one).
     Two colours are one when they differ by at most ``colour_tolerance_dn`` in every RGB
     channel (0–255). The merged shape takes the place and the colour of its first member."""
-    if gap_px <= 0.0 or len(shapes) < 2:
+    if gap_px <= 0.0:
         return shapes
     polys = [shapely.Polygon(s.polygon_px, list(s.holes_px)) for s in shapes]
     group = list(range(len(shapes)))
@@ -42,7 +45,7 @@ def merge_touching(
     out: list[Shape] = []
     for first, idx in sorted(members.items()):
         if len(idx) == 1:
-            out.append(shapes[first])
+            out.append(_without_strips(shapes[first], gap_px))
             continue
         half = gap_px / 2.0
         union = shapely.union_all([polys[i].buffer(half, join_style="mitre") for i in idx])
@@ -51,17 +54,34 @@ def merge_touching(
             out.extend(shapes[i] for i in idx)  # did not close into one outline: keep apart
             continue
         closed = closed.simplify(0.5, preserve_topology=True)
+        holes = [r for r in closed.interiors if not _strip(shapely.Polygon(r), gap_px)]
         out.append(
             Shape.from_rings(
                 colour_rgb=shapes[first].colour_rgb,
                 polygon_px=np.asarray(closed.exterior.coords[:-1], dtype=np.float64),
-                holes_px=tuple(
-                    np.asarray(r.coords[:-1], dtype=np.float64) for r in closed.interiors
-                ),
+                holes_px=tuple(np.asarray(r.coords[:-1], dtype=np.float64) for r in holes),
                 cut_by_border=any(shapes[i].cut_by_border for i in idx),
             )
         )
     return tuple(out)
+
+
+def _strip(hole: shapely.Polygon, gap_px: float) -> bool:
+    """A hole thinner on average (twice its area over its perimeter) than the gap: a strip of
+    wall between two roofs of one building, not a courtyard."""
+    return bool(2.0 * hole.area < gap_px * hole.length)
+
+
+def _without_strips(shape: Shape, gap_px: float) -> Shape:
+    holes = tuple(h for h in shape.holes_px if not _strip(shapely.Polygon(h), gap_px))
+    if len(holes) == len(shape.holes_px):
+        return shape
+    return Shape.from_rings(
+        colour_rgb=shape.colour_rgb,
+        polygon_px=shape.polygon_px,
+        holes_px=holes,
+        cut_by_border=shape.cut_by_border,
+    )
 
 
 def _colour_gap_dn(a: tuple[int, int, int], b: tuple[int, int, int]) -> int:

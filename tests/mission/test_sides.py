@@ -1,0 +1,39 @@
+"""Side photos: which edges a silhouette touches, and a building taller than it looked."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from uavtool.camera import Intrinsics
+from uavtool.mission import Status
+from uavtool.mission.analysis import cut_edges
+from uavtool.runner.fly import FlyConfig, fly
+from uavtool.vision import Shape
+
+K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
+
+
+def _box(u0: float, v0: float, u1: float, v1: float) -> Shape:
+    ring = np.array([[u0, v0], [u1, v0], [u1, v1], [u0, v1]], dtype=np.float64)
+    touches = u0 <= 1.0 or v0 <= 1.0 or u1 >= 638.0 or v1 >= 478.0
+    return Shape.from_rings(colour_rgb=(200, 40, 40), polygon_px=ring, cut_by_border=touches)
+
+
+def test_cut_edges() -> None:
+    assert cut_edges((_box(100, 50, 500, 400),), K) == set()
+    assert cut_edges((_box(100, 0, 500, 400),), K) == {"top"}
+    assert cut_edges((_box(0, 0, 500, 479),), K) == {"top", "left", "bottom"}
+    assert cut_edges((_box(100, 50, 639, 400), _box(10, 0, 60, 80)), K) == {"right", "top"}
+
+
+def test_a_stepped_tower_taller_than_its_outline_is_photographed_whole() -> None:
+    """In `tall-spread`, red is a 24 m tower of three L-shaped tiers; seen from above its
+    outline is its lowest tier's, 7.8 m up. The front photo, planned for that, cuts the tower's
+    top: the mission plans it again for a taller building from the same side, and the right
+    photo is planned for that height before it is flown. The model is built."""
+    summary = fly(FlyConfig(scene="tall-spread", no_record=True))
+    o, e = summary.outcome, summary.evaluation
+    assert o.status is Status.COMPLETED, o.reason
+    assert e.matched_building == "red" and o.model_built
+    assert e.model_iou is not None and e.model_iou > 0.55
+    assert summary.clearance_m is not None and summary.clearance_m > 4.0
