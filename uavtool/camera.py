@@ -6,9 +6,14 @@ Conventions
 * Camera frame: OpenCV's — x right, y down, z forward (optical axis).
 * Pixels: OpenCV/ROS convention, pixel ``(i, j)`` has its centre at ``u = i, v = j``;
   the principal point of a W×H image is ``((W-1)/2, (H-1)/2)``.
-* The gimbal is stabilised: the camera's attitude is the vehicle heading plus the gimbal
-  yaw, and the gimbal pitch (−90° nadir … 0° forward); vehicle roll and pitch do not tilt
-  the image. At heading 0° and pitch −90° the image is a map: north up, east right.
+* A camera's attitude is heading, roll, pitch in a gimbal's own order: the heading turns
+  about the vertical, the roll tilts the heading's horizontal right axis, the pitch turns
+  about that rolled right axis (−90° nadir … 0° forward). That order is singular only at
+  ±90° roll, never at the nadir, so a camera looking straight down keeps the heading its
+  image shows. At heading 0°, roll 0° and pitch −90° the image is a map: north up, east right.
+* :func:`camera_from_attitude` composes a vehicle's attitude and a gimbal's quaternion
+  (MAVLink's, in its vehicle or earth frame) into that attitude through rotation matrices,
+  never through Euler angles.
 
 Only ``math`` trigonometry and IEEE arithmetic are used to build matrices, so a pose gives
 bit-identical matrices on every machine.
@@ -72,12 +77,14 @@ class CameraPose:
     """Where the camera is and where it looks, in world ENU.
 
     ``heading_deg`` is the camera's own heading (vehicle heading + gimbal yaw), clockwise
-    from north; ``pitch_deg`` is the gimbal pitch, −90 looking straight down.
+    from north; ``pitch_deg`` is the gimbal pitch, −90 looking straight down; ``roll_deg``
+    tilts the camera's right side down (a stabilised gimbal's residual, a few tenths).
     """
 
     pos_enu_m: tuple[float, float, float]
     heading_deg: float
     pitch_deg: float
+    roll_deg: float = 0.0
 
     @classmethod
     def from_vehicle(
@@ -97,8 +104,16 @@ class CameraPose:
         h = math.radians(self.heading_deg)
         p = math.radians(self.pitch_deg)
         sh, ch, sp, cp = math.sin(h), math.cos(h), math.sin(p), math.cos(p)
-        forward = (sh * cp, ch * cp, sp)
-        right = (ch, -sh, 0.0)
+        if self.roll_deg == 0.0:
+            forward = (sh * cp, ch * cp, sp)
+            right = (ch, -sh, 0.0)
+        else:
+            r = math.radians(self.roll_deg)
+            sr, cr = math.sin(r), math.cos(r)
+            # heading's forward (sh, ch, 0) and right (ch, -sh, 0); the roll tilts right and up
+            right = (cr * ch, -cr * sh, -sr)
+            up = (sr * ch, -sr * sh, cr)
+            forward = (cp * sh + sp * up[0], cp * ch + sp * up[1], sp * up[2])
         # down = forward × right
         down = (
             forward[1] * right[2] - forward[2] * right[1],
@@ -107,6 +122,28 @@ class CameraPose:
         )
         return right, down, forward
 
+    @classmethod
+    def from_axes(cls, pos_enu_m: Vec3, right: Vec3, forward: Vec3) -> CameraPose:
+        """The pose whose :meth:`axes` are ``right`` and ``forward`` (unit, orthogonal, ENU).
+        Well conditioned everywhere but at ±90° roll; the heading is wrapped to [0, 360)."""
+        horizontal = math.hypot(right[0], right[1])
+        roll = math.atan2(-right[2], horizontal)
+        heading = math.atan2(-right[1], right[0])
+        sh, ch = math.sin(heading), math.cos(heading)
+        sr, cr = math.sin(roll), math.cos(roll)
+        up = (sr * ch, -sr * sh, cr)  # the rolled frame's up
+        pitch = math.atan2(
+            forward[0] * up[0] + forward[1] * up[1] + forward[2] * up[2],
+            forward[0] * sh + forward[1] * ch,
+        )
+        heading_deg = math.degrees(heading) % 360.0
+        return cls(
+            pos_enu_m,
+            0.0 if heading_deg == 360.0 else heading_deg,
+            math.degrees(pitch),
+            math.degrees(roll) + 0.0,  # never -0.0
+        )
+
     def world_from_camera(self) -> FloatArray:
         """3×3 rotation whose columns are the camera's x (right), y (down), z (forward) in ENU."""
         return np.array(self.axes()).T.copy()
@@ -114,6 +151,79 @@ class CameraPose:
     def camera_from_world(self) -> FloatArray:
         """The inverse rotation (its transpose)."""
         return self.world_from_camera().T.copy()
+
+
+Quaternion = tuple[float, float, float, float]
+"""(w, x, y, z), MAVLink's order and frame: x north (or forward), y east (or right), z down."""
+
+
+def camera_from_attitude(
+    pos_enu_m: Vec3,
+    *,
+    vehicle_heading_deg: float,
+    gimbal_q: Quaternion,
+    yaw_in_vehicle_frame: bool,
+    vehicle_roll_deg: float = 0.0,
+    vehicle_pitch_deg: float = 0.0,
+    stabilised: bool = True,
+) -> CameraPose:
+    """The camera's pose from the vehicle's attitude and its gimbal's quaternion (the
+    camera looks along the gimbal's x axis, its image right along y).
+
+    ``yaw_in_vehicle_frame``: the quaternion's yaw is relative to the nose (MAVLink's
+    ``GIMBAL_DEVICE_FLAGS_YAW_IN_VEHICLE_FRAME``), else to north. ``stabilised``: its roll
+    and pitch are relative to the horizon (``ROLL_LOCK``/``PITCH_LOCK``, any stabilised
+    gimbal), else to the vehicle's body, whose roll and pitch then tilt the camera (a camera
+    fixed to the frame: the identity quaternion with pitch −90° looks straight down).
+    Raises InputError for a quaternion that is not finite or is zero."""
+    w, x, y, z = gimbal_q
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    if not math.isfinite(n) or n < 1e-6:
+        raise InputError(f"gimbal quaternion {gimbal_q} is not a rotation")
+    w, x, y, z = w / n, x / n, y / n, z / n
+    gimbal = (
+        (1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)),
+        (2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)),
+        (2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)),
+    )
+    if not stabilised:
+        body = _rotation_ned(vehicle_heading_deg, vehicle_pitch_deg, vehicle_roll_deg)
+        world = _matmul(body, gimbal)
+    elif yaw_in_vehicle_frame:
+        world = _matmul(_rotation_ned(vehicle_heading_deg, 0.0, 0.0), gimbal)
+    else:
+        world = gimbal
+    # columns: the gimbal's x (forward) and y (right) in NED; ENU is (east, north, up)
+    forward = (world[1][0], world[0][0], -world[2][0])
+    right = (world[1][1], world[0][1], -world[2][1])
+    return CameraPose.from_axes(pos_enu_m, right, forward)
+
+
+Matrix3 = tuple[Vec3, Vec3, Vec3]
+
+
+def _rotation_ned(yaw_deg: float, pitch_deg: float, roll_deg: float) -> Matrix3:
+    """NED-from-body rotation of a vehicle's (yaw, pitch, roll): aerospace Z-Y-X order."""
+    cy, sy = math.cos(math.radians(yaw_deg)), math.sin(math.radians(yaw_deg))
+    cp, sp = math.cos(math.radians(pitch_deg)), math.sin(math.radians(pitch_deg))
+    cr, sr = math.cos(math.radians(roll_deg)), math.sin(math.radians(roll_deg))
+    return (
+        (cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr),
+        (sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr),
+        (-sp, cp * sr, cp * cr),
+    )
+
+
+def _matmul(a: Matrix3, b: Matrix3) -> Matrix3:
+    rows = [
+        tuple(a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j] for j in range(3))
+        for i in range(3)
+    ]
+    return (
+        (rows[0][0], rows[0][1], rows[0][2]),
+        (rows[1][0], rows[1][1], rows[1][2]),
+        (rows[2][0], rows[2][1], rows[2][2]),
+    )
 
 
 def project(points_enu_m: FloatArray, pose: CameraPose, intrinsics: Intrinsics) -> FloatArray:

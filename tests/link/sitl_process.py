@@ -22,7 +22,17 @@ def sitl_udpin(*, speedup: float, scene: str = "paper") -> Iterator[int]:
     """A vehicle listening on ``udpin:127.0.0.1:PORT`` (yields the port), stopped on exit."""
     port = free_udp_port()
     endpoint = f"udpin:127.0.0.1:{port}"
-    command = ["uavtool", "sitl", "--speedup", str(speedup), "--scene", scene]
+    # With a mount (ArduCopter, and `uavtool sitl`, boot without one).
+    command = [
+        "uavtool",
+        "sitl",
+        "--speedup",
+        str(speedup),
+        "--scene",
+        scene,
+        "--param",
+        "MNT1_TYPE=1",
+    ]
     proc = subprocess.Popen(
         [sys.executable, "-m", *command, "--endpoint", endpoint],
         stdout=subprocess.PIPE,

@@ -132,7 +132,7 @@ def test_two_threads_share_a_writer_without_loss_or_reordering(tmp_path: Path) -
             t.join()
     with RecordingReader(path) as reader:
         steps = [m.data for m in reader.messages(["/runner"])]
-        raw = [m.data for m in reader.messages(["/mavlink/raw"])]
+        raw = [reader.decode(m).data for m in reader.messages(["/mavlink/raw"])]  # type: ignore[union-attr]
     assert steps == [json.dumps({"step": i}).replace(" ", "").encode() for i in range(n)]
     assert raw == [f for _, f in frames]
 
@@ -163,7 +163,7 @@ def test_corrupt_and_unknown_frames_stay_raw_only(tmp_path: Path) -> None:
         writer.write_mavlink(b"\x00garbage", direction=Direction.IN, log_time_ns=T0_NS + 1)
     with RecordingReader(path) as reader:
         assert reader.topics() == ["/mavlink/raw"]
-        assert [m.data for m in reader.messages()] == [bad_crc, b"\x00garbage"]
+        assert [e.value.data for e in reader.entries()] == [bad_crc, b"\x00garbage"]  # type: ignore[union-attr]
 
 
 def test_unknown_schema_is_a_clear_error(tmp_path: Path) -> None:

@@ -33,6 +33,7 @@ class Client:
         self.frames: list[Any] = []
         self.latest: dict[str, Any] = {}
         self._cursor = 0
+        self._sent_at = 0  # len(received) when the last command was sent
 
     @classmethod
     def tcp(cls, port: int, **kw: Any) -> Client:
@@ -88,6 +89,18 @@ class Client:
                 raise AssertionError(f"no {msg_type} within {timeout} s")
             self.pump(0.02)
 
+    def reason(self, timeout: float = 10.0) -> str:
+        """The text of the first STATUSTEXT since the last command was sent: ArduPilot says
+        why it refuses a command just before its COMMAND_ACK."""
+        end = time.monotonic() + timeout
+        while True:
+            for msg in self.received[self._sent_at :]:
+                if msg.get_type() == "STATUSTEXT":
+                    return str(msg.text)
+            if time.monotonic() >= end:
+                raise AssertionError(f"no STATUSTEXT within {timeout} s")
+            self.pump(0.02)
+
     def wait_until(
         self, cond: Callable[[Client], bool], timeout: float = 30.0, what: str = ""
     ) -> None:
@@ -103,6 +116,7 @@ class Client:
         self, command: int, *params: float, target: tuple[int, int] = (1, 1), timeout: float = 5.0
     ) -> Any:
         p = [*params, *([0.0] * (7 - len(params)))]
+        self._sent_at = len(self.received)
         self.send(M.MAVLink_command_long_message(*target, command, 0, *p))
         return self.wait_for("COMMAND_ACK", lambda m: m.command == command, timeout)
 
@@ -117,6 +131,7 @@ class Client:
         timeout: float = 5.0,
     ) -> Any:
         p = [*params, *([0.0] * (4 - len(params)))]
+        self._sent_at = len(self.received)
         self.send(M.MAVLink_command_int_message(1, 1, frame, command, 0, 0, *p, x, y, z))
         return self.wait_for("COMMAND_ACK", lambda m: m.command == command, timeout)
 

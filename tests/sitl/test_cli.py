@@ -88,8 +88,9 @@ from pymavlink import mavutil
 m = mavutil.mavlink_connection("tcp:127.0.0.1:{port}", source_system=255)
 m.wait_heartbeat(timeout=10)
 m.set_mode("GUIDED")
-m.arducopter_arm()
-m.motors_armed_wait()
+while not m.motors_armed():  # like ArduCopter, it refuses to arm for a few s after boot
+    m.arducopter_arm()
+    m.recv_match(type="HEARTBEAT", blocking=True, timeout=1)
 m.mav.command_long_send(1, 1, mavutil.mavlink.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, 0, 5)
 while m.recv_match(type="GLOBAL_POSITION_INT", blocking=True, timeout=10).relative_alt < 4800:
     pass

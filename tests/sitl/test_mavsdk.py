@@ -9,6 +9,7 @@ from typing import Any
 
 import pytest
 
+from tests.sitl.conftest import MOUNT
 from uavtool.geo import GeoPoint, geo_from_enu
 from uavtool.mavlink import mavlink as M
 from uavtool.sitl import Sitl, SitlConfig
@@ -34,7 +35,8 @@ def _until(check: Callable[[], Any], what: str, timeout: float = 20.0) -> Any:
 
 @pytest.fixture
 def drone() -> Iterator[tuple[Sitl, Any]]:
-    with Sitl(SitlConfig(endpoints=("tcpin:127.0.0.1:0",), speedup=10)) as sitl:
+    config = SitlConfig(endpoints=("tcpin:127.0.0.1:0",), speedup=10, params=MOUNT)
+    with Sitl(config) as sitl:
         sdk = mavsdk.Mavsdk(
             mavsdk.Configuration.create_with_component_type(mavsdk.ComponentType.GROUND_STATION)
         )

@@ -22,7 +22,7 @@ def test_listed_with_an_example() -> None:
     assert code == 0 and "view" in out
     code, out, _ = _run("view", "--help")
     assert code == 0
-    assert "uavtool view recordings/paper.mcap --web" in out
+    assert "uavtool view recordings/golden/paper.mcap --web" in out
 
 
 def test_not_a_recording(tmp_path: Path) -> None:

@@ -20,6 +20,7 @@ from uavtool.errors import UavtoolError
 _COMMANDS: tuple[tuple[str, str], ...] = (
     ("uavtool.cli.fly", "fly"),
     ("uavtool.cli.replay", "replay"),
+    ("uavtool.cli.record", "record"),
     ("uavtool.cli.sitl", "sitl"),
     ("uavtool.cli.recording", "info"),
     ("uavtool.cli.recording", "export"),
@@ -60,8 +61,24 @@ def cli(ctx: click.Context, debug: bool, verbose: int) -> None:
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
 
 
+def _first_sentence(command: click.Command) -> str:
+    """A command's first sentence, whole: click would cut it at the terminal's width."""
+    text = " ".join((command.help or "").split("\n\n", 1)[0].split())
+    end = text.find(". ")
+    return text if end < 0 else text[: end + 1]
+
+
+def _whole_help_lines(command: click.Command) -> None:
+    if command.short_help is None:
+        command.short_help = _first_sentence(command)
+    if isinstance(command, click.Group):
+        for sub in command.commands.values():
+            _whole_help_lines(sub)
+
+
 for _module, _attr in _COMMANDS:
     cli.add_command(getattr(importlib.import_module(_module), _attr))
+_whole_help_lines(cli)
 
 
 def main() -> None:

@@ -110,6 +110,19 @@ _OUTAGE = Numbers(":", (("START", NON_NEGATIVE), ("DURATION", POSITIVE)), exampl
     metavar="spawn|web|FILE.rrd",
     help="Stream the flight live to Rerun: the native viewer, the web viewer, or a file.",
 )
+@click.option(
+    "--no-gimbal",
+    is_flag=True,
+    help="The camera is fixed straight down: fly the search only (no gimbal check, no model).",
+)
+@click.option(
+    "--scene-origin",
+    type=click.Choice(["vehicle", "scene"]),
+    default="vehicle",
+    show_default=True,
+    help="With --camera sim and --connect: put the scene at the vehicle's home, or keep the "
+    "scene's own position (refused, with the SITL --home to use, when the vehicle is far).",
+)
 @click.option("-q", "--quiet", is_flag=True, help="Print only the summary.")
 def fly(
     connect: str | None,
@@ -128,6 +141,8 @@ def fly(
     outages: tuple[tuple[float, float], ...],
     timeout: float,
     rerun_target: str | None,
+    no_gimbal: bool,
+    scene_origin: str,
     quiet: bool,
 ) -> None:
     """Search the scene for the target building, photograph it from three sides and build
@@ -142,6 +157,7 @@ def fly(
       uavtool fly                                  # built-in SITL, scene 'paper'
       uavtool fly --visit-all --scene blocked-front
       uavtool fly --connect tcp:127.0.0.1:5760     # ArduPilot SITL (sim_vehicle.py)
+      uavtool fly --connect tcp:127.0.0.1:5760 --no-gimbal   # a camera fixed down
     """
     from uavtool.mission.params import Params, parse_settings, with_overrides
     from uavtool.runner.fly import FlyConfig
@@ -171,6 +187,8 @@ def fly(
         link_outages_s=outages,
         connect_timeout_s=timeout,
         rerun=rerun_target,
+        no_gimbal=no_gimbal,
+        scene_origin=scene_origin,
     )
 
     def echo(text: str) -> None:
@@ -181,6 +199,7 @@ def fly(
         config,
         progress=lambda text, t: echo(format_progress(text, t)),
         status=lambda text: echo(f"uavtool fly: {text}"),
+        vehicle_says=lambda text: echo(f"uavtool fly: {text}"),
     )
     click.echo(format_summary(summary))
     sys.exit(EXIT_CODES[summary.outcome.status.value])

@@ -13,7 +13,7 @@ _PATH = click.Path(dir_okay=False, path_type=Path)
 
 
 @click.command()
-@click.argument("rec", type=_PATH)
+@click.argument("rec", metavar="RECORDING", type=_PATH)
 @click.option(
     "--verify/--no-verify",
     default=True,
@@ -23,7 +23,8 @@ _PATH = click.Path(dir_okay=False, path_type=Path)
 )
 @click.option("--recover", is_flag=True, help="Rewrite everything readable as a whole file.")
 @click.option("-o", "--output", type=_PATH, help="Where --recover writes (required with it).")
-def info(rec: Path, verify: bool, recover: bool, output: Path | None) -> None:
+@click.option("--json", "as_json", is_flag=True, help="Print the report as one JSON object.")
+def info(rec: Path, verify: bool, recover: bool, output: Path | None, as_json: bool) -> None:
     """Show a recording's duration, topics, frames, outcome and file health.
 
     Every chunk's CRC is checked: a corrupt chunk is reported with its topics, log times
@@ -33,15 +34,21 @@ def info(rec: Path, verify: bool, recover: bool, output: Path | None) -> None:
 
     \b
     Example:
-      uavtool info recordings/2024-05-01T10-00-00.mcap
+      uavtool info recordings/golden/paper.mcap
       uavtool info --recover crashed.mcap -o fixed.mcap
+      uavtool info --json recordings/golden/paper.mcap
     """
     if recover != (output is not None):
         raise click.UsageError("--recover and -o/--output go together")
     from uavtool.recording import info as recording_info
 
     summary = recording_info.summarize(rec, verify=verify or recover)
-    click.echo(recording_info.format_info(summary))
+    if as_json:
+        import json
+
+        click.echo(json.dumps(recording_info.info_json(summary), indent=2))
+    else:
+        click.echo(recording_info.format_info(summary))
     if recover and output is not None:
         from uavtool.recording.recover import recover as do_recover
 
@@ -59,21 +66,42 @@ def info(rec: Path, verify: bool, recover: bool, output: Path | None) -> None:
 
 
 @click.command()
-@click.argument("rec", type=_PATH)
-@click.option("--tlog", "tlog", type=_PATH, required=True, help="Write /mavlink/raw as a .tlog.")
-def export(rec: Path, tlog: Path) -> None:
-    """Export a recording's MAVLink frames to a telemetry log.
+@click.argument("rec", metavar="RECORDING", type=_PATH)
+@click.option("--tlog", "tlog", type=_PATH, default=None, help="Write /mavlink/raw as a .tlog.")
+@click.option(
+    "--frames",
+    "frames_dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    metavar="DIR",
+    help="Write every camera frame as DIR/frame_NNNN.png with a .json sidecar of its pose "
+    "(and DIR/target.png when the recording holds a target picture).",
+)
+def export(rec: Path, tlog: Path | None, frames_dir: Path | None) -> None:
+    """Export a recording's MAVLink frames to a telemetry log, or its camera frames to PNG.
 
     The .tlog opens in MAVProxy, MAVExplorer and mavlogdump.py.
 
     \b
     Example:
       uavtool export flight.mcap --tlog flight.tlog && mavlogdump.py flight.tlog
+      uavtool export flight.mcap --frames frames/     # frame_0000.png + frame_0000.json …
     """
-    from uavtool.recording.tlog import export_tlog
+    if tlog is None and frames_dir is None:
+        raise click.UsageError("say what to export: --tlog FILE and/or --frames DIR")
+    if tlog is not None:
+        from uavtool.recording.tlog import export_tlog
 
-    result = export_tlog(rec, tlog)
-    click.echo(f"wrote {result.frames} MAVLink frames to {tlog}")
+        result = export_tlog(rec, tlog)
+        click.echo(f"wrote {result.frames} MAVLink frames to {tlog}")
+    if frames_dir is not None:
+        from uavtool.recording.frames import export_frames
+
+        frames = export_frames(rec, frames_dir)
+        target = " and target.png" if frames.target else ""
+        click.echo(
+            f"wrote {frames.frames} frames ({frames.with_pose} with a pose){target} to {frames_dir}"
+        )
 
 
 @click.command(name="import")

@@ -40,6 +40,13 @@ from uavtool.errors import FailureError, InputError
 )
 @click.option("--vision-only", is_flag=True, help="Only re-run vectorize/match on every frame.")
 @click.option(
+    "--target",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    metavar="PNG",
+    help="--vision-only of a recording from `uavtool record`: the picture to match.",
+)
+@click.option(
     "--update-golden",
     is_flag=True,
     help="Rewrite RECORDING's outputs (and its .outputs.txt digest) with what the mission "
@@ -67,6 +74,7 @@ def replay(
     params_file: Path | None,
     out: Path | None,
     vision_only: bool,
+    target: Path | None,
     update_golden: bool,
     refly: bool,
     quiet: bool,
@@ -82,6 +90,7 @@ def replay(
       uavtool replay flight.mcap --set vectorize.rdp_epsilon_px=3 --out replayed.mcap
       uavtool replay --refly recordings/golden/paper.mcap   # vehicle, renderer and mission
       uavtool replay --check recordings/golden --out check.parquet  # a folder or a glob, on Dask
+      uavtool replay --vision-only recorded.mcap --target red.png --out analysed.mcap
     """
     from uavtool.cli.replay_batch import is_batch, replay_batch
 
@@ -106,6 +115,17 @@ def replay(
     from uavtool.replay import replay as run_replay
     from uavtool.replay.write import write_replay
 
+    if vision_only and not refly and not update_golden:
+        from uavtool.replay.photos import is_recorded_flight
+
+        if is_recorded_flight(recording):  # from `uavtool record`: no mission, only photos
+            from uavtool.cli.replay_photos import replay_photos
+
+            extra = _params_file(params_file) if params_file is not None else {}
+            replay_photos(recording, target=target, settings=settings, overrides=extra, out=out)
+            return
+    if target is not None:
+        raise click.UsageError("--target is for --vision-only of a recording from uavtool record")
     if refly:
         if settings or params_file or vision_only or update_golden or check:
             raise click.UsageError(

@@ -147,6 +147,36 @@ def render(
 @scene.command()
 @click.argument("scene_ref", metavar="SCENE")
 @click.option(
+    "-o", "--output", required=True, type=click.Path(path_type=Path), help="PNG file to write."
+)
+def target(scene_ref: str, output: Path) -> None:
+    """Write SCENE's target picture: the target building alone, from above.
+
+    It is the picture `uavtool fly` searches for when no --target is given (same camera:
+    640x480, 60 degrees across).
+
+    \b
+    Example:
+      uavtool scene target paper -o target.png
+      uavtool fly --target target.png
+    """
+    from uavtool.camera import Intrinsics
+    from uavtool.runner.fly import FlyConfig, target_picture
+    from uavtool.world import load_scene
+
+    config = FlyConfig()
+    (width, height), hfov = config.size_px, config.hfov_deg
+    intrinsics = Intrinsics.from_hfov(width_px=width, height_px=height, hfov_deg=hfov)
+    try:
+        output.write_bytes(target_picture(load_scene(scene_ref), intrinsics))
+    except OSError as exc:
+        raise click.FileError(str(output), exc.strerror) from None
+    click.echo(f"wrote {output}: the target building of {scene_ref}")
+
+
+@scene.command()
+@click.argument("scene_ref", metavar="SCENE")
+@click.option(
     "--size", default="960x720", show_default=True, metavar="WxH", help="Image size in pixels."
 )
 @click.option(

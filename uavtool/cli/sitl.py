@@ -95,12 +95,14 @@ def sitl(
     """
     from uavtool.sitl import Sitl, SitlConfig, parse_home, parse_signing_key
     from uavtool.sitl.config import (
+        ARMING_SETTLE_S,
         DEFAULT_ENDPOINTS,
         parse_duration,
         parse_outage,
         parse_param,
         parse_wind,
     )
+    from uavtool.sitl.mount import SERVO_ROLL_TRIM_DEG
     from uavtool.sitl.params import load_param_file
 
     kwargs: dict[str, object] = {}
@@ -134,6 +136,9 @@ def sitl(
         instance=instance,
         seed=seed,
         link_outages_s=tuple(parse_outage(text) for text in outages),
+        # As ArduCopter's SITL: arming refused while it boots, a servo mount's residual roll.
+        arming_settle_s=ARMING_SETTLE_S,
+        mount_roll_trim_deg=SERVO_ROLL_TRIM_DEG,
         **kwargs,  # type: ignore[arg-type]
     )
     vehicle = Sitl(config)

@@ -47,9 +47,9 @@ def view(
 
     \b
     Examples:
-      uavtool view recordings/paper.mcap                 # native viewer
-      uavtool view recordings/paper.mcap --web           # open the printed URL
-      uavtool view recordings/paper.mcap --save paper.rrd
+      uavtool view recordings/golden/paper.mcap          # native viewer
+      uavtool view recordings/golden/paper.mcap --web    # open the printed URL
+      uavtool view recordings/golden/paper.mcap --save paper.rrd
       uavtool view paper.mcap --compare paper-replay.mcap
     """
     from uavtool.view import view as show

@@ -11,8 +11,9 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from uavtool.errors import LinkError
-from uavtool.geo import GeoPoint
+from uavtool.camera import CameraPose, Quaternion, camera_from_attitude
+from uavtool.errors import InputError, LinkError
+from uavtool.geo import GeoPoint, wrap_180
 from uavtool.link.freshness import FreshnessFilter
 from uavtool.link.transport import Transport
 from uavtool.mavlink.dialect import mavlink as M
@@ -49,6 +50,9 @@ class VehicleState:
     sys_status: Any = None
     gimbal_pitch_deg: float | None = None
     gimbal_yaw_deg: float | None = None
+    """The camera's pitch from the horizon and yaw from the nose, wrapped to ±180°, as the
+    gimbal reports them (from its whole quaternion, see :func:`gimbal_camera_pose`)."""
+    gimbal: Any = None  # GIMBAL_DEVICE_ATTITUDE_STATUS
     home: GeoPoint | None = None
     statustext: list[tuple[int, str]] = field(default_factory=list)
 
@@ -134,7 +138,8 @@ class VehicleLink:
         elif kind == "HOME_POSITION":
             s.home = GeoPoint(msg.latitude / 1e7, msg.longitude / 1e7, msg.altitude / 1000.0)
         elif kind == "GIMBAL_DEVICE_ATTITUDE_STATUS":
-            s.gimbal_pitch_deg, s.gimbal_yaw_deg = _gimbal_angles(msg)
+            s.gimbal = msg
+            s.gimbal_pitch_deg, s.gimbal_yaw_deg = _gimbal_angles(msg, _heading_deg(s))
         elif kind == "MOUNT_STATUS":
             s.gimbal_pitch_deg, s.gimbal_yaw_deg = msg.pointing_a / 100.0, msg.pointing_c / 100.0
         elif kind == "STATUSTEXT":
@@ -190,13 +195,44 @@ class VehicleLink:
             self.poll(0.05)
 
 
-def _gimbal_angles(msg: Any) -> tuple[float, float]:
-    """(pitch, yaw relative to the vehicle) in degrees from a gimbal attitude quaternion."""
-    w, x, y, z = msg.q
-    if any(math.isnan(v) for v in (w, x, y, z)):
+def gimbal_camera_pose(
+    msg: Any, *, pos_enu_m: tuple[float, float, float], vehicle_heading_deg: float
+) -> CameraPose | None:
+    """The camera's pose from a GIMBAL_DEVICE_ATTITUDE_STATUS: its whole quaternion composed
+    with the vehicle's heading when its flags say the yaw is in the vehicle frame (ArduPilot
+    always does), taken as it is in the earth frame; None when the quaternion is unknown."""
+    q: Quaternion = (float(msg.q[0]), float(msg.q[1]), float(msg.q[2]), float(msg.q[3]))
+    try:
+        return camera_from_attitude(
+            pos_enu_m,
+            vehicle_heading_deg=vehicle_heading_deg,
+            gimbal_q=q,
+            yaw_in_vehicle_frame=_yaw_in_vehicle_frame(int(msg.flags)),
+        )
+    except InputError:
+        return None
+
+
+def _yaw_in_vehicle_frame(flags: int) -> bool:
+    if flags & M.GIMBAL_DEVICE_FLAGS_YAW_IN_VEHICLE_FRAME:
+        return True
+    if flags & M.GIMBAL_DEVICE_FLAGS_YAW_IN_EARTH_FRAME:
+        return False
+    return not flags & M.GIMBAL_DEVICE_FLAGS_YAW_LOCK  # MAVLink's rule when neither is set
+
+
+def _heading_deg(s: VehicleState) -> float:
+    if s.position is not None and s.position.hdg != 65535:
+        return float(s.position.hdg) / 100.0
+    return math.degrees(s.attitude.yaw) % 360.0 if s.attitude is not None else 0.0
+
+
+def _gimbal_angles(msg: Any, vehicle_heading_deg: float) -> tuple[float, float]:
+    """(pitch from the horizon, yaw from the nose wrapped to ±180) in degrees; NaN when the
+    gimbal does not know its attitude."""
+    pose = gimbal_camera_pose(
+        msg, pos_enu_m=(0.0, 0.0, 0.0), vehicle_heading_deg=vehicle_heading_deg
+    )
+    if pose is None:
         return math.nan, math.nan
-    pitch = math.degrees(math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x)))))
-    yaw = math.degrees(math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))
-    if not msg.flags & M.GIMBAL_DEVICE_FLAGS_YAW_IN_VEHICLE_FRAME and not math.isnan(msg.delta_yaw):
-        yaw -= math.degrees(msg.delta_yaw)  # earth-frame yaw: make it relative to the nose
-    return pitch, yaw
+    return pose.pitch_deg, wrap_180(pose.heading_deg - vehicle_heading_deg)

@@ -37,6 +37,8 @@ def encode(value: Any) -> Any:
         for f in dataclasses.fields(value):
             if f.name == "image_rgb":
                 continue
+            if f.name == "roll_deg" and isinstance(value, CameraPose) and value.roll_deg == 0.0:
+                continue  # a level camera is written as before rolls were recorded
             out[f.name] = encode(getattr(value, f.name))
         return out
     if isinstance(value, np.ndarray):
@@ -97,7 +99,10 @@ def decode_observation(data: dict[str, Any], image_rgb: U8Array | None = None) -
                 str(data["tag"]),
                 int(data["time_boot_ms"]),
                 CameraPose(
-                    _vec3(pose["pos_enu_m"]), float(pose["heading_deg"]), float(pose["pitch_deg"])
+                    _vec3(pose["pos_enu_m"]),
+                    float(pose["heading_deg"]),
+                    float(pose["pitch_deg"]),
+                    float(pose.get("roll_deg", 0.0)),
                 ),
                 Intrinsics(
                     int(k["width_px"]),

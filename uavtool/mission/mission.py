@@ -360,7 +360,9 @@ class Mission:
         """Point the gimbal (if needed), then take a photo and return it."""
         p = self.params.mission
         last = self.last
-        if last is None or abs(last.gimbal_pitch_deg - pitch_deg) > p.gimbal_tolerance_deg:
+        if not p.gimbal:
+            pass  # a camera fixed straight down: nothing to point
+        elif last is None or abs(last.gimbal_pitch_deg - pitch_deg) > p.gimbal_tolerance_deg:
             yield from self.command(lambda i: SetGimbal(i, pitch_deg), f"gimbal to {pitch_deg:g}°")
             ok = yield from self.wait_until(
                 lambda t: abs(t.gimbal_pitch_deg - pitch_deg) <= p.gimbal_tolerance_deg,

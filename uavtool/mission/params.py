@@ -99,6 +99,10 @@ class MissionParams:
     view, smaller perspective steps between its heights; never above the second overview)."""
     visit_all: bool = False
     """Visit every point of interest even after a match (then keep the best-scoring match)."""
+    gimbal: bool = True
+    """The vehicle can point its camera. Without a gimbal (``uavtool fly --no-gimbal``) the
+    camera is fixed straight down: the search is flown, no gimbal command is sent, and the
+    flight ends at the match as partial, since the side photos need a gimbal."""
     arrive_radius_m: float = 0.6
     """A position counts as reached within this distance …"""
     arrive_speed_m_s: float = 0.3

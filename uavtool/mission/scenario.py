@@ -15,6 +15,9 @@ if TYPE_CHECKING:
     from uavtool.mission.mission import Mission, Wait
 
 
+NO_GIMBAL_REASON = "target found, no model: the vehicle has no gimbal"
+
+
 def fly(m: Mission) -> Wait[None]:
     """The whole flight up to (not including) the return home."""
     p = m.params.mission
@@ -53,4 +56,6 @@ def fly(m: Mission) -> Wait[None]:
         return
     m.matched_poi = found.poi.index
     m.match_score = found.score
+    if not p.gimbal:
+        raise m.end(Status.PARTIAL, NO_GIMBAL_REASON)
     yield from photograph_and_model(m, found, seen, transit_m)

@@ -27,6 +27,8 @@ from uavtool.recording.values import (
     Model3D,
     Pose,
     PosesInFrame,
+    SceneEntity,
+    SceneMarkers,
 )
 from uavtool.recording.writer import RecordingWriter
 
@@ -51,6 +53,8 @@ __all__ = [
     "RecordingInfo",
     "RecordingReader",
     "RecordingWriter",
+    "SceneEntity",
+    "SceneMarkers",
     "TlogError",
     "TopicNotFoundError",
     "UnknownSchemaError",

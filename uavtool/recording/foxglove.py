@@ -20,6 +20,7 @@ from foxglove_schemas_protobuf.PosesInFrame_pb2 import PosesInFrame as PbPosesIn
 from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate as PbSceneUpdate
 from mcap_protobuf.schema import build_file_descriptor_set
 
+from uavtool.recording.scene import decode_markers, encode_markers
 from uavtool.recording.values import (
     CameraCalibration,
     CompressedImage,
@@ -30,6 +31,7 @@ from uavtool.recording.values import (
     Model3D,
     Pose,
     PosesInFrame,
+    SceneMarkers,
 )
 
 FoxgloveValue = (
@@ -40,6 +42,7 @@ FoxgloveValue = (
     | PosesInFrame
     | LogEntry
     | Model3D
+    | SceneMarkers
 )
 
 _GLB_MEDIA_TYPE = "model/gltf-binary"
@@ -53,6 +56,7 @@ _PB_CLASS: dict[type, Any] = {
     PosesInFrame: PbPosesInFrame,
     LogEntry: PbLog,
     Model3D: PbSceneUpdate,
+    SceneMarkers: PbSceneUpdate,  # one schema, two views: a model, or markers
 }
 _SCHEMA_DATA: dict[type, bytes] = {}
 SCHEMA_NAMES: frozenset[str] = frozenset(c.DESCRIPTOR.full_name for c in _PB_CLASS.values())
@@ -124,6 +128,8 @@ def encode(value: FoxgloveValue, t_ns: int) -> bytes:
         _stamp(pb, t_ns)
         pb.level = int(value.level)
         pb.message, pb.name, pb.file, pb.line = value.message, value.name, value.file, value.line
+    elif isinstance(value, SceneMarkers):
+        encode_markers(value, pb, t_ns)
     else:  # Model3D: one scene entity holding one embedded glTF model
         entity = pb.entities.add()
         _stamp(entity, t_ns)
@@ -163,6 +169,8 @@ def decode(name: str, data: bytes) -> FoxgloveValue:
         return PosesInFrame(tuple(_pose(p) for p in pb.poses), pb.frame_id)
     if cls is PbLog:
         return LogEntry(LogLevel(pb.level), pb.message, pb.name, pb.file, pb.line)
+    if not any(e.models for e in pb.entities):
+        return decode_markers(pb)
     entity = pb.entities[0]
     model = entity.models[0]
     return Model3D(model.data, entity.id, entity.frame_id, _pose(model.pose))

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from uavtool.recording import foxglove
 from uavtool.recording.reader import RecordingReader
+from uavtool.recording.topics import IMAGE
 from uavtool.recording.values import CompressedImage
 
 OUTCOME_METADATA = "outcome"  # the record the mission runner writes when it finishes
@@ -34,7 +37,7 @@ class RecordingInfo:
     start_ns: int
     end_ns: int
     message_count: int
-    frame_count: int
+    frame_count: int  # camera frames (/camera/image), as the outcome's ``frames`` counts them
     topics: tuple[TopicInfo, ...]
     metadata_names: tuple[str, ...]
     outcome: dict[str, str] | None
@@ -42,6 +45,7 @@ class RecordingInfo:
     summary_problem: str = ""  # why the summary was not used ("" if used or absent)
     damage: tuple[str, ...] = ()  # each corrupt chunk or damaged record, in words
     messages_lost: int = 0  # in the corrupt chunks, as far as their indexes tell
+    other_images: tuple[tuple[str, int], ...] = ()  # (topic, count): e.g. the target picture
 
     @property
     def duration_s(self) -> float:
@@ -66,14 +70,14 @@ def summarize(path: str | Path, *, verify: bool = True) -> RecordingInfo:
         schemas = reader.schemas
         kinds: dict[str, tuple[str, str]] = {}  # topic -> (schema name, message encoding)
         totals: dict[str, int] = {}
-        frames = 0
+        images: dict[str, int] = {}
         image_schema = foxglove.schema_name(CompressedImage)
         for cid, channel in sorted(reader.channels.items()):
             schema = schemas.get(channel.schema_id)
             name = schema.name if schema else ""
             count = counts.get(cid, 0)
             if name == image_schema:
-                frames += count
+                images[channel.topic] = images.get(channel.topic, 0) + count
             kinds.setdefault(channel.topic, (name, channel.message_encoding))
             totals[channel.topic] = totals.get(channel.topic, 0) + count
         topics = tuple(
@@ -97,7 +101,8 @@ def summarize(path: str | Path, *, verify: bool = True) -> RecordingInfo:
             end_ns=end_ns,
             # the summary counts what was written; a scan counts only what it could read
             message_count=sum(counts.values()) + (0 if health.indexed else lost),
-            frame_count=frames,
+            frame_count=images.pop(IMAGE, 0),
+            other_images=tuple(sorted(images.items())),
             topics=topics,
             metadata_names=tuple(name for name, _ in metadata),
             outcome=outcome,
@@ -122,6 +127,14 @@ def damage_problem(info: RecordingInfo) -> str:
             f"`uavtool info --recover {info.path} -o fixed.mcap` writes a sound summary"
         )
     return ""
+
+
+def info_json(info: RecordingInfo) -> dict[str, Any]:
+    """What `uavtool info --json` prints: every field of ``info``, plus ``duration_s``."""
+    data = dataclasses.asdict(info)
+    data["duration_s"] = info.duration_s
+    data["other_images"] = dict(info.other_images)
+    return data
 
 
 def format_info(info: RecordingInfo) -> str:
@@ -156,7 +169,8 @@ def format_info(info: RecordingInfo) -> str:
         f" ({info.message_count - info.messages_lost} readable)" if info.messages_lost else ""
     )
     lines.append(f"messages:  {info.message_count}{readable}")
-    lines.append(f"frames:    {info.frame_count}")
+    others = "".join(f"; {n} on {topic}" for topic, n in info.other_images)
+    lines.append(f"frames:    {info.frame_count} on {IMAGE}{others}")
     if info.outcome is None:
         lines.append("outcome:   unknown (no 'outcome' record: the mission did not finish)")
     else:

@@ -16,7 +16,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
-from uavtool.recording import foxglove
+from uavtool.recording import foxglove, rawframe
 from uavtool.recording.chunks import Block, ChunkDamaged, Damage, chunk_damage, read_chunk
 from uavtool.recording.errors import (
     CorruptRecordingError,
@@ -352,7 +352,14 @@ class RecordingReader:
         """The value a message carries; `UnknownSchemaError` if we do not know its schema."""
         channel, schema = message.channel, message.schema
         encoding = channel.message_encoding
-        if encoding == MAVLINK_ENCODING:
+        if encoding == PROTOBUF_ENCODING and schema and schema.name == rawframe.SCHEMA_NAME:
+            try:
+                return MavlinkFrame(*rawframe.decode(message.data))
+            except ValueError as exc:
+                raise RecordingError(
+                    self.path, f"topic {channel.topic!r} #{message.sequence}: {exc}"
+                ) from None
+        if encoding == MAVLINK_ENCODING:  # recordings written before uavtool.MavlinkFrame
             try:
                 direction = Direction(channel.metadata.get("direction"))
             except ValueError:

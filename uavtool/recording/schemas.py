@@ -2,8 +2,14 @@
 
 Every decoded MAVLink message type gets its own JSON schema, generated from pymavlink's
 message definitions (field types, array lengths, units, enums, the message description), so
-Foxglove lists and plots every field. Non-finite floats (MAVLink's "NaN = unchanged") become
-``null``: JSON has no NaN, and the exact bytes stay in ``/mavlink/raw``.
+Foxglove and Lichtblick list and plot every field.
+
+The rule for JSON channels (`NULL_RULE`): each field has exactly one JSON type — the one its
+values have — because Foxglove's and Lichtblick's schema parsers reject a list of types such
+as ``["number", "null"]`` and then drop the whole channel. A value that is absent or not
+finite (MAVLink's "NaN = unchanged", ±∞, an unset optional) is written as ``null``: JSON has
+no NaN, those viewers read ``null`` as "no value" (a gap in a plot), and the exact bytes stay
+in ``/mavlink/raw``.
 """
 
 from __future__ import annotations
@@ -63,6 +69,7 @@ _INT_TYPES = {
     "uint64_t",
 }
 _FLOAT_TYPES = {"float", "double"}
+NULL_RULE = "null: no value (not finite, or not set)"
 
 _HEADER_SCHEMA = {
     "type": "object",
@@ -94,12 +101,12 @@ def _field_schema(
     if base == "char":
         item = {"type": "string"}
     elif base in _FLOAT_TYPES:
-        item = {"type": ["number", "null"]}
+        item = {"type": "number"}
     elif base in _INT_TYPES:
         item = {"type": "integer"}
     else:  # pragma: no cover - every MAVLink wire type is listed above
         raise ValueError(f"unknown MAVLink field type {field_type!r}")
-    notes = [f"{base}"]
+    notes = [f"{base}"] if base not in _FLOAT_TYPES else [f"{base}", NULL_RULE]
     if units:
         notes.append(f"units: {units}")
     if enum:

@@ -16,8 +16,8 @@ from pathlib import Path
 from uavtool.recording.errors import TlogError, UnknownSchemaError, create_file, write_failed
 from uavtool.recording.files import NotRegularFileError, atomic_output, open_input
 from uavtool.recording.reader import RecordingReader
-from uavtool.recording.schemas import DEFAULT_DIALECT, MAVLINK_ENCODING, MAVLINK_RAW, MavlinkDecoder
-from uavtool.recording.values import Direction
+from uavtool.recording.schemas import DEFAULT_DIALECT, MAVLINK_RAW, MavlinkDecoder
+from uavtool.recording.values import Direction, MavlinkFrame
 from uavtool.recording.writer import RecordingWriter
 
 _STAMP = struct.Struct(">Q")
@@ -46,13 +46,14 @@ def export_tlog(rec: str | Path, out: str | Path) -> TlogResult:
             try:
                 with f:
                     for message in messages:
-                        if message.channel.message_encoding != MAVLINK_ENCODING:
+                        frame = reader.decode(message)
+                        if not isinstance(frame, MavlinkFrame):
                             raise UnknownSchemaError(
                                 rec,
                                 f"{MAVLINK_RAW} has encoding {message.channel.message_encoding!r}",
                             )
                         f.write(_STAMP.pack(message.log_time_ns // 1000))
-                        f.write(message.data)
+                        f.write(frame.data)
                         count += 1
             except OSError as exc:
                 raise write_failed(out, exc) from None

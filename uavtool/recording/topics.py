@@ -10,8 +10,23 @@ OUTPUTS = "/mission/outputs"
 TARGET = "/mission/target"
 EVENTS = "/mission/events"
 MODEL = "/mission/model"
+SCENE = "/mission/scene"
+"""The route flown, photo poses, points of interest and viewpoints (`foxglove.SceneUpdate`)."""
 IMAGE = "/camera/image"
 CALIBRATION = "/camera/calibration"
 CAMERA_POSE = "/camera/pose"
 FIX = "/vehicle/fix"
 POSE = "/vehicle/pose"
+
+# A flight recorded by `uavtool record` (no mission): the vehicle's state and the camera's
+# frames with their poses, instead of the mission's observations.
+TELEMETRY = "/vehicle/telemetry"
+"""Every telemetry sample (JSON, as a ``Telemetry`` observation)."""
+FRAMES = "/camera/frames"
+"""One per ``/camera/image`` frame, in the same order (JSON: a ``Photo`` observation plus
+``photo``, ``trigger``, ``pose_time_boot_ms``, ``pose_dt_ms``)."""
+VEHICLE_EVENTS = "/vehicle/events"
+"""Mode changes, arming, STATUSTEXT, mission progress, photos (``foxglove.Log``)."""
+VISION = "/vision/results"
+"""``replay --vision-only`` of such a recording: per photo, its ``Shapes`` and
+``Recognition`` against the target (JSON, as the mission's outputs)."""

@@ -188,6 +188,31 @@ class Model3D:
     pose: Pose = Pose((0.0, 0.0, 0.0))
 
 
+@dataclass(frozen=True, slots=True)
+class SceneEntity:
+    """Markers a 3D panel draws (`foxglove.SceneEntity`), in ``frame_id``, one colour.
+
+    ``line_m`` : (n, 3) points of one polyline; ``arrows`` : poses whose x axis points the
+    way; ``spheres_m`` : (k, 3) centres of spheres ``size_m`` across; ``texts`` : labels.
+    """
+
+    entity_id: str
+    colour_rgba: tuple[float, float, float, float]
+    line_m: tuple[Vec3, ...] = ()
+    arrows: tuple[Pose, ...] = ()
+    spheres_m: tuple[Vec3, ...] = ()
+    texts: tuple[tuple[Vec3, str], ...] = ()
+    size_m: float = 1.0
+    frame_id: str = "world"
+
+
+@dataclass(frozen=True, slots=True)
+class SceneMarkers:
+    """A `foxglove.SceneUpdate` of marker entities; each replaces the entity of its id."""
+
+    entities: tuple[SceneEntity, ...]
+
+
 Value = (
     MavlinkFrame
     | JsonDocument
@@ -198,6 +223,7 @@ Value = (
     | PosesInFrame
     | LogEntry
     | Model3D
+    | SceneMarkers
 )
 
 

@@ -22,13 +22,12 @@ from typing import Any
 from mcap.writer import LIBRARY_IDENTIFIER
 
 from uavtool import __version__
-from uavtool.recording import foxglove
+from uavtool.recording import foxglove, rawframe
 from uavtool.recording.errors import RecordingError
 from uavtool.recording.schemas import (
     DEFAULT_DIALECT,
     JSON_ENCODING,
     JSONSCHEMA_ENCODING,
-    MAVLINK_ENCODING,
     MAVLINK_RAW,
     PROTOBUF_ENCODING,
     MavlinkDecoder,
@@ -218,16 +217,20 @@ class RecordingWriter:
         log_time_ns: int,
         publish_time_ns: int | None = None,
     ) -> None:
-        """Write one whole MAVLink frame to ``/mavlink/raw`` and, if it decodes, its JSON view
-        to ``/mavlink/<in|out>/<MSGNAME>``. Unknown or corrupt frames are kept raw only."""
+        """Write one whole MAVLink frame to ``/mavlink/raw`` (see `rawframe`) and, if it
+        decodes, its JSON view to ``/mavlink/<in|out>/<MSGNAME>``. Unknown or corrupt frames
+        are kept raw only."""
         frame = bytes(frame)
         with self._lock:
             self._check_open()
-            raw_id = self._channels.get(direction)
+            raw_id = self._channels.get(MAVLINK_RAW)
             if raw_id is None:
-                meta = {"direction": direction.value, "dialect": self.dialect}
-                raw_id = self._channel(direction, MAVLINK_RAW, MAVLINK_ENCODING, 0, meta)
-            self._add(raw_id, log_time_ns, publish_time_ns, frame)
+                schema_id = self._schema(
+                    rawframe.SCHEMA_NAME, PROTOBUF_ENCODING, rawframe.SCHEMA_DATA
+                )
+                meta = {"dialect": self.dialect}
+                raw_id = self._channel(MAVLINK_RAW, MAVLINK_RAW, PROTOBUF_ENCODING, schema_id, meta)
+            self._add(raw_id, log_time_ns, publish_time_ns, rawframe.encode(direction, frame))
             decoded = self._decoder.decode(frame)
             if decoded is None:
                 return

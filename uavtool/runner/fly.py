@@ -36,6 +36,8 @@ from uavtool.runner.camera import open_camera
 from uavtool.runner.evaluate import Evaluation, closest_clearance, evaluate
 from uavtool.runner.live import LiveView
 from uavtool.runner.params import set_vehicle_params
+from uavtool.runner.placement import SCENE_ORIGINS, place_scene
+from uavtool.runner.preflight import check_camera, check_gimbal, check_home
 from uavtool.runner.record import ClockNs, MissionRecorder
 from uavtool.runner.runner import Progress, Runner
 from uavtool.world import Scene, load_scene, render, scene_to_dict
@@ -43,6 +45,8 @@ from uavtool.world import Scene, load_scene, render, scene_to_dict
 if TYPE_CHECKING:
     from uavtool.sitl.lockstep import LockstepTransport
 
+BOOT_ONLY_PARAMS = frozenset({"MNT1_TYPE"})
+"""Parameters ArduPilot reads at boot only: the built-in vehicle boots with them."""
 _TARGET_VIEW_M = 30.0  # the default target picture: from this far above its roof
 
 
@@ -72,6 +76,13 @@ class FlyConfig:
     connect_timeout_s: float = 30.0
     rerun: str | None = None
     """Stream live to Rerun: ``"spawn"`` (native viewer), ``"web"`` or a ``.rrd`` path."""
+    no_gimbal: bool = False
+    """The camera is fixed straight down: no gimbal check, the search only (see
+    ``MissionParams.gimbal``). The built-in vehicle then boots without a mount."""
+    scene_origin: str = "vehicle"
+    """With the sim camera and another vehicle: ``"vehicle"`` puts the scene at the vehicle's
+    home, ``"scene"`` keeps the scene's own geographic origin (refused when the vehicle is
+    beyond the scene's extent)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -93,6 +104,8 @@ class FlightSummary:
     clearance_building: str
     flight_wall_s: float
     """Wall time of the same span (the mission itself, without start-up)."""
+    last_refusal: str = ""
+    """The last command the vehicle refused, with its reason ("" if none)."""
     stale_dropped: tuple[tuple[str, int], ...] = ()
     """Messages dropped as older than one already taken (late on the link), per message name;
     the recording keeps them."""
@@ -119,11 +132,21 @@ def fly(
     *,
     progress: Progress | None = None,
     status: Callable[[str], None] | None = None,
+    vehicle_says: Callable[[str], None] | None = None,
 ) -> FlightSummary:
-    """Fly one mission; raises InputError on bad input, LinkError when the vehicle cannot be
-    reached. ``progress`` hears each mission event, ``status`` the set-up steps."""
+    """Fly one mission; raises InputError on bad input or a failed pre-flight check
+    (:class:`PreflightError`, before arming), LinkError when the vehicle cannot be reached.
+    ``progress`` hears each mission event, ``status`` the set-up steps, ``vehicle_says`` the
+    vehicle's warnings and refusals as they arrive."""
     say = status or (lambda _text: None)
     wall0 = time.monotonic()
+    if config.scene_origin not in SCENE_ORIGINS:
+        raise InputError(f"--scene-origin {config.scene_origin}: expected vehicle or scene")
+    if config.no_gimbal and config.params.mission.gimbal:
+        mission_params = dataclasses.replace(config.params.mission, gimbal=False)
+        config = dataclasses.replace(
+            config, params=dataclasses.replace(config.params, mission=mission_params)
+        )
     scene = config.scene if isinstance(config.scene, Scene) else load_scene(config.scene)
     w, h = config.size_px
     intrinsics = Intrinsics.from_hfov(width_px=w, height_px=h, hfov_deg=config.hfov_deg)
@@ -199,15 +222,25 @@ def fly(
             recorder.note(Level.INFO, f"connected to sysid {link.target_system} on {link.name}")
         if config.vehicle_params:
             set_vehicle_params(link, config.vehicle_params)
+        check_home(link)
+        if config.camera != "sim":
+            check_camera(camera)
+        if not config.no_gimbal:
+            check_gimbal(link)
+        origin = scene.home
+        if config.camera == "sim" and config.connect is not None:
+            origin = place_scene(scene, home, config.scene_origin, say)
         runner = Runner(
             link,
             camera,
             mission,
             recorder=recorder,
             live=live,
-            scene_origin=scene.home if config.camera == "sim" else None,
+            scene_origin=origin if config.camera == "sim" else None,
             true_pose=true_pose,
             progress=progress,
+            vehicle_says=vehicle_says,
+            fixed_camera=config.no_gimbal,
         )
         flight_wall0, vehicle0 = time.perf_counter(), clock()
         flown.append(True)
@@ -246,6 +279,7 @@ def fly(
             clearance_m if clearance_m is None or math.isfinite(clearance_m) else None,
             clearance_building,
             flight_wall_s,
+            runner.last_refusal,
             tuple(sorted(link.freshness.dropped_by_type.items())),
         )
         if recorder is not None:
@@ -277,6 +311,8 @@ def summary_record(s: FlightSummary) -> dict[str, object]:
     if s.clearance_m is not None:
         record["closest_clearance_m"] = round(s.clearance_m, 2)
         record["closest_building"] = s.clearance_building
+    if s.last_refusal:
+        record["last_refusal"] = s.last_refusal
     if s.stale_dropped:  # only on lossy links: a lockstep flight's record stays as it was
         record["stale_dropped"] = sum(n for _, n in s.stale_dropped)
     return record
@@ -298,7 +334,13 @@ def _builtin_sitl(config: FlyConfig, scene: Scene) -> Iterator[LockstepTransport
     from uavtool.sitl.lockstep import SIM_EPOCH_UNIX_S, LockstepTransport  # noqa: PLC0415
     from uavtool.world.obstacles import scene_obstacles  # noqa: PLC0415
 
+    # The vehicle `fly` starts has a servo mount (ArduCopter's default has none) and holds
+    # its nose on the way (WP_YAW_BEHAVIOR 0): the mission photographs from known headings.
+    mount = 0.0 if config.no_gimbal else 1.0
+    boot: tuple[tuple[str, float], ...] = (("MNT1_TYPE", mount), ("WP_YAW_BEHAVIOR", 0.0))
+    boot += tuple((n, v) for n, v in config.vehicle_params if n in BOOT_ONLY_PARAMS)
     sitl_config = SitlConfig(
+        params=boot,
         endpoints=(),
         obstacles=scene_obstacles(scene),
         home=scene.home,
@@ -333,6 +375,7 @@ def flight_metadata(config: FlyConfig, scene: Scene) -> dict[str, dict[str, str]
             "builtin": str(builtin).lower(),
             "camera": config.camera,
             "clock": "lockstep" if builtin else "wall",
+            "scene_origin": _origin_name(config),
         },
         "flight": {
             "seed": str(config.seed),
@@ -345,6 +388,15 @@ def flight_metadata(config: FlyConfig, scene: Scene) -> dict[str, dict[str, str]
             "target": "file" if config.target else "scene",
         },
     }
+
+
+def _origin_name(config: FlyConfig) -> str:
+    """Which geographic origin the scene was placed at."""
+    if config.camera != "sim":
+        return "none"
+    if config.connect is None:
+        return "scene"  # the built-in vehicle boots at the scene's home
+    return "vehicle-home" if config.scene_origin == "vehicle" else "scene"
 
 
 def _abort(link: VehicleLink, recorder: MissionRecorder | None, why: str) -> None:

@@ -4,7 +4,8 @@ The authoritative streams are ``/mission/observations`` (every observation, in t
 mission consumed it, numbered by ``step``) and ``/mission/outputs`` (every output, numbered by
 ``n``, with the ``step`` that produced it): replay reads these. Photos go to ``/camera/*``,
 telemetry also to ``/vehicle/*``, events also to ``/mission/events`` and the model's GLB to
-``/mission/model`` so Foxglove and Rerun show them natively.
+``/mission/model``, and the route flown, photo poses, points of interest and viewpoints to
+``/mission/scene`` (markers), so Foxglove, Lichtblick and Rerun show them natively.
 
 The clock rule: every message's ``log_time`` is when the runner received or produced it on the
 recording's clock — for a simulated flight flown in lockstep, the vehicle's time since boot
@@ -24,6 +25,7 @@ from uavtool.geo import GeoPoint, geo_from_enu
 from uavtool.images import png_encode
 from uavtool.mission import Level, ModelBuilt, Observation, Output, Photo, Telemetry
 from uavtool.mission.codec import encode_observation, encode_output
+from uavtool.mission.schema import observation_schema, output_schema
 from uavtool.recording import (
     CameraCalibration,
     CompressedImage,
@@ -36,6 +38,7 @@ from uavtool.recording import (
     Pose,
     PosesInFrame,
     RecordingWriter,
+    SceneMarkers,
 )
 from uavtool.recording.topics import (
     CALIBRATION,
@@ -47,31 +50,11 @@ from uavtool.recording.topics import (
     OBSERVATIONS,
     OUTPUTS,
     POSE,
+    SCENE,
     TARGET,
 )
+from uavtool.runner.markers import RouteMarkers
 
-_OBS_SCHEMA = {
-    "title": "uavtool.Observation",
-    "description": "What the mission consumed, in order: Telemetry, CommandResult, Photo "
-    "(pixels on /camera/image, same frame_index), LinkLost, LinkRestored.",
-    "type": "object",
-    "properties": {"step": {"type": "integer"}, "type": {"type": "string"}},
-    "required": ["step", "type"],
-}
-_OUT_SCHEMA = {
-    "title": "uavtool.Output",
-    "description": "What the mission produced, in order: commands (SetMode, Arm, Takeoff, "
-    "GoTo, SetGimbal, TakePhoto), Event, Shapes, Plan, Recognition, Viewpoints, DiagonalView, "
-    "ModelBuilt, "
-    "Outcome.",
-    "type": "object",
-    "properties": {
-        "n": {"type": "integer"},
-        "step": {"type": "integer"},
-        "type": {"type": "string"},
-    },
-    "required": ["n", "step", "type"],
-}
 _LEVELS = {Level.INFO: LogLevel.INFO, Level.WARNING: LogLevel.WARNING, Level.ERROR: LogLevel.ERROR}
 
 
@@ -87,9 +70,12 @@ class MissionRecorder:
         self.writer = writer
         self.clock_ns = clock_ns
         self.home: GeoPoint | None = None
-        writer.add_json_topic(OBSERVATIONS, schema_name="uavtool.Observation", schema=_OBS_SCHEMA)
-        writer.add_json_topic(OUTPUTS, schema_name="uavtool.Output", schema=_OUT_SCHEMA)
+        writer.add_json_topic(
+            OBSERVATIONS, schema_name="uavtool.Observation", schema=observation_schema()
+        )
+        writer.add_json_topic(OUTPUTS, schema_name="uavtool.Output", schema=output_schema())
         self._outputs = 0
+        self._markers = RouteMarkers()
 
     def mavlink(self, direction: str, frame: bytes) -> None:
         self.writer.write_mavlink(
@@ -122,7 +108,9 @@ class MissionRecorder:
                 FrameTransform.from_camera_pose(obs.pose),
                 log_time_ns=t,
             )
+            self._scene(self._markers.photo(obs.pose), t)
         elif isinstance(obs, Telemetry):
+            self._markers.telemetry(obs.pos_enu_m)
             pose = Pose.from_enu_heading(obs.pos_enu_m, obs.heading_deg)
             self.writer.write(POSE, PosesInFrame((pose,)), log_time_ns=t)
             if self.home is not None:
@@ -165,6 +153,11 @@ class MissionRecorder:
             self.writer.write(EVENTS, entry, log_time_ns=log_time_ns)
         elif glb is not None:
             self.writer.write(MODEL, Model3D(glb), log_time_ns=log_time_ns)
+        self._scene(self._markers.output(data), log_time_ns)
+
+    def _scene(self, markers: SceneMarkers | None, t_ns: int) -> None:
+        if markers is not None:
+            self.writer.write(SCENE, markers, log_time_ns=t_ns)
 
     def note(self, level: Level, text: str, *, name: str = "runner") -> None:
         """A runner event (connection, vehicle STATUSTEXT …) on the events topic only."""

@@ -37,10 +37,19 @@ from uavtool.mission import (
 from uavtool.runner.camera import CameraSource
 from uavtool.runner.live import LiveView
 from uavtool.runner.record import MissionRecorder
-from uavtool.runner.vehicle import RESULT_NAMES, camera_pose, send_command, telemetry
+from uavtool.runner.vehicle import (
+    COMMAND_NAMES,
+    RESULT_NAMES,
+    photo_pose,
+    send_command,
+    telemetry,
+)
 
 Progress = Callable[[str, Telemetry | None], None]
 """Told each mission event, with the latest telemetry."""
+VehicleSays = Callable[[str], None]
+"""Told what the vehicle says as it arrives: each STATUSTEXT of severity WARNING or worse,
+and each refused command with the vehicle's reason."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -72,8 +81,15 @@ class Runner:
         true_pose: Callable[[], CameraPose] | None = None,
         config: RunnerConfig = RunnerConfig(),
         progress: Progress | None = None,
+        vehicle_says: VehicleSays | None = None,
+        fixed_camera: bool = False,
     ) -> None:
         self.link = link
+        self.vehicle_says = vehicle_says or (lambda _text: None)
+        self.fixed_camera = fixed_camera
+        self.last_refusal = ""
+        """The last command the vehicle refused, with its reason ("" if none)."""
+        self._warnings: list[str] = []  # STATUSTEXTs of WARNING or worse, in order
         self.camera = camera
         self.mission = mission
         self.recorder = recorder
@@ -87,7 +103,8 @@ class Runner:
         self.coalesced = 0  # telemetry snapshots superseded before the mission saw them
         self.route: list[tuple[int, tuple[float, float, float]]] = []  # (time_boot_ms, ENU)
         self._queue: deque[Observation] = deque()
-        self._pending: dict[int, tuple[int, int]] = {}  # MAV_CMD -> (action id, vehicle ms)
+        self._pending: dict[int, tuple[int, int, int]] = {}
+        """MAV_CMD -> (action id, vehicle ms, warnings heard when sent)."""
         self._gimbal = (0.0, 0.0)
         self._last: Telemetry | None = None
         self._lost_reported = 0.0
@@ -180,8 +197,13 @@ class Runner:
             # Pace our heartbeat by the vehicle's: at any speed-up the vehicle hears us as
             # often as it speaks, so its ground-station failsafe never fires by accident.
             self._heartbeat(self.link.clock())
-        elif kind == "STATUSTEXT" and self.recorder is not None:
-            self.recorder.note(Level.INFO, f"vehicle: {msg.text}", name="vehicle")  # type: ignore[attr-defined]
+        elif kind == "STATUSTEXT":
+            text, severity = msg.text, msg.severity  # type: ignore[attr-defined]
+            if self.recorder is not None:
+                self.recorder.note(Level.INFO, f"vehicle: {text}", name="vehicle")
+            if severity <= M.MAV_SEVERITY_WARNING:
+                self._warnings.append(text)
+                self.vehicle_says(f"vehicle: {text}")
 
     def _on_ack(self, msg: object) -> None:
         command, result = msg.command, msg.result  # type: ignore[attr-defined]
@@ -191,11 +213,18 @@ class Runner:
         del self._pending[command]
         accepted = result == M.MAV_RESULT_ACCEPTED
         detail = "" if accepted else f"refused ({RESULT_NAMES.get(result, result)})"
+        if not accepted:
+            # The vehicle's reason is the warning it sent since the command (ArduPilot sends
+            # it just before the ACK); DO_MOUNT_CONTROL without a mount has none.
+            said = self._warnings[-1] if len(self._warnings) > pending[2] else ""
+            name = COMMAND_NAMES.get(command, str(command))
+            self.last_refusal = f"{name} {detail}" + (f": {said}" if said else "")
+            self.vehicle_says(f"vehicle refused {self.last_refusal}")
         self._queue.append(CommandResult(pending[0], accepted, detail))
 
     def _expire_acks(self, now_ms: int) -> None:
         limit_ms = self.config.ack_timeout_s * 1000.0
-        for command, (action_id, sent_ms) in list(self._pending.items()):
+        for command, (action_id, sent_ms, _) in list(self._pending.items()):
             if now_ms - sent_ms > limit_ms:
                 del self._pending[command]
                 detail = f"no COMMAND_ACK in {self.config.ack_timeout_s:g} s"
@@ -227,15 +256,17 @@ class Runner:
             self._queue.append(CommandResult(cmd.id, True, "sent"))
         else:
             now_ms = self._last.time_boot_ms if self._last is not None else 0
-            self._pending[sent.mav_cmd] = (cmd.id, now_ms)
+            self._pending[sent.mav_cmd] = (cmd.id, now_ms, len(self._warnings))
 
     def _photo(self, cmd: TakePhoto) -> Photo:
         t = self._last
         assert t is not None  # the mission photographs only after telemetry
-        pose = camera_pose(t)
+        pose = photo_pose(self.link, t, fixed_down=self.fixed_camera)
         at = self.true_pose() if self.true_pose is not None else pose
         (x, y, z), (dx, dy) = at.pos_enu_m, self.scene_offset
-        image = self.camera.capture(CameraPose((x + dx, y + dy, z), at.heading_deg, at.pitch_deg))
+        image = self.camera.capture(
+            CameraPose((x + dx, y + dy, z), at.heading_deg, at.pitch_deg, at.roll_deg)
+        )
         photo = Photo(
             cmd.id, self.frames, cmd.tag, t.time_boot_ms, pose, self.camera.intrinsics, image
         )

@@ -57,5 +57,7 @@ def format_summary(s: FlightSummary) -> str:
             f"link           {sum(n for _, n in s.stale_dropped)} stale messages dropped "
             f"(older than one already received: {kinds})"
         )
+    if s.last_refusal:
+        lines.append(f"last refusal   {s.last_refusal}")
     lines.append(f"recording      {s.recording if s.recording else '(not recorded)'}")
     return "\n".join(lines)

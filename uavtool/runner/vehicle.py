@@ -7,9 +7,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from uavtool.camera import CameraPose
+from uavtool.camera import CameraPose, Quaternion, camera_from_attitude
 from uavtool.geo import GeoPoint, enu_from_geo, geo_from_enu
 from uavtool.link import VehicleLink
+from uavtool.link.client import gimbal_camera_pose
 from uavtool.mavlink.dialect import COPTER_MODE_NAMES, COPTER_MODES
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mission import Arm, Command, GoTo, SetGimbal, SetMode, Takeoff, Telemetry
@@ -77,6 +78,36 @@ def camera_pose(t: Telemetry) -> CameraPose:
     )
 
 
+NADIR: Quaternion = (math.sqrt(0.5), 0.0, -math.sqrt(0.5), 0.0)
+"""A camera fixed to the frame looking straight down: pitch −90° in the body frame."""
+
+
+def photo_pose(link: VehicleLink, t: Telemetry, *, fixed_down: bool = False) -> CameraPose:
+    """The camera's pose at a photo from the whole attitude: the gimbal's last quaternion
+    composed with the vehicle's heading; for a camera ``fixed_down`` to the frame, the
+    vehicle's roll and pitch tilt it too. Without a gimbal report, the commanded angles."""
+    s = link.state
+    if fixed_down:
+        att = s.attitude
+        roll, pitch = (math.degrees(att.roll), math.degrees(att.pitch)) if att else (0.0, 0.0)
+        return camera_from_attitude(
+            t.pos_enu_m,
+            vehicle_heading_deg=t.heading_deg,
+            gimbal_q=NADIR,
+            yaw_in_vehicle_frame=True,
+            vehicle_roll_deg=roll,
+            vehicle_pitch_deg=pitch,
+            stabilised=False,
+        )
+    if s.gimbal is not None:
+        pose = gimbal_camera_pose(
+            s.gimbal, pos_enu_m=t.pos_enu_m, vehicle_heading_deg=t.heading_deg
+        )
+        if pose is not None:
+            return pose
+    return camera_pose(t)
+
+
 @dataclass(frozen=True, slots=True)
 class Sent:
     """A command on the wire: the MAVLink command number its ACK will carry (0: none)."""
@@ -141,4 +172,9 @@ def send_command(link: VehicleLink, cmd: Command, home: GeoPoint) -> Sent:
 
 RESULT_NAMES = {
     v: k for k, v in vars(M).items() if k.startswith("MAV_RESULT_") and isinstance(v, int)
+}
+COMMAND_NAMES = {
+    v: k.removeprefix("MAV_CMD_")
+    for k, v in vars(M).items()
+    if k.startswith("MAV_CMD_") and isinstance(v, int)
 }

@@ -30,6 +30,7 @@ SUPPORTED_COMMANDS = NAV_COMMANDS | {
     mavlink.MAV_CMD_CONDITION_YAW,
     mavlink.MAV_CMD_DO_MOUNT_CONTROL,
     mavlink.MAV_CMD_DO_GIMBAL_MANAGER_PITCHYAW,
+    mavlink.MAV_CMD_DO_DIGICAM_CONTROL,
 }
 _GLOBAL_FRAMES = RELATIVE_ALT_FRAMES | AMSL_FRAMES
 
@@ -206,3 +207,5 @@ class AutoMission:
             flags = item.x  # MISSION_ITEM_INT carries param5 (the flags) in x
             locked = bool(flags & mavlink.GIMBAL_MANAGER_FLAGS_YAW_LOCK)
             ap.set_gimbal(pitch_deg=item.param1, yaw_deg=item.param2, yaw_locked=locked)
+        elif cmd == mavlink.MAV_CMD_DO_DIGICAM_CONTROL:
+            ap.shutter.trigger()

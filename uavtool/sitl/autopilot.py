@@ -18,9 +18,12 @@ from uavtool.sitl.auto import AutoMission
 from uavtool.sitl.battery import Battery
 from uavtool.sitl.crash import Collisions
 from uavtool.sitl.fence import Fence
+from uavtool.sitl.mount import Mount
 from uavtool.sitl.obstacles import Prism
 from uavtool.sitl.params import ParamStore
 from uavtool.sitl.physics import Multicopter, State, Target
+from uavtool.sitl.prearm import boot_failure
+from uavtool.sitl.shutter import Shutter
 from uavtool.sitl.state import (
     ACCEPTED,
     ARMABLE_MODES,
@@ -30,6 +33,7 @@ from uavtool.sitl.state import (
     denied,
     failed,
 )
+from uavtool.sitl.yaw import travel_yaw_deg
 
 FORCE_MAGIC = 21196  # ArduPilot's "force" value for ARM_DISARM param2
 _NS = 1_000_000_000
@@ -48,8 +52,12 @@ class Autopilot:
         seed: int,
         obstacles: Sequence[Prism] = (),
         body_radius_m: float = 0.4,
+        arming_settle_s: float = 0.0,
+        mount_roll_trim_deg: float = 0.0,
     ) -> None:
         self.params = params
+        self.mount = Mount.at_boot(params, roll_trim_deg=mount_roll_trim_deg)
+        self.arming_settle_s = arming_settle_s
         self.home = home
         # Separate streams: how many sensor readings are sent (clients, rates) must not
         # change the gusts, so the trajectory depends only on the seed and the commands.
@@ -61,6 +69,7 @@ class Autopilot:
         self.gimbal = Gimbal(pitch_deg=0.0, target_pitch_deg=0.0)
         self.gimbal_owner = (0, 0)  # (sysid, compid) in primary control of the gimbal
         self.mission = AutoMission(self)
+        self.shutter = Shutter()  # DO_DIGICAM_CONTROL / IMAGE_START_CAPTURE
         self.events: deque[tuple[int, str]] = deque()  # (MAV_SEVERITY, text) to send as STATUSTEXT
         self.failsafe_gcs = False
         self.failsafe_battery = False
@@ -134,6 +143,11 @@ class Autopilot:
                 return failed(f"Arm: Mode not armable ({self.mode.name})")
             if self.battery.voltage() < self.params["BATT_LOW_VOLT"]:
                 return failed("PreArm: Battery below minimum arming voltage")
+            why = boot_failure(self.now_ns, self.arming_settle_s) or self.mount.pre_arm_failure(
+                self.params
+            )
+            if why is not None:
+                return failed(f"Arm: {why}")
         self.armed = True
         self.vehicle.motors_on = True
         self.vehicle.set_target(Target(yaw_deg=None))
@@ -235,6 +249,11 @@ class Autopilot:
         fence = self.fence.check_target(pos_ned_m)
         if fence is not None:
             return fence
+        if yaw_deg is None:
+            n, e, _ = self.state.pos_ned_m
+            yaw_deg = travel_yaw_deg(
+                int(self.params["WP_YAW_BEHAVIOR"]), from_ne_m=(n, e), to_ne_m=pos_ned_m[:2]
+            )
         yaw = yaw_deg if yaw_deg is not None else self.vehicle.target.yaw_deg
         self.taking_off = False
         self.vehicle.set_target(Target(pos_ned_m=pos_ned_m, yaw_deg=yaw))
@@ -305,6 +324,8 @@ class Autopilot:
     def set_gimbal(
         self, *, pitch_deg: float | None, yaw_deg: float | None, yaw_locked: bool = False
     ) -> Result:
+        if not self.mount.present:
+            return failed("")  # ArduPilot: FAILED, and no STATUSTEXT
         g = self.gimbal
         if pitch_deg is not None and math.isfinite(pitch_deg):
             low, high = self.params["MNT1_PITCH_MIN"], self.params["MNT1_PITCH_MAX"]

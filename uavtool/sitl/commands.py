@@ -163,11 +163,23 @@ def _gimbal_configure(session: GcsSession, cmd: CommandArgs) -> Result:
     return ACCEPTED
 
 
+GIMBAL_MESSAGES = frozenset(
+    {
+        M.MAVLINK_MSG_ID_GIMBAL_DEVICE_ATTITUDE_STATUS,
+        M.MAVLINK_MSG_ID_GIMBAL_MANAGER_STATUS,
+        M.MAVLINK_MSG_ID_GIMBAL_MANAGER_INFORMATION,
+        M.MAVLINK_MSG_ID_GIMBAL_DEVICE_INFORMATION,
+    }
+)
+
+
 def _request_message(session: GcsSession, cmd: CommandArgs) -> Result:
     msg_id = whole(cmd.p(1), 0, MSG_ID_MAX)
     if msg_id is None:
         return denied(f"Request message: no message id {cmd.p(1):g}")
     msg = session.telemetry.build(msg_id)
+    if msg is None and msg_id in GIMBAL_MESSAGES:
+        return ACCEPTED  # as ArduPilot: a known message, nothing to send without a mount
     if msg is None:
         return failed(f"Request message: message {msg_id} is not available")
     session.defer(msg)  # sent right after the ACK
@@ -247,6 +259,10 @@ HANDLERS: dict[int, Handler] = {
     M.MAV_CMD_GET_HOME_POSITION: _get_home,
     M.MAV_CMD_MISSION_START: _mission_start,
     M.MAV_CMD_DO_SET_MISSION_CURRENT: _set_mission_current,
+    M.MAV_CMD_DO_DIGICAM_CONTROL: lambda session, cmd: (
+        session.ap.shutter.trigger() if cmd.p(5) == 1 else ACCEPTED  # param5 1: shoot
+    ),
+    M.MAV_CMD_IMAGE_START_CAPTURE: lambda session, cmd: session.ap.shutter.trigger(),
     M.MAV_CMD_REQUEST_PROTOCOL_VERSION: lambda session, cmd: failed(
         "Protocol version: not provided"
     ),

@@ -14,6 +14,9 @@ from uavtool.sitl.params import check
 DEFAULT_ENDPOINTS = ("tcpin:127.0.0.1:5760", "udpout:127.0.0.1:14550")
 # ArduPilot SITL's default home: Canberra Model Aircraft Club field.
 DEFAULT_HOME = (-35.363261, 149.165230, 584.0, 353.0)
+ARMING_SETTLE_S = 4.0
+"""The built-in vehicle's boot settling (ArduCopter's SITL takes ~20 s: a few seconds keep
+tests short and still show the refusals)."""
 WIND_RANGE_MS = (0.0, 50.0)  # SIM_WIND_SPD's range
 HOME_ALT_RANGE_M = (-1000.0, 10000.0)
 """Home altitudes above mean sea level the vehicle accepts (the Dead Sea to above Everest)."""
@@ -46,6 +49,13 @@ class SitlConfig:
     (``uavtool sitl --scene`` turns a scene's buildings into these). Touching one in flight
     is a crash; a NAV_TAKEOFF that would climb into one is DENIED."""
     body_radius_m: float = 0.4
+    arming_settle_s: float = 0.0
+    """Sim seconds after boot during which arming is refused with ArduCopter's texts ("Arm:
+    Gyros inconsistent", then "Arm: Need Position Estimate"); 0: armable at once
+    (``uavtool sitl`` boots with :data:`ARMING_SETTLE_S`)."""
+    mount_roll_trim_deg: float = 0.0
+    """The roll a stabilised servo mount keeps, reported and real; 0: a perfect gimbal
+    (``uavtool sitl`` boots with :data:`SERVO_ROLL_TRIM_DEG`, as ArduCopter's servo mount)."""
     """The vehicle's body for collisions: a sphere of this radius around its position (0.4 m:
     a 450–500 mm quadcopter with its propellers). Used against obstacles only; the ground is
     met by the position itself, as landing gear would."""

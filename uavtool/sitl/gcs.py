@@ -157,9 +157,9 @@ class GcsSession:
             self.sitl.fault(self.link, f"command {cmd.command}")
             result, self._deferred = failed(f"Command {cmd.command}: internal error"), []
         sysid, compid = cmd.source
-        self.send(M.MAVLink_command_ack_message(cmd.command, result.code, 0, 0, sysid, compid))
-        if result.reason:
+        if result.reason:  # before the ACK, as ArduPilot: a client reading the ACK has it
             self.statustext(M.MAV_SEVERITY_WARNING, result.reason)
+        self.send(M.MAVLink_command_ack_message(cmd.command, result.code, 0, 0, sysid, compid))
         for deferred in self._deferred:
             self.send(deferred)
         self._deferred = []

@@ -18,6 +18,7 @@ import time
 
 from uavtool.camera import CameraPose
 from uavtool.sitl.config import SitlConfig
+from uavtool.sitl.mount import true_camera_pose
 from uavtool.sitl.server import Sitl
 
 _NS = 1_000_000_000
@@ -63,10 +64,7 @@ class LockstepTransport:
         a simulated camera photographs the world from here, not from the pose the telemetry
         last reported (which lags, and carries the GPS noise a real one would)."""
         ap = self.vehicle.autopilot
-        north, east, down = ap.state.pos_ned_m
-        gimbal = ap.gimbal
-        heading = gimbal.yaw_deg if gimbal.yaw_locked else ap.state.yaw_deg + gimbal.yaw_deg
-        return CameraPose((east, north, -down), heading % 360.0, gimbal.pitch_deg)
+        return true_camera_pose(ap.state, ap.gimbal, ap.mount)
 
     # --- Transport -----------------------------------------------------------------------------
 

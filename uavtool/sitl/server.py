@@ -72,6 +72,8 @@ class Sitl:
             seed=config.seed,
             obstacles=config.obstacles,
             body_radius_m=config.body_radius_m,
+            arming_settle_s=config.arming_settle_s,
+            mount_roll_trim_deg=config.mount_roll_trim_deg,
         )
         self.telemetry = Telemetry(
             self.autopilot,
@@ -247,6 +249,9 @@ class Sitl:
             self.broadcast(self.telemetry.mission_current())
         while mission.reached:
             self.broadcast(M.MAVLink_mission_item_reached_message(mission.reached.pop(0)))
+        if ap.shutter.pending:
+            for msg in ap.shutter.feedback(self.telemetry, target_system=0):
+                self.broadcast(msg)
         for session in self.sessions:
             try:
                 session.tick(now)

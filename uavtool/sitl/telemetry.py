@@ -14,6 +14,7 @@ from typing import Any
 from uavtool.geo import wrap_180
 from uavtool.mavlink.dialect import mavlink
 from uavtool.sitl.autopilot import Autopilot
+from uavtool.sitl.mount import gimbal_quaternion
 from uavtool.sitl.state import Mode
 
 M = mavlink
@@ -320,9 +321,11 @@ class Telemetry:
             self.uid2,
         )
 
-    def gimbal_device_attitude_status(self) -> Any:
+    def gimbal_device_attitude_status(self) -> Any | None:
+        if not self.ap.mount.present:
+            return None  # ArduPilot sends no gimbal message without a mount
         g = self.ap.gimbal
-        q = _quat_from_euler(0.0, math.radians(g.pitch_deg), math.radians(g.yaw_deg))
+        q = list(gimbal_quaternion(g, self.ap.mount))
         flags = (
             M.GIMBAL_DEVICE_FLAGS_ROLL_LOCK
             | M.GIMBAL_DEVICE_FLAGS_PITCH_LOCK
@@ -334,7 +337,9 @@ class Telemetry:
             0, 0, self.boot_ms, flags, q, math.nan, math.nan, math.nan, 0, vehicle_yaw, math.nan, 1
         )
 
-    def gimbal_manager_status(self) -> Any:
+    def gimbal_manager_status(self) -> Any | None:
+        if not self.ap.mount.present:
+            return None  # ArduPilot sends no gimbal message without a mount
         flags = M.GIMBAL_MANAGER_FLAGS_ROLL_LOCK | M.GIMBAL_MANAGER_FLAGS_PITCH_LOCK
         if self.ap.gimbal.yaw_locked:
             flags |= M.GIMBAL_MANAGER_FLAGS_YAW_LOCK
@@ -342,7 +347,9 @@ class Telemetry:
         compid = self.ap.gimbal_owner[1]
         return M.MAVLink_gimbal_manager_status_message(self.boot_ms, flags, 1, sysid, compid, 0, 0)
 
-    def gimbal_manager_information(self) -> Any:
+    def gimbal_manager_information(self) -> Any | None:
+        if not self.ap.mount.present:
+            return None  # ArduPilot sends no gimbal message without a mount
         cap = (
             M.GIMBAL_MANAGER_CAP_FLAGS_HAS_PITCH_AXIS
             | M.GIMBAL_MANAGER_CAP_FLAGS_HAS_PITCH_LOCK
@@ -354,7 +361,9 @@ class Telemetry:
             self.boot_ms, cap, 1, 0.0, 0.0, *self._gimbal_limits_rad()
         )
 
-    def gimbal_device_information(self) -> Any:
+    def gimbal_device_information(self) -> Any | None:
+        if not self.ap.mount.present:
+            return None  # ArduPilot sends no gimbal message without a mount
         cap = (
             M.GIMBAL_DEVICE_CAP_FLAGS_HAS_PITCH_AXIS
             | M.GIMBAL_DEVICE_CAP_FLAGS_HAS_PITCH_LOCK
@@ -372,18 +381,6 @@ class Telemetry:
         names = ("MNT1_PITCH_MIN", "MNT1_PITCH_MAX", "MNT1_YAW_MIN", "MNT1_YAW_MAX")
         low_pitch, high_pitch, low_yaw, high_yaw = (math.radians(p[n]) for n in names)
         return low_pitch, high_pitch, low_yaw, high_yaw
-
-
-def _quat_from_euler(roll: float, pitch: float, yaw: float) -> list[float]:
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return [
-        cr * cp * cy + sr * sp * sy,
-        sr * cp * cy - cr * sp * sy,
-        cr * sp * cy + sr * cp * sy,
-        cr * cp * sy - sr * sp * cy,
-    ]
 
 
 class Streams:

@@ -1,7 +1,7 @@
 """Missions in Rerun: ``uavtool view`` (a recording) and ``uavtool fly --rerun`` (live).
 
 >>> from uavtool.view import view
->>> result = view("recordings/paper.mcap", save="paper.rrd")  # doctest: +SKIP
+>>> result = view("recordings/golden/paper.mcap", save="paper.rrd")  # doctest: +SKIP
 >>> result.counts.frames  # doctest: +SKIP
 8
 

@@ -44,6 +44,22 @@ def log_world(rec: rr.RecordingStream, paths: Paths) -> None:
     )
 
 
+def vertex_normals(vertices_m: Any, faces: Any) -> Any:
+    """Unit normals, (n, 3) float32: each vertex's faces' normals weighted by their area.
+
+    trimesh's ``vertex_normals`` does the same through scipy's sparse matrices and logs a
+    traceback when scipy is missing; scipy is not a dependency of ours.
+    """
+    v = np.asarray(vertices_m, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    area_normals = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    sums = np.zeros_like(v)
+    for k in range(3):
+        np.add.at(sums, f[:, k], area_normals)
+    lengths = np.linalg.norm(sums, axis=1, keepdims=True)
+    return (sums / np.where(lengths > 0.0, lengths, 1.0)).astype(np.float32)
+
+
 def log_scene(rec: rr.RecordingStream, paths: Paths, *, scene: Scene) -> None:
     """The ground-truth buildings as meshes in their colours, and the ground; static."""
     xs: list[float] = [0.0]
@@ -55,7 +71,7 @@ def log_scene(rec: rr.RecordingStream, paths: Paths, *, scene: Scene) -> None:
             rr.Mesh3D(
                 vertex_positions=np.asarray(mesh.vertices, dtype=np.float32),
                 triangle_indices=np.asarray(mesh.faces, dtype=np.uint32),
-                vertex_normals=np.asarray(mesh.vertex_normals, dtype=np.float32),
+                vertex_normals=vertex_normals(mesh.vertices, mesh.faces),
                 albedo_factor=(*building.color_rgb, 255),
             ),
             static=True,

@@ -16,6 +16,7 @@ from uavtool.geo import GeoPoint
 from uavtool.recording import CompressedImage, JsonDocument, LogEntry, RecordingReader
 from uavtool.view.errors import ViewError
 from uavtool.view.logger import MissionLogger
+from uavtool.view.recorded import is_recorded_flight, log_recorded_flight
 from uavtool.world import SceneError, scene_from_dict
 
 OBSERVATIONS = "/mission/observations"
@@ -33,6 +34,9 @@ def log_recording(path: str | Path, logger: MissionLogger) -> None:
     a recording, `ViewError` if it holds no mission."""
     with RecordingReader(path) as reader:
         present = set(reader.topics())
+        if OBSERVATIONS not in present and is_recorded_flight(present):
+            log_recorded_flight(path, reader, logger)  # from `uavtool record`: no mission
+            return
         if OBSERVATIONS not in present:
             raise ViewError(f"{path}: no {OBSERVATIONS} topic: not a mission recording")
         reader.require_metadata(("scene", "mission"))  # else the view would lack them quietly

@@ -352,8 +352,23 @@ def inverse_depth_plane(
 
 def ground_rows(pose: CameraPose, intr: Intrinsics) -> int:
     """Index of the first image row that sees the ground (rows above it see the sky)."""
+    if pose.roll_deg != 0.0:
+        return _ground_rows_rolled(pose, intr)
     p = math.radians(pose.pitch_deg)
     sp, cp = math.sin(p), math.cos(p)
     # a pixel row looks down when  -cos(p)·(v - cy)/fy + sin(p) < 0
     for_row = [(-cp * (j - intr.cy_px) / intr.fy_px + sp) < 0.0 for j in range(intr.height_px)]
     return for_row.index(True) if True in for_row else intr.height_px
+
+
+def _ground_rows_rolled(pose: CameraPose, intr: Intrinsics) -> int:
+    """:func:`ground_rows` for a rolled camera: the first row either of whose end pixels
+    looks down (the horizon is a straight line across the image)."""
+    right, down, forward = pose.axes()
+    for j in range(intr.height_px):
+        y = (j - intr.cy_px) / intr.fy_px
+        for i in (0, intr.width_px - 1):
+            x = (i - intr.cx_px) / intr.fx_px
+            if x * right[2] + y * down[2] + forward[2] < 0.0:
+                return j
+    return intr.height_px

@@ -1,0 +1,82 @@
+"""``uavtool fly`` against ArduPilot's own ArduCopter SITL, when ``UAVTOOL_ARDUCOPTER`` names
+a built ``arducopter`` binary (``./waf copter`` in an ArduPilot tree); skipped otherwise.
+
+Without a mount the run must stop on the ground with exit 2 and the fix; with a servo mount
+in a defaults file it must complete. ArduCopter boots in ~20 s of sim time, so each flight
+takes minutes of wall time.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import pytest
+
+ARDUCOPTER = os.environ.get("UAVTOOL_ARDUCOPTER", "")
+pytestmark = pytest.mark.skipif(
+    not ARDUCOPTER or not Path(ARDUCOPTER).is_file(),
+    reason="UAVTOOL_ARDUCOPTER does not name a built arducopter binary",
+)
+MOUNT_PARM = (
+    "MNT1_TYPE 1\nMNT1_PITCH_MIN -90\nMNT1_PITCH_MAX 0\nSERVO9_FUNCTION 7\nSERVO10_FUNCTION 6\n"
+)
+HOME = "50.0647,19.945,219,0"  # the paper scene's home (the scene follows the vehicle anyway)
+
+
+def _copter_defaults() -> Path:
+    """ArduPilot's copter.parm beside the binary's tree (build/sitl/bin/arducopter)."""
+    tree = Path(ARDUCOPTER).resolve().parents[3]
+    return tree / "Tools" / "autotest" / "default_params" / "copter.parm"
+
+
+@contextmanager
+def arducopter(tmp_path: Path, *, mount: bool) -> Iterator[int]:
+    defaults = [str(_copter_defaults())]
+    if mount:
+        parm = tmp_path / "mount.parm"
+        parm.write_text(MOUNT_PARM)
+        defaults.append(str(parm))
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    cmd = [
+        ARDUCOPTER, "--model", "+", "--home", HOME, "--defaults", ",".join(defaults),
+        "--serial0", f"tcp:{port}", "--wipe", "-I0",
+    ]  # fmt: skip
+    proc = subprocess.Popen(cmd, cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT)
+    try:
+        time.sleep(2.0)
+        yield port
+    finally:
+        proc.terminate()
+        proc.wait(timeout=10)
+
+
+def _fly(port: int, tmp_path: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "uavtool", "fly", "--connect", f"tcp:127.0.0.1:{port}",
+         "--timeout", "120", "--record", str(tmp_path / "f.mcap")],
+        capture_output=True, text=True, timeout=1800, check=False,
+    )  # fmt: skip
+
+
+def test_without_a_mount_exit_2_on_the_ground(tmp_path: Path) -> None:
+    with arducopter(tmp_path, mount=False) as port:
+        result = _fly(port, tmp_path)
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert "MNT1_TYPE" in result.stderr and "reboot" in result.stderr
+    assert "taking off" not in result.stdout
+
+
+def test_with_a_mount_the_mission_completes(tmp_path: Path) -> None:
+    with arducopter(tmp_path, mount=True) as port:
+        result = _fly(port, tmp_path)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "outcome        completed" in result.stdout

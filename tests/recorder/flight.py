@@ -1,0 +1,102 @@
+"""A flight someone else flies, for the recorder's tests: the built-in vehicle over the paper
+scene, flown in AUTO by a scripted ground station (upload, arm, MISSION_START), with a photo
+(DO_DIGICAM_CONTROL item) above each building."""
+
+from __future__ import annotations
+
+import socket
+from collections import Counter
+from typing import Any
+
+from tests.sitl.client import Client
+from uavtool.geo import geo_from_enu
+from uavtool.mavlink import mavlink as M
+from uavtool.sitl import Sitl, SitlConfig
+from uavtool.world import Scene
+
+REL = M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
+PHOTO_ALT_M = 20.0
+# Above each building of the paper scene (ENU metres from home), in visiting order.
+STOPS = {"purple": (0.0, 9.0), "yellow": (-13.0, 7.0), "blue": (-11.0, -8.0), "red": (10.0, -8.0)}
+
+
+def free_udp_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+class LinkCounter:
+    """The vehicle's frame tap: frames received, per link name."""
+
+    def __init__(self) -> None:
+        self.received: Counter[str] = Counter()
+
+    def __call__(self, direction: str, link: Any, raw: bytes) -> None:
+        if direction == "in":
+            self.received[link.name] += 1
+
+
+def vehicle(scene: Scene, *, endpoints: tuple[str, ...], tap: LinkCounter | None = None) -> Sitl:
+    config = SitlConfig(endpoints=endpoints, speedup=8.0, home=scene.home)
+    return Sitl(config, frame_tap=tap)
+
+
+def mission_items(scene: Scene) -> list[tuple[Any, ...]]:
+    home = scene.home
+    items: list[tuple[Any, ...]] = [
+        (
+            M.MAV_CMD_NAV_WAYPOINT,
+            M.MAV_FRAME_GLOBAL_INT,
+            0,
+            0,
+            0,
+            0,
+            home.lat_e7,
+            home.lon_e7,
+            home.alt_amsl_m,
+        ),
+        (
+            M.MAV_CMD_DO_MOUNT_CONTROL,
+            M.MAV_FRAME_MISSION,
+            -90,
+            0,
+            0,
+            0,
+            0,
+            0,
+            M.MAV_MOUNT_MODE_MAVLINK_TARGETING,
+        ),
+        (M.MAV_CMD_NAV_TAKEOFF, REL, 0, 0, 0, 0, 0, 0, PHOTO_ALT_M),
+    ]
+    for east, north in STOPS.values():
+        p = geo_from_enu(home, east, north, 0.0)
+        items.append((M.MAV_CMD_NAV_WAYPOINT, REL, 1, 0, 0, 0, p.lat_e7, p.lon_e7, PHOTO_ALT_M))
+        items.append((M.MAV_CMD_DO_DIGICAM_CONTROL, M.MAV_FRAME_MISSION, 0, 0, 0, 0, 1, 0, 0))
+    items.append((M.MAV_CMD_NAV_LAND, REL, 0, 0, 0, 0, 0, 0, 0))
+    return items
+
+
+def fly_auto_mission(client: Client, scene: Scene) -> None:
+    """Upload the mission, arm, start it and wait until the vehicle has landed and disarmed."""
+    items = mission_items(scene)
+    client.send(M.MAVLink_mission_count_message(1, 1, len(items), 0))
+    while True:
+        msg = client.wait_for("MISSION_REQUEST_INT", timeout=5)
+        cmd, frame, p1, p2, p3, p4, x, y, z = items[msg.seq]
+        client.send(
+            M.MAVLink_mission_item_int_message(
+                1, 1, msg.seq, frame, cmd, 0, 1, p1, p2, p3, p4, x, y, z, 0
+            )
+        )
+        if msg.seq == len(items) - 1:
+            break
+    assert client.wait_for("MISSION_ACK").type == M.MAV_MISSION_ACCEPTED
+    client.set_mode("GUIDED")
+    assert client.command(M.MAV_CMD_COMPONENT_ARM_DISARM, 1).result == M.MAV_RESULT_ACCEPTED
+    assert client.command(M.MAV_CMD_MISSION_START, 0, 0).result == M.MAV_RESULT_ACCEPTED
+    client.wait_until(
+        lambda c: not c.latest["HEARTBEAT"].base_mode & M.MAV_MODE_FLAG_SAFETY_ARMED,
+        timeout=60,
+        what="the end of the AUTO mission",
+    )

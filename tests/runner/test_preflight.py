@@ -1,0 +1,94 @@
+"""Pre-flight checks on the ground, ``--no-gimbal``, the scene placed where the vehicle is,
+and the vehicle's refusals in the terminal and the summary (issue 18)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from uavtool.cli import cli
+from uavtool.geo import geo_from_enu
+from uavtool.mission import Params, Status
+from uavtool.mission.params import with_overrides
+from uavtool.mission.scenario import NO_GIMBAL_REASON
+from uavtool.runner.fly import FlyConfig, flight_metadata, fly
+from uavtool.runner.placement import place_scene
+from uavtool.runner.preflight import PreflightError
+from uavtool.world import load_scene
+
+
+def test_no_mount_stops_on_the_ground_naming_the_fix(tmp_path: Path) -> None:
+    said: list[str] = []
+    path = tmp_path / "f.mcap"
+    with pytest.raises(PreflightError) as exc:
+        fly(FlyConfig(record=path, vehicle_params=(("MNT1_TYPE", 0.0),)), status=said.append)
+    text = str(exc.value)
+    assert "no gimbal" in text and "MNT1_TYPE=1" in text and "reboot" in text
+    assert "--no-gimbal" in text
+    assert not path.exists()  # nothing flew: no recording is left
+
+
+def test_no_mount_is_exit_2_with_one_line() -> None:
+    result = CliRunner().invoke(cli, ["fly", "--no-record", "-q", "--param", "MNT1_TYPE=0"])
+    assert result.exit_code == 2
+    assert len(result.output.strip().splitlines()) == 1
+
+
+def test_no_gimbal_flies_the_search_and_ends_partial(tmp_path: Path) -> None:
+    summary = fly(FlyConfig(record=tmp_path / "f.mcap", no_gimbal=True))
+    o = summary.outcome
+    assert o.status == Status.PARTIAL
+    assert o.reason == NO_GIMBAL_REASON
+    assert summary.evaluation.matched_building == "red"
+    assert not o.model_built
+
+
+def test_a_vehicle_that_refuses_is_heard_and_summarised(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A mount type set at run time on a vehicle that booted without one: ArduCopter's
+    "Arm: Mount: check TYPE" is printed as it arrives and repeated in the summary."""
+    monkeypatch.setattr("uavtool.runner.fly.BOOT_ONLY_PARAMS", frozenset())  # set after boot
+    heard: list[str] = []
+    config = FlyConfig(
+        no_record=True,
+        no_gimbal=True,
+        params=with_overrides(Params(), {"mission.arm_wait_s": "3"}),
+        vehicle_params=(("MNT1_TYPE", 1.0),),
+    )
+    summary = fly(config, vehicle_says=heard.append)
+    assert summary.outcome.status == Status.ABORTED
+    assert any("Arm: Mount: check TYPE" in h for h in heard)
+    assert "Arm: Mount: check TYPE" in summary.last_refusal
+    assert "COMPONENT_ARM_DISARM" in summary.last_refusal
+
+
+def test_the_scene_goes_where_the_vehicle_is() -> None:
+    scene = load_scene("paper")
+    canberra = geo_from_enu(scene.home, 0.0, 252_000.0, 0.0)
+    assert place_scene(scene, canberra, "vehicle", lambda _t: None) == canberra
+
+
+def test_scene_origin_scene_refuses_a_far_vehicle_with_the_home_to_use() -> None:
+    scene = load_scene("paper")
+    far = geo_from_enu(scene.home, 0.0, 252_000.0, 0.0)
+    with pytest.raises(PreflightError) as exc:
+        place_scene(scene, far, "scene", lambda _t: None)
+    assert "252.0 km" in str(exc.value)
+    assert f"--home {scene.home.lat_deg:.7f},{scene.home.lon_deg:.7f}" in str(exc.value)
+    near = geo_from_enu(scene.home, 5.0, 0.0, 0.0)
+    assert place_scene(scene, near, "scene", lambda _t: None) == scene.home
+
+
+def test_the_metadata_says_which_origin() -> None:
+    scene = load_scene("paper")
+    origin = {
+        (connect, where): flight_metadata(FlyConfig(connect=connect, scene_origin=where), scene)[
+            "vehicle"
+        ]["scene_origin"]
+        for connect in (None, "tcp:127.0.0.1:5760")
+        for where in ("vehicle", "scene")
+    }
+    assert origin[None, "vehicle"] == "scene"  # the built-in vehicle boots at the scene's home
+    assert origin["tcp:127.0.0.1:5760", "vehicle"] == "vehicle-home"
+    assert origin["tcp:127.0.0.1:5760", "scene"] == "scene"

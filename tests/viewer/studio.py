@@ -1,0 +1,56 @@
+"""Foxglove Studio's own MCAP data source, run in node over a recording (`foxglove_source.cjs`).
+
+Lichtblick's app is not published on npm (`@lichtblick/suite` holds only the extension API
+types), and neither is Foxglove's app shell; `@foxglove/studio-base` 1.48.0, the last
+open-source Studio core on npm, ships the built bundle with the MCAP source, its channel
+parser (`parseChannel`, `parseJsonSchema`, Protobuf descriptors) and its deserializers, the
+code Lichtblick forked. It is installed once into a cache folder outside the repository
+(``$UAVTOOL_NPM_CACHE``, default ``~/.cache/uavtool/npm``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+from pathlib import Path
+from typing import Any
+
+PACKAGE = "@foxglove/studio-base"
+VERSION = "1.48.0"
+HARNESS = Path(__file__).with_name("foxglove_source.cjs")
+
+
+def cache_dir() -> Path:
+    default = Path.home() / ".cache" / "uavtool" / "npm"
+    return Path(os.environ.get("UAVTOOL_NPM_CACHE", default)) / f"studio-base-{VERSION}"
+
+
+def assets() -> Path | None:
+    """The installed bundle's assets folder (installing it on first use); None if npm or
+    node is missing."""
+    if shutil.which("node") is None or shutil.which("npm") is None:
+        return None
+    folder = cache_dir()
+    found = folder / "node_modules" / PACKAGE / "assets"
+    if not (found / "index.js").is_file():
+        folder.mkdir(parents=True, exist_ok=True)
+        subprocess.run(
+            ["npm", "install", "--no-save", "--no-audit", "--no-fund", "--ignore-scripts",
+             "--prefix", str(folder), f"{PACKAGE}@{VERSION}"],
+            check=True, capture_output=True, timeout=600,
+        )  # fmt: skip
+    return found
+
+
+def open_in_studio(bundle: Path, recording: Path) -> dict[str, Any]:
+    """What Studio's data source makes of ``recording``: ``topics``, ``problems``,
+    ``perTopic`` (decoded count and first message) and ``datatypes``."""
+    done = subprocess.run(
+        ["node", str(HARNESS), str(bundle), str(recording)],
+        check=False, capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    result: dict[str, Any] = json.loads(done.stdout)
+    return result

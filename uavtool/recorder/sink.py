@@ -1,0 +1,127 @@
+"""Where a passive recording's messages go: the same `RecordingWriter`, topics and Foxglove
+values as a mission's, with the vehicle's telemetry and the camera's frames in place of the
+mission's observations (README, "Recording flights you don't fly")."""
+
+from __future__ import annotations
+
+from uavtool.geo import GeoPoint, geo_from_enu
+from uavtool.mission import Telemetry
+from uavtool.mission.codec import encode, encode_observation
+from uavtool.recorder.frames import Frame
+from uavtool.recorder.watch import Event
+from uavtool.recording import (
+    CameraCalibration,
+    CompressedImage,
+    Direction,
+    FrameTransform,
+    LocationFix,
+    LogEntry,
+    Pose,
+    PosesInFrame,
+    RecordingWriter,
+)
+from uavtool.recording.topics import (
+    CALIBRATION,
+    CAMERA_POSE,
+    FIX,
+    FRAMES,
+    IMAGE,
+    POSE,
+    TELEMETRY,
+    VEHICLE_EVENTS,
+)
+from uavtool.runner.record import ClockNs
+
+TELEMETRY_SCHEMA = {
+    "title": "uavtool.Telemetry",
+    "description": "The vehicle's state from GLOBAL_POSITION_INT, HEARTBEAT, "
+    "EXTENDED_SYS_STATE and the gimbal status, in ENU metres around the recording's origin.",
+    "type": "object",
+    "properties": {
+        "time_boot_ms": {"type": "integer"},
+        "pos_enu_m": {"type": "array", "items": {"type": "number"}},
+        "heading_deg": {"type": "number"},
+        "mode": {"type": "string"},
+        "armed": {"type": "boolean"},
+        "landed": {"type": "boolean"},
+    },
+    "required": ["time_boot_ms", "pos_enu_m"],
+}
+FRAME_SCHEMA = {
+    "title": "uavtool.Frame",
+    "description": "A camera frame's capture (vehicle time) and pose; its pixels are the "
+    "frame_index-th message on /camera/image.",
+    "type": "object",
+    "properties": {
+        "frame_index": {"type": "integer"},
+        "tag": {"type": "string"},
+        "photo": {"type": "integer"},
+        "trigger": {"type": "string"},
+        "time_boot_ms": {"type": "integer"},
+        "pose_time_boot_ms": {"type": "integer"},
+        "pose_dt_ms": {"type": "integer"},
+    },
+    "required": ["frame_index", "time_boot_ms"],
+}
+
+
+class PassiveRecorder:
+    """Writes a flight it does not command into ``writer``, stamped by ``clock_ns``;
+    ``origin`` is the local frame's origin (the vehicle's home) for WGS-84 fixes."""
+
+    def __init__(self, writer: RecordingWriter, *, clock_ns: ClockNs, origin: GeoPoint) -> None:
+        self.writer = writer
+        self.clock_ns = clock_ns
+        self.origin = origin
+        self.counts = {"in": 0, "out": 0, "telemetry": 0, "frames": 0, "photos": 0, "events": 0}
+        self.max_pose_dt_ms = 0
+        writer.add_json_topic(TELEMETRY, schema_name="uavtool.Telemetry", schema=TELEMETRY_SCHEMA)
+        writer.add_json_topic(FRAMES, schema_name="uavtool.Frame", schema=FRAME_SCHEMA)
+
+    def mavlink(self, direction: str, frame: bytes) -> None:
+        """The link's tap: every whole frame, as it crossed the link."""
+        self.counts[direction] += 1
+        self.writer.write_mavlink(
+            frame,
+            direction=Direction.IN if direction == "in" else Direction.OUT,
+            log_time_ns=self.clock_ns(),
+        )
+
+    def telemetry(self, t: Telemetry) -> None:
+        now = self.clock_ns()
+        self.counts["telemetry"] += 1
+        self.writer.write_json(TELEMETRY, encode_observation(t), log_time_ns=now)
+        pose = Pose.from_enu_heading(t.pos_enu_m, t.heading_deg)
+        self.writer.write(POSE, PosesInFrame((pose,)), log_time_ns=now)
+        geo = geo_from_enu(self.origin, *t.pos_enu_m)
+        fix = LocationFix(geo.lat_deg, geo.lon_deg, geo.alt_amsl_m)
+        self.writer.write(FIX, fix, log_time_ns=now)
+
+    def frame(self, f: Frame) -> None:
+        now = self.clock_ns()
+        self.counts["frames"] += 1
+        self.counts["photos"] += f.photo >= 0
+        self.max_pose_dt_ms = max(self.max_pose_dt_ms, abs(f.pose_dt_ms))
+        self.writer.write(IMAGE, CompressedImage(f.png), log_time_ns=now)
+        calibration = CameraCalibration.from_intrinsics(f.intrinsics)
+        self.writer.write(CALIBRATION, calibration, log_time_ns=now)
+        self.writer.write(CAMERA_POSE, FrameTransform.from_camera_pose(f.pose), log_time_ns=now)
+        record = {
+            "type": "Photo",
+            "action_id": -1,
+            "frame_index": f.index,
+            "tag": f.tag,
+            "time_boot_ms": f.time_boot_ms,
+            "pose": encode(f.pose),
+            "intrinsics": encode(f.intrinsics),
+            "photo": f.photo,
+            "trigger": f.trigger,
+            "pose_time_boot_ms": f.pose_time_boot_ms,
+            "pose_dt_ms": f.pose_dt_ms,
+        }
+        self.writer.write_json(FRAMES, record, log_time_ns=now)
+
+    def event(self, e: Event) -> None:
+        self.counts["events"] += 1
+        entry = LogEntry(e.level, e.text, name=e.source)
+        self.writer.write(VEHICLE_EVENTS, entry, log_time_ns=self.clock_ns())

@@ -1,0 +1,117 @@
+"""Checks on the ground, before arming: what the mission needs of the vehicle and the camera.
+
+The vehicle is asked what it has (GIMBAL_MANAGER_INFORMATION, and ArduPilot's ``MNT1_TYPE``)
+so that a missing mount stops the run before take-off with the fix, not at 45 m with a
+refused DO_MOUNT_CONTROL. Every wait is on the link's clock (vehicle time in lockstep).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+from uavtool.camera import CameraPose
+from uavtool.errors import InputError
+from uavtool.link import VehicleLink
+from uavtool.mavlink.dialect import mavlink as M
+from uavtool.runner.camera import CameraSource
+
+ANSWER_S = 3.0
+"""How long the vehicle has to answer each question."""
+RETRY_S = 0.5
+"""How often an unanswered question is asked again."""
+SERVO_MOUNT_FIX = (
+    "set MNT1_TYPE=1 (servo) with SERVO9_FUNCTION=7 (mount pitch) and SERVO10_FUNCTION=6 "
+    "(mount yaw), e.g. in a defaults file, and reboot the autopilot (ArduPilot reads "
+    "MNT1_TYPE only at boot)"
+)
+
+
+class PreflightError(InputError):
+    """The vehicle or the camera lacks what the mission needs; raised before arming."""
+
+
+def check_home(link: VehicleLink) -> None:
+    if link.state.home is None:
+        raise PreflightError(f"{link.name}: the vehicle has no home position; wait for GPS")
+
+
+def check_camera(camera: CameraSource) -> None:
+    """One frame from the camera, or PreflightError."""
+    try:
+        camera.capture(CameraPose((0.0, 0.0, 0.0), 0.0, -90.0))
+    except Exception as exc:  # any camera failure stops the run on the ground
+        raise PreflightError(f"camera: no frame before take-off: {exc}") from None
+
+
+def check_gimbal(
+    link: VehicleLink,
+    *,
+    need_pitch_deg: tuple[float, float] = (-90.0, 0.0),
+    on_wait: Callable[[], None] | None = None,
+) -> Any:
+    """The vehicle's GIMBAL_MANAGER_INFORMATION if its gimbal can point at each of
+    ``need_pitch_deg``; PreflightError naming the fix otherwise."""
+    info = _ask(
+        link,
+        lambda: link.command_long(
+            M.MAV_CMD_REQUEST_MESSAGE, M.MAVLINK_MSG_ID_GIMBAL_MANAGER_INFORMATION
+        ),
+        "GIMBAL_MANAGER_INFORMATION",
+        on_wait,
+    )
+    if info is None:
+        raise PreflightError(
+            f"the vehicle has no gimbal: {_mount_fix(link, on_wait)}; or fly with --no-gimbal"
+        )
+    low, high = math.degrees(info.pitch_min), math.degrees(info.pitch_max)
+    missing = [p for p in need_pitch_deg if not low - 0.5 <= p <= high + 0.5]
+    if missing:
+        raise PreflightError(
+            f"the gimbal pitches {low:g}..{high:g}° but the mission needs "
+            f"{', '.join(f'{p:g}°' for p in missing)}: set MNT1_PITCH_MIN=-90 and MNT1_PITCH_MAX=0"
+        )
+    return info
+
+
+def _mount_fix(link: VehicleLink, on_wait: Callable[[], None] | None) -> str:
+    """What to do, from ArduPilot's MNT1_TYPE when it answers."""
+    heartbeat = link.state.heartbeat
+    if heartbeat is None or heartbeat.autopilot != M.MAV_AUTOPILOT_ARDUPILOTMEGA:
+        return "configure a gimbal on the autopilot (gimbal protocol v2)"
+    value = _ask(
+        link,
+        lambda: link.send(
+            M.MAVLink_param_request_read_message(
+                link.target_system, link.target_component, b"MNT1_TYPE", -1
+            )
+        ),
+        "PARAM_VALUE",
+        on_wait,
+    )
+    if value is not None and value.param_value != 0:
+        return (
+            f"MNT1_TYPE is {value.param_value:g} but no mount started: reboot the autopilot "
+            "(ArduPilot reads MNT1_TYPE only at boot)"
+        )
+    return f"MNT1_TYPE=0; {SERVO_MOUNT_FIX}"
+
+
+def _ask(
+    link: VehicleLink, request: Callable[[], None], kind: str, on_wait: Callable[[], None] | None
+) -> Any:
+    """The first ``kind`` message after ``request``, asked again every :data:`RETRY_S` (a
+    lossy link may drop the question or the answer); None after :data:`ANSWER_S`."""
+    deadline = link.clock() + ANSWER_S
+    asked = -math.inf
+    while link.clock() < deadline:
+        if link.clock() - asked >= RETRY_S:
+            request()
+            asked = link.clock()
+        for msg in link.poll(0.05):
+            if msg.get_type() == kind:
+                return msg
+        if on_wait is not None:
+            on_wait()
+    return None
