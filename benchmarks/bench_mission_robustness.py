@@ -1,7 +1,8 @@
 """Does the mission find the right building when the flight is not perfect?
 
-Flies the built-in SITL (``uavtool fly --no-record`` through :func:`uavtool.runner.fly.fly`)
-over the ``paper``, ``blocked-front`` and ``dense`` scenes and prints per flight: did it
+Flies the built-in SITL as one ``uavtool sweep`` (:func:`uavtool.sweep.run_sweep`: each flight
+a Dask task on a local cluster, one recording and one table row per flight) over the
+``paper``, ``blocked-front`` and ``dense`` scenes and prints per flight, from the table: did it
 match the target building (the runner knows the scene's ground truth), the target's
 score(s) at its point of interest (``a→b`` when the mission looked twice), the model's IoU
 against the true building, and the flight time (vehicle seconds). Conditions, per scene:
@@ -15,11 +16,14 @@ against the true building, and the flight time (vehicle seconds). Conditions, pe
 Each condition is flown with two mission parameter sets in one run: ``new`` (today's
 defaults) and ``baseline`` (the same with the robustness features switched off through
 their ``mission.*`` keys: roofs joined only when their colours are equal, one look per point
-of interest), so the summary compares them on the same seeds. A flight takes ~3–6 s of wall
-time; the default run (30 conditions × 2) about 4–5 minutes on two busy cores.
+of interest), so the summary compares them on the same seeds. The conditions are the sweep
+spec's ``[[cases]]`` (condition × variant), crossed with its scenes; the flights are the same as
+when this script flew them one after another, so are the figures. A flight takes ~3–6 s of
+one core; the default run (30 conditions × 2) about 3 minutes on two busy cores.
 
     python benchmarks/bench_mission_robustness.py [--scenes paper,dense] [--seeds 1,2]
         [--wind 6] [--wind-dirs 0,90,180,270] [--headings 30,60] [--variants new,baseline]
+        [--workers 2 | --scheduler ADDRESS] [--out FOLDER]
 """
 
 from __future__ import annotations
@@ -28,18 +32,18 @@ import argparse
 import json
 import tempfile
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
-from uavtool.mission import Params
-from uavtool.mission.params import valid_keys, with_overrides
-from uavtool.replay.load import load_flight
-from uavtool.runner.fly import FlightSummary, FlyConfig, fly
-from uavtool.world import load_scene, scene_to_dict
+from uavtool.cli.fly import EXIT_CODES
+from uavtool.mission.params import valid_keys
+from uavtool.sweep import run_sweep
+from uavtool.sweep.spec import parse_spec
 
 # The switches that turn today's robustness features off (see MissionParams); keys this
 # checkout does not know are left out, so the script also measures older missions.
-BASELINE = {"mission.roof_colour_tolerance_dn": "0", "mission.max_looks": "1"}
+BASELINE = {"mission.roof_colour_tolerance_dn": 0, "mission.max_looks": 1}
 
 
 @dataclass(frozen=True, slots=True)
@@ -49,7 +53,8 @@ class Condition:
     wind: tuple[float, float] = (0.0, 0.0)
     noise: bool = True
     heading_deg: float = 0.0
-    """The vehicle's heading at home (it keeps it over the points of interest)."""
+    """The vehicle's heading at home (it keeps it over the points of interest); 0: the
+    scene's own."""
 
     @property
     def label(self) -> str:
@@ -59,24 +64,14 @@ class Condition:
             f"{wind:<12s} hdg {self.heading_deg:3.0f}"
         )
 
-
-@dataclass(frozen=True, slots=True)
-class Seen:
-    """One recognition: the point of interest looked at and its candidate's score."""
-
-    poi: int
-    score: float
-
-
-@dataclass(slots=True)
-class Result:
-    summary: FlightSummary
-    recognitions: list[Seen] = field(default_factory=list)
-
-    @property
-    def correct(self) -> bool:
-        e = self.summary.evaluation
-        return bool(e.matched_building) and e.matched_building == e.target_building
+    def inputs(self) -> dict[str, Any]:
+        """The condition as sweep inputs (the scene is the spec's)."""
+        out: dict[str, Any] = {"seed": self.seed, "noise": self.noise}
+        if self.wind[0]:
+            out |= {"wind_speed_ms": self.wind[0], "wind_from_deg": self.wind[1]}
+        if self.heading_deg:
+            out["home_heading_deg"] = self.heading_deg
+        return out
 
 
 def conditions(
@@ -101,59 +96,38 @@ def conditions(
     return out
 
 
-def scene_arg(cond: Condition, tmp: Path) -> str:
-    """The scene's name, or a scene file with the home heading turned."""
-    if cond.heading_deg == 0.0:
-        return cond.scene
-    data = scene_to_dict(load_scene(cond.scene))
-    data["origin"]["heading_deg"] = cond.heading_deg
-    path = tmp / f"{cond.scene}-hdg{cond.heading_deg:g}.json"
-    path.write_text(json.dumps(data), encoding="utf-8")
-    return str(path)
-
-
-def fly_one(cond: Condition, params: Params, tmp: Path) -> Result:
-    """Fly one condition, recorded; its recognitions are read back from the recording."""
-    record = tmp / "flight.mcap"
-    config = FlyConfig(
-        scene=scene_arg(cond, tmp),
-        record=record,
-        params=params,
-        seed=cond.seed,
-        noise=cond.noise,
-        wind=cond.wind,
-    )
-    summary = fly(config)
-    seen = [
-        Seen(out.data["poi"], out.data["score"])
-        for out in load_flight(record).outputs
-        if out.data["type"] == "Recognition"
+def sweep_data(
+    scenes: list[str], per_scene: list[Condition], variants: dict[str, dict[str, Any]]
+) -> dict[str, Any]:
+    """The sweep spec: the scenes, crossed with one case per condition and variant (the
+    conditions of one scene: they are the same for every scene but for its name)."""
+    cases = [
+        c.inputs() | {f"set.{k}": v for k, v in settings.items()}
+        for c in per_scene
+        for settings in variants.values()
     ]
-    return Result(summary, seen)
+    return {"scenes": {"builtin": scenes}, "cases": cases, "sweep": {"retries": 0}}
 
 
-def target_scores(r: Result) -> str:
+def target_scores(r: dict[str, Any]) -> str:
     """The scores at the target building's point(s) of interest, in the order judged."""
-    o, e = r.summary.outcome, r.summary.evaluation
-    building = dict(zip(o.visited, e.visited, strict=False))
-    scores = [
-        f"{rec.score:.3f}" for rec in r.recognitions if building.get(rec.poi) == e.target_building
-    ]
-    return "→".join(scores) if scores else "not seen"
+    scores = json.loads(r["target_scores"] or "[]")
+    return "→".join(f"{v:.3f}" for v in scores) if scores else "not seen"
 
 
-def row(cond: Condition, variant: str, r: Result) -> str:
-    s, e = r.summary, r.summary.evaluation
-    if r.correct:
+def row(cond: Condition, variant: str, r: dict[str, Any]) -> str:
+    if r["status"] == "error":
+        return f"{cond.label} {variant:<8s} ERROR {r['error']}"
+    if r["correct"]:
         verdict = "ok"
-    elif e.matched_building:
-        verdict = f"WRONG ({e.matched_building})"
+    elif r["matched_building"]:
+        verdict = f"WRONG ({r['matched_building']})"
     else:
-        verdict = f"MISSED ({s.outcome.status.value})"
-    iou = f"{e.model_iou:.3f}" if e.model_iou is not None else "-"
+        verdict = f"MISSED ({r['status']})"
+    iou = f"{r['iou']:.3f}" if r["iou"] is not None else "-"
     return (
         f"{cond.label} {variant:<8s} {verdict:<18s} target {target_scores(r):<14s} "
-        f"IoU {iou:<5s} flight {s.flight_time_s:6.1f} s  wall {s.wall_time_s:4.1f} s"
+        f"IoU {iou:<5s} flight {r['flight_time_s']:6.1f} s  wall {r['wall_s']:4.1f} s"
     )
 
 
@@ -169,37 +143,46 @@ def main() -> None:
     parser.add_argument("--wind-dirs", default="0,90,180,270", help="from, degrees")
     parser.add_argument("--headings", default="30,60", help="home headings, degrees")
     parser.add_argument("--variants", default="new,baseline")
+    parser.add_argument("--workers", type=int, default=None, help="default: one per core")
+    parser.add_argument("--scheduler", default=None, help="a running Dask scheduler")
+    parser.add_argument("--out", type=Path, default=None, help="keep the sweep folder here")
     args = parser.parse_args()
     known = valid_keys()
     baseline = {k: v for k, v in BASELINE.items() if k in known}
-    variants = {
-        "new": Params(),
-        "baseline": with_overrides(Params(), baseline, source="baseline"),
-    }
-    chosen = args.variants.split(",")
-    conds = conditions(
-        args.scenes.split(","),
-        [int(s) for s in args.seeds.split(",")],
-        args.wind,
-        floats(args.wind_dirs),
-        floats(args.headings),
-    )
+    all_variants = {"new": {}, "baseline": baseline}
+    variants = {v: all_variants[v] for v in args.variants.split(",")}
+    scenes = args.scenes.split(",")
+    seeds = [int(s) for s in args.seeds.split(",")]
+    dirs, headings = floats(args.wind_dirs), floats(args.headings)
+    conds = conditions(scenes, seeds, args.wind, dirs, headings)
     print(f"baseline = today's defaults with {baseline or '(no switch known: same mission)'}")
-    tally: dict[str, list[Result]] = {v: [] for v in chosen}
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
-        for cond in conds:
-            for variant in chosen:
-                r = fly_one(cond, variants[variant], Path(tmp))
-                tally[variant].append(r)
-                print(row(cond, variant, r), flush=True)
-    print(f"{len(conds)} conditions, {time.perf_counter() - t0:.0f} s wall")
-    for variant, results in tally.items():
-        ok = sum(r.correct for r in results)
-        wrong = sum(bool(r.summary.evaluation.matched_building) and not r.correct for r in results)
-        flight = sum(r.summary.flight_time_s for r in results) / max(len(results), 1)
+        out = args.out or Path(tmp) / "sweep"
+        per_scene = conditions(scenes[:1], seeds, args.wind, dirs, headings)
+        data = sweep_data(scenes, per_scene, variants)
+        spec = parse_spec(data, source="bench_mission_robustness", base=Path(tmp), default_out=out)
+        result = run_sweep(
+            spec,
+            exit_codes=EXIT_CODES,
+            scheduler=args.scheduler,
+            workers=args.workers,
+            plots=False,
+        )
+    flights = [(c, v) for c in conds for v in variants]
+    assert len(result.rows) == len(flights), "the sweep was interrupted"
+    tally: dict[str, list[dict[str, Any]]] = {v: [] for v in variants}
+    for (cond, variant), r in zip(flights, result.rows, strict=True):
+        tally[variant].append(r)
+        print(row(cond, variant, r))
+    kept = f"; table {result.table}" if args.out else ""
+    print(f"{len(conds)} conditions, {time.perf_counter() - t0:.0f} s wall{kept}")
+    for variant, rows in tally.items():
+        ok = sum(bool(r["correct"]) for r in rows)
+        wrong = sum(bool(r["matched_building"]) and not r["correct"] for r in rows)
+        flight = sum(float(r["flight_time_s"] or 0.0) for r in rows) / max(len(rows), 1)
         print(
-            f"{variant:<8s} success {ok}/{len(results)}, wrong matches {wrong}, "
+            f"{variant:<8s} success {ok}/{len(rows)}, wrong matches {wrong}, "
             f"mean flight {flight:.1f} s"
         )
 

@@ -18,23 +18,36 @@ buildings' judgeable frames scoring at or above the threshold; those whose true 
 is the target's shape up to scale and rotation (area-normalised IoU ≥ 0.9 at the best
 rotation) cannot be told apart by shape alone and are counted too.
 
+Each scene is one task of the sweep machinery (:func:`uavtool.sweep.dispatch.run_tasks` on a
+local Dask cluster, or ``--scheduler``); its counts are one row of a table (``--out`` keeps it
+as Parquet or CSV), summed here in seed order. The camera positions are drawn by the driver
+from one seeded generator, in seed order, as when the scenes were judged one after another:
+the figures do not depend on the number of workers.
+
     python benchmarks/bench_vision_recognition.py [--scenes 200] [--buildings 5]
+        [--workers 2 | --scheduler ADDRESS] [--out TABLE.parquet]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import random
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import cv2
 import numpy as np
+import pyarrow as pa
 import shapely
 from shapely import affinity
 
 from uavtool.camera import CameraPose, Intrinsics
+from uavtool.sweep.cluster import open_client
+from uavtool.sweep.dispatch import run_tasks
+from uavtool.sweep.table import write_table
 from uavtool.vision import RecognizeParams, Shape, VectorizeParams, match_shapes, vectorize
 from uavtool.vision.model3d import central_shape, same_colour
 from uavtool.world import render
@@ -79,6 +92,22 @@ def same_shape_iou(a: tuple[tuple[float, float], ...], b: tuple[tuple[float, flo
     )
 
 
+COUNTS = (
+    "frames",
+    "target_cut",
+    "cut_ours_top1",
+    "cut_hu_top1",
+    "ours_top1",
+    "hu_top1",
+    "misses",  # judgeable targets scoring below the threshold
+    "others",  # judgeable frames of other buildings
+    "false",
+    "false_same_shape",
+    "no_shape",
+)
+MODES = {"clean": False, "noise": True}
+
+
 @dataclass
 class Tally:
     scenes: int = 0
@@ -88,88 +117,137 @@ class Tally:
     cut_hu_top1: int = 0
     ours_top1: int = 0
     hu_top1: int = 0
-    misses: int = 0  # judgeable targets scoring below the threshold
-    others: int = 0  # judgeable frames of other buildings
+    misses: int = 0
+    others: int = 0
     false: int = 0
     false_same_shape: int = 0
     no_shape: int = 0
     errors: list[str] = field(default_factory=list)
 
+    def add(self, row: dict, mode: str) -> None:
+        """Add one scene's row (the columns ``MODE.COUNT`` and ``MODE.errors``)."""
+        self.scenes += 1
+        for name in COUNTS:
+            setattr(self, name, getattr(self, name) + row[f"{mode}.{name}"])
+        self.errors += json.loads(row[f"{mode}.errors"])
 
-def run(scenes: int, buildings: int) -> None:
-    params = RecognizeParams()
-    seeds = list(range(1000, 1000 + scenes))
+
+def camera_draws(seeds: list[int], buildings: int) -> list[tuple[float, ...]]:
+    """Three uniform draws per building (position error radius, its direction, heading) for
+    each scene, from one generator in seed order."""
     rng = random.Random(4)
-    tallies = {noise: Tally() for noise in (False, True)}
-    t0 = time.perf_counter()
-    for seed in seeds:
-        scene = generate_scene(seed=seed, buildings=buildings)
-        tb = scene.target_building
-        ti = [b.name for b in scene.buildings].index(scene.target)
-        target = max(
-            vectorize(target_bitmap(tb.blocks[0].footprint_enu_m, tb.color_rgb)),
-            key=lambda s: s.area_px,
+    return [tuple(rng.random() for _ in range(3 * buildings)) for _ in seeds]
+
+
+def judge_scene(seed: int, buildings: int, draws: tuple[float, ...]) -> dict:
+    """One scene, without and with sensor noise: its row of counts (a Dask task)."""
+    params = RecognizeParams()
+    scene = generate_scene(seed=seed, buildings=buildings)
+    tb = scene.target_building
+    ti = [b.name for b in scene.buildings].index(scene.target)
+    target = max(
+        vectorize(target_bitmap(tb.blocks[0].footprint_enu_m, tb.color_rgb)),
+        key=lambda s: s.area_px,
+    )
+    poses = []
+    for i, b in enumerate(scene.buildings):
+        cx, cy = np.array(b.blocks[0].footprint_enu_m).mean(axis=0)
+        r = MAX_POS_ERR_M * math.sqrt(draws[3 * i])
+        a = draws[3 * i + 1] * 2 * math.pi
+        heading = draws[3 * i + 2] * 360.0
+        poses.append(
+            CameraPose((cx + r * math.cos(a), cy + r * math.sin(a), ALT_M), heading, -90.0)
         )
-        poses = []
-        for b in scene.buildings:
-            cx, cy = np.array(b.blocks[0].footprint_enu_m).mean(axis=0)
-            r = MAX_POS_ERR_M * math.sqrt(rng.random())
-            a = rng.random() * 2 * math.pi
-            heading = rng.random() * 360.0
-            poses.append(
-                CameraPose((cx + r * math.cos(a), cy + r * math.sin(a), ALT_M), heading, -90.0)
-            )
-        for noise, st in tallies.items():
-            st.scenes += 1
-            ours: list[float | None] = []  # None: not judgeable (or no shape)
-            hu: list[float | None] = []
-            raw: list[tuple[float, float]] = []  # every frame's scores, cut or not
-            for i, (b, pose) in enumerate(zip(scene.buildings, poses, strict=True)):
-                frame = render(scene, pose, K, noise_seed=seed * 100 + i if noise else None)
-                shapes = vectorize(frame, NADIR)
-                # The building under the camera: its colour (the mission knows it from the
-                # overview), else the central shape.
-                own = same_colour(shapes, b.color_rgb, hue_tolerance_deg=8.0)
-                cand = central_shape(own or shapes, K)
-                st.frames += 1
-                if cand is None:
-                    st.no_shape += 1
-                    ours.append(None)
-                    hu.append(None)
-                    raw.append((0.0, math.inf))
-                    continue
-                m = match_shapes(target, cand, params)
-                h = cv2.matchShapes(_contour(target), _contour(cand), cv2.CONTOURS_MATCH_I1, 0.0)
-                raw.append((m.score, h))
-                ours.append(m.score if m.judgeable else None)
-                hu.append(h if m.judgeable else None)
-                if i != ti and m.judgeable:
-                    st.others += 1
-                    if m.score >= params.threshold:
-                        st.false += 1
-                        fp = b.blocks[0].footprint_enu_m
-                        same = same_shape_iou(tb.blocks[0].footprint_enu_m, fp)
-                        st.false_same_shape += same >= SAME_SHAPE_IOU
-            if ours[ti] is None:
-                st.target_cut += 1
-                scores = [s for s, _ in raw]
-                st.cut_ours_top1 += int(np.argmax(scores)) == ti
-                st.cut_hu_top1 += int(np.argmin([d for _, d in raw])) == ti
+    row: dict = {"seed": seed}
+    for mode, noise in MODES.items():
+        st = dict.fromkeys(COUNTS, 0)
+        errors: list[str] = []
+        ours: list[float | None] = []  # None: not judgeable (or no shape)
+        hu: list[float | None] = []
+        raw: list[tuple[float, float]] = []  # every frame's scores, cut or not
+        for i, (b, pose) in enumerate(zip(scene.buildings, poses, strict=True)):
+            frame = render(scene, pose, K, noise_seed=seed * 100 + i if noise else None)
+            shapes = vectorize(frame, NADIR)
+            # The building under the camera: its colour (the mission knows it from the
+            # overview), else the central shape.
+            own = same_colour(shapes, b.color_rgb, hue_tolerance_deg=8.0)
+            cand = central_shape(own or shapes, K)
+            st["frames"] += 1
+            if cand is None:
+                st["no_shape"] += 1
+                ours.append(None)
+                hu.append(None)
+                raw.append((0.0, math.inf))
                 continue
+            m = match_shapes(target, cand, params)
+            h = cv2.matchShapes(_contour(target), _contour(cand), cv2.CONTOURS_MATCH_I1, 0.0)
+            raw.append((m.score, h))
+            ours.append(m.score if m.judgeable else None)
+            hu.append(h if m.judgeable else None)
+            if i != ti and m.judgeable:
+                st["others"] += 1
+                if m.score >= params.threshold:
+                    st["false"] += 1
+                    fp = b.blocks[0].footprint_enu_m
+                    same = same_shape_iou(tb.blocks[0].footprint_enu_m, fp)
+                    st["false_same_shape"] += same >= SAME_SHAPE_IOU
+        if ours[ti] is None:
+            st["target_cut"] += 1
+            scores = [s for s, _ in raw]
+            st["cut_ours_top1"] += int(np.argmax(scores)) == ti
+            st["cut_hu_top1"] += int(np.argmin([d for _, d in raw])) == ti
+        else:
             t_score, t_hu = ours[ti], hu[ti]
             assert t_score is not None
             assert t_hu is not None
             rivals = [(s, d) for k, (s, d) in enumerate(zip(ours, hu, strict=True)) if k != ti]
             ok = all(s is None or s < t_score for s, _ in rivals)
-            st.ours_top1 += ok
-            st.hu_top1 += all(d is None or d > t_hu for _, d in rivals)
-            st.misses += t_score < params.threshold
+            st["ours_top1"] += ok
+            st["hu_top1"] += all(d is None or d > t_hu for _, d in rivals)
+            st["misses"] += t_score < params.threshold
             if not ok:
-                st.errors.append(
+                errors.append(
                     f"seed {seed}: target {t_score:.3f}, others "
                     + ", ".join("cut" if s is None else f"{s:.3f}" for s, _ in rivals)
                 )
+        row |= {f"{mode}.{k}": int(v) for k, v in st.items()}
+        row[f"{mode}.errors"] = json.dumps(errors)
+    return row
+
+
+def judge_all(
+    seeds: list[int], buildings: int, scheduler: str | None, workers: int | None
+) -> list[dict]:
+    """Every scene's row, in seed order."""
+    items = [(s, buildings, d) for s, d in zip(seeds, camera_draws(seeds, buildings), strict=True)]
+    rows: dict[int, dict] = {}
+    with open_client(scheduler, workers=workers) as client:
+        for task in run_tasks(client, judge_scene, items):
+            if task.error is not None:
+                raise task.error
+            rows[task.index] = task.result
+    return [rows[i] for i in range(len(items))]
+
+
+def run(
+    scenes: int,
+    buildings: int,
+    *,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    out: Path | None = None,
+) -> None:
+    params = RecognizeParams()
+    seeds = list(range(1000, 1000 + scenes))
+    t0 = time.perf_counter()
+    rows = judge_all(seeds, buildings, scheduler, workers)
     elapsed = time.perf_counter() - t0
+    if out is not None:
+        write_table(pa.Table.from_pylist(rows), out)
+    tallies = {noise: Tally() for noise in MODES.values()}
+    for row in rows:
+        for mode, noise in MODES.items():
+            tallies[noise].add(row, mode)
     print(
         f"seeds {seeds[0]}..{seeds[-1]} ({scenes} scenes x {buildings} buildings), "
         f"{ALT_M:.0f} m nadir, heading random, position error <= {MAX_POS_ERR_M} m; "
@@ -199,5 +277,8 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenes", type=int, default=200)
     ap.add_argument("--buildings", type=int, default=5)
+    ap.add_argument("--workers", type=int, default=None, help="default: one per core")
+    ap.add_argument("--scheduler", default=None, help="a running Dask scheduler")
+    ap.add_argument("--out", type=Path, default=None, help="write the per-scene table here")
     a = ap.parse_args()
-    run(a.scenes, a.buildings)
+    run(a.scenes, a.buildings, scheduler=a.scheduler, workers=a.workers, out=a.out)

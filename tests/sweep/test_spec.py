@@ -53,6 +53,36 @@ def test_scenes_grid_and_draws_multiply(tmp_path: Path) -> None:
         ]
 
 
+def test_cases_go_together_and_cross_the_scenes_and_the_grid(tmp_path: Path) -> None:
+    spec = load_spec(
+        write(
+            tmp_path,
+            """
+            [scenes]
+            builtin = ["paper", "arch"]
+            [grid]
+            noise = [false, true]
+            [[cases]]
+            seed = 11
+            wind_speed_ms = 6
+            [[cases]]
+            seed = 21
+            set.mission.max_looks = 1
+            """,
+        )
+    )
+    flights = plan_flights(spec)
+    assert [(f.label, f.value("seed"), f.value("noise")) for f in flights] == [
+        (scene, seed, noise)
+        for scene in ("paper", "arch")
+        for seed in (11, 21)
+        for noise in (False, True)
+    ]
+    assert [f.value("wind_speed_ms") for f in flights[:4]] == [6.0, 6.0, 0.0, 0.0]
+    assert [f.settings() for f in flights[1:3]] == [{}, {"mission.max_looks": "1"}]
+    assert dimension_keys(spec)[-1] == "set.mission.max_looks"
+
+
 def test_a_changed_input_is_a_new_flight_key(tmp_path: Path) -> None:
     a = plan_flights(load_spec(write(tmp_path, "[grid]\nseed = [1]\n")))[0]
     b = plan_flights(load_spec(write(tmp_path, "[grid]\nseed = [2]\n")))[0]
@@ -81,6 +111,11 @@ def test_a_changed_input_is_a_new_flight_key(tmp_path: Path) -> None:
         ("[grid\nseed = 1\n", [], "not valid TOML"),
         ("", ["grid.seed=[-1]"], "grid.seed[0]: expected a whole number ≥ 0"),
         ("[grid]\nseed = [1]\n[random]\nseed = 3\n", [], "random.seed: already a grid dimension"),
+        ("[[cases]]\nseed = 1\n[[cases]]\nwind = 3\n", [], "cases[1].wind: unknown flight input"),
+        ("[[cases]]\nnoise = 1\n", [], "cases[0].noise: expected true or false"),
+        ("[grid]\nseed = [1]\n[[cases]]\nseed = 3\n", [], "cases[0].seed: already a grid"),
+        ("cases = 3\n", [], "cases: expected an array of tables"),
+        ("[sweep]\ntimeout_s = 0\n", [], "sweep.timeout_s: expected vehicle seconds > 0"),
     ],
 )
 def test_a_bad_spec_exits_2_naming_the_key_path(

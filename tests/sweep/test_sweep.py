@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import shutil
 import signal
+import sys
 import threading
 import time
 from pathlib import Path
@@ -77,11 +78,17 @@ def test_a_sweep_gives_one_row_per_flight(swept: Path) -> None:
     assert not list(swept.rglob("*.part"))
 
 
-def test_the_table_is_the_same_with_one_worker(
+def test_the_table_is_the_same_with_one_worker_and_a_small_window(
     swept: Path, spec_path: Path, tmp_path: Path
 ) -> None:
+    # A window of 2 tasks on the scheduler: the rest are submitted as those finish.
     result = run_sweep(
-        load_spec(spec_path), exit_codes=EXIT_CODES, out=tmp_path / "one", workers=1, plots=False
+        load_spec(spec_path),
+        exit_codes=EXIT_CODES,
+        out=tmp_path / "one",
+        workers=1,
+        plots=False,
+        window=2,
     )
     assert {r["worker"] for r in result.rows if r["status"] != "error"} == {"0"}
     assert reproducible(read_table(result.table)) == reproducible(
@@ -173,3 +180,34 @@ def _busy_worker(client: Any, *, since_s: float) -> str:
                     return str(worker)
         time.sleep(0.05)
     raise AssertionError("no flight started")
+
+
+def test_a_timeout_a_csv_table_and_no_matplotlib(
+    tmp_path: Path, scheduler: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A flight past --timeout (vehicle seconds) is a row with its error; --csv writes the
+    table as CSV; without matplotlib the sweep says it skipped the plots and still succeeds
+    in writing the rest. --resume keeps the stopped flight under the same limit only."""
+    monkeypatch.setitem(sys.modules, "matplotlib.figure", None)  # import fails
+    path = tmp_path / "one.toml"
+    path.write_text('[scenes]\nbuiltin = ["paper"]\n')
+    out = tmp_path / "out"
+    args = ["sweep", str(path), "--out", str(out), "--scheduler", scheduler, "--csv", "-q"]
+    result = CliRunner().invoke(cli, [*args, "--timeout", "30"])
+    assert result.exit_code == 1, result.output
+    assert "plots skipped: matplotlib is not installed" in result.output
+    assert not (out / "results.parquet").exists() and not list(out.glob("plots/*.png"))
+    (row,) = read_table(out / "results.csv")
+    assert row["status"] == "error" and row["timeout_s"] == 30.0
+    assert row["error"] == (
+        "FlightTimeoutError: stopped after 30 s of vehicle time (sweep.timeout_s)"
+    )
+    assert (out / row["recording"]).stat().st_size == row["recording_bytes"]
+
+    again = CliRunner().invoke(cli, [*args, "--timeout", "30", "--resume"])
+    assert "flights        1 of 1" in again.output
+    assert read_table(out / "results.csv") == [row]  # kept: nothing flown
+    longer = CliRunner().invoke(cli, [*args, "--timeout", "40", "--resume"])
+    assert longer.exit_code == 1, longer.output
+    (row,) = read_table(out / "results.csv")
+    assert row["timeout_s"] == 40.0 and "after 40 s" in row["error"]

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 import time
 from pathlib import Path
 
 import click
+
+from uavtool.sweep.spec import TableFormat
 
 
 @click.command()
@@ -38,6 +41,16 @@ import click
     default=None,
     help="Worker processes of the local cluster.  [default: one per core]",
 )
+@click.option(
+    "--timeout",
+    "timeout_s",
+    type=click.FloatRange(min=0, min_open=True),
+    default=None,
+    metavar="SECONDS",
+    help="Stop a flight after this much vehicle time; it becomes a row with its error "
+    "(vehicle seconds, so the same flights stop on any machine).  [default: the spec's "
+    "sweep.timeout_s, else none]",
+)
 @click.option("--resume", is_flag=True, help="Keep flights whose recording is whole; fly the rest.")
 @click.option("--csv", is_flag=True, help="Write the table as CSV instead of Parquet.")
 @click.option("--no-plots", is_flag=True, help="Write no PNG plots.")
@@ -48,6 +61,7 @@ def sweep(
     out: Path | None,
     scheduler: str | None,
     workers: int | None,
+    timeout_s: float | None,
     resume: bool,
     csv: bool,
     no_plots: bool,
@@ -67,6 +81,7 @@ def sweep(
     Examples:
       uavtool sweep wind.toml
       uavtool sweep wind.toml -o random.draws=200 --resume
+      uavtool sweep wind.toml --timeout 900 --csv
       uavtool sweep wind.toml --scheduler tcp://head-node:8786 --out /shared/sweeps/wind
     """
     from uavtool.cli.fly import EXIT_CODES
@@ -74,11 +89,9 @@ def sweep(
 
     loaded = load_spec(spec, overrides)
     if csv:
-        import dataclasses
-
-        from uavtool.sweep.spec import TableFormat
-
         loaded = dataclasses.replace(loaded, table_format=TableFormat.CSV)
+    if timeout_s is not None:
+        loaded = dataclasses.replace(loaded, timeout_s=timeout_s)
     draw = _Line(quiet)
     result = run_sweep(
         loaded,

@@ -1,7 +1,8 @@
 """Where tasks run: a Dask ``LocalCluster`` of worker processes sized to the machine (one
 single-threaded worker per core: flights are CPU-bound Python), or any running Dask
 scheduler given by address (``dask scheduler`` plus ``dask worker`` elsewhere, or any Dask
-deployment). Nothing else about a sweep changes with the cluster."""
+deployment). Nothing else about a sweep changes with the cluster. The local cluster's workers
+ignore Ctrl-C (:mod:`~uavtool.sweep.interrupt`): the driver stops the sweep and closes them."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
 from uavtool.errors import InputError
+from uavtool.sweep.interrupt import PRELOAD, sigint_ignored
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -47,16 +49,17 @@ def open_client(scheduler: str | None = None, *, workers: int | None = None) -> 
     n = workers if workers is not None else default_workers()
     if n < 1:
         raise InputError(f"--workers must be ≥ 1, got {n}")
-    with (
-        LocalCluster(
+    # The workers must not hear the terminal's Ctrl-C: see uavtool.sweep.interrupt.
+    with sigint_ignored():
+        cluster = LocalCluster(
             n_workers=n,
             threads_per_worker=1,
             processes=True,
             dashboard_address=":0",  # no fixed port: several clusters may run at once
             silence_logs=logging.ERROR,
-        ) as cluster,
-        Client(cluster) as client,
-    ):
+            preload=[PRELOAD],
+        )
+    with cluster, Client(cluster) as client:
         yield client
 
 

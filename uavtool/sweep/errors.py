@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from uavtool.errors import InputError
+from uavtool.errors import FailureError, InputError
 
 
 class SpecError(InputError):
@@ -16,3 +16,11 @@ class SpecError(InputError):
 
 class OutputExistsError(InputError):
     """The output folder already holds a sweep and ``--resume`` was not given."""
+
+
+class FlightTimeoutError(FailureError):
+    """A flight went on past the sweep's ``timeout_s`` of vehicle time and was stopped."""
+
+    def __init__(self, timeout_s: float) -> None:
+        super().__init__(f"stopped after {timeout_s:g} s of vehicle time (sweep.timeout_s)")
+        self.timeout_s = timeout_s

@@ -21,6 +21,7 @@ from uavtool.sweep.plan import FlightSpec
 PER_FOLDER = 1000
 _MCAP_MAGIC = b"\x89MCAP0\r\n"
 _PART = ".part"
+_PARTIAL = ".partial"  # where the recorder writes a recording until it is whole
 
 
 @dataclass(frozen=True, slots=True)
@@ -79,8 +80,10 @@ class SweepLayout:
         return row if tail == _MCAP_MAGIC else None
 
     def remove_partials(self) -> int:
-        """Delete what interrupted writers left (``*.part``); how many."""
-        found = list(self.flights.glob(f"*/*{_PART}")) if self.flights.is_dir() else []
+        """Delete what interrupted writers left (``*.part``, ``*.partial``); how many."""
+        found = []
+        if self.flights.is_dir():
+            found = [*self.flights.glob(f"*/*{_PART}"), *self.flights.glob(f"*/*{_PARTIAL}")]
         for path in found:
             path.unlink(missing_ok=True)
         return len(found)

@@ -1,5 +1,6 @@
-"""A spec expanded into flights: scenes × grid × random draws, each a :class:`FlightSpec` with a
-stable index and a key that changes whenever any of its inputs does."""
+"""A spec expanded into flights: scenes × cases × grid × random draws, each a
+:class:`FlightSpec` with a stable index and a key that changes whenever any of its inputs
+does."""
 
 from __future__ import annotations
 
@@ -89,18 +90,20 @@ class FlightSpec:
 
 def dimension_keys(spec: SweepSpec) -> tuple[str, ...]:
     """The table's input columns: the built-in ones, then the sweep's own set./param. keys."""
-    extra = [k for k, _ in (*spec.grid, *spec.random) if k not in dimensions.BUILTIN_KEYS]
+    named = [k for case in spec.cases for k, _ in case]
+    named += [k for k, _ in (*spec.grid, *spec.random)]
+    extra = [k for k in dict.fromkeys(named) if k not in dimensions.BUILTIN_KEYS]
     keys = list(_DEFAULTS)
     keys += [k for k in ("outage_start_s", "outage_duration_s") if _uses(spec, k)]
     return (*keys, *extra)
 
 
 def _uses(spec: SweepSpec, key: str) -> bool:
-    return any(k == key for k, _ in (*spec.grid, *spec.random))
+    return any(k == key for k, _ in (*spec.grid, *spec.random, *itertools.chain(*spec.cases)))
 
 
 def plan_flights(spec: SweepSpec) -> list[FlightSpec]:
-    """Every flight, in a fixed order: scene, then grid combination, then draw. Raises
+    """Every flight, in a fixed order: scene, case, grid combination, draw. Raises
     SpecError when a random draw is not a valid value of its dimension."""
     return list(_flights(spec))
 
@@ -113,10 +116,10 @@ def _flights(spec: SweepSpec) -> Iterator[FlightSpec]:
         for seed in source.seeds or (None,):
             one = dataclasses.replace(source, seeds=() if seed is None else (seed,))
             label = scene_label(source, seed)
-            combos = itertools.product(*(values for _, values in spec.grid))
-            for g, combo in enumerate(combos):
+            combos = itertools.product(spec.cases or ((),), *(v for _, v in spec.grid))
+            for g, (case, *combo) in enumerate(combos):
                 for d in range(max(spec.draws, 1)):
-                    inputs = list(zip(keys, combo, strict=True))
+                    inputs = [*case, *zip(keys, combo, strict=True)]
                     if spec.random:
                         rng = random.Random(f"{spec.rng_seed}|{label}|{g}|{d}")
                         inputs += [(k, _draw(k, law, rng, checked, spec)) for k, law in spec.random]

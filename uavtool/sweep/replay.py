@@ -20,6 +20,7 @@ import pyarrow as pa
 
 from uavtool.errors import InputError
 from uavtool.sweep.cluster import open_client
+from uavtool.sweep.dispatch import run_tasks
 from uavtool.sweep.progress import Progress, ProgressCallback
 from uavtool.sweep.table import write_table
 
@@ -168,31 +169,29 @@ def replay_many(
     progress: ProgressCallback | None = None,
 ) -> BatchReplay:
     """Replay every recording as a Dask task; Ctrl-C returns the rows done (``interrupted``)."""
-    from distributed import as_completed  # noqa: PLC0415
-
     report = progress or (lambda _p: None)
     rows: dict[int, dict[str, Any]] = {}
     interrupted = False
     report(Progress(0, len(paths)))
-    with open_client(scheduler, workers=workers) as client:
-        t0 = time.perf_counter()
-        futures = {
-            client.submit(replay_recording, str(p), dict(overrides), vision_only, pure=False): i
-            for i, p in enumerate(paths)
-        }
-        try:
-            for future in as_completed(futures):
-                i = futures.pop(future)
-                try:
-                    rows[i] = future.result()
-                except Exception as exc:  # e.g. its worker died too often
-                    rows[i] = {"recording": str(paths[i]), "result": ERROR, "error": str(exc)}
-                errors = sum(r["result"] == ERROR for r in rows.values())
+    try:
+        with open_client(scheduler, workers=workers) as client:
+            t0 = time.perf_counter()
+            errors = 0
+            for task in run_tasks(
+                client,
+                replay_recording,
+                [(str(p),) for p in paths],
+                kwargs={"overrides": dict(overrides), "vision_only": vision_only},
+            ):
+                row = task.result
+                if task.error is not None:  # e.g. its worker died too often
+                    row = {"recording": str(paths[task.index]), "result": ERROR}
+                    row["error"] = str(task.error)
+                rows[task.index] = row
+                errors += row["result"] == ERROR
                 report(Progress(len(rows), len(paths), 0, errors, time.perf_counter() - t0))
-        except KeyboardInterrupt:
-            interrupted = True
-        finally:
-            client.cancel(list(futures))
+    except KeyboardInterrupt:
+        interrupted = True
     return BatchReplay(tuple(rows[i] for i in sorted(rows)), interrupted)
 
 

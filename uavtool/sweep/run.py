@@ -1,5 +1,6 @@
 """A sweep from spec to table: plan the flights, skip those already whole (``--resume``), fly
-the rest as Dask tasks, and write the table, the summary and the plots.
+the rest as Dask tasks through a bounded window (:mod:`~uavtool.sweep.dispatch`), and write the
+table, the summary and the plots.
 
 Dask does the scheduling, the retries (a task that raised outside its flight is re-run
 ``retries`` times; a task whose worker died is re-run elsewhere by the scheduler) and the
@@ -16,7 +17,8 @@ from pathlib import Path
 from typing import Any
 
 from uavtool.sweep.cluster import open_client
-from uavtool.sweep.errors import OutputExistsError
+from uavtool.sweep.dispatch import run_tasks
+from uavtool.sweep.errors import FlightTimeoutError, OutputExistsError
 from uavtool.sweep.layout import SweepLayout
 from uavtool.sweep.plan import FlightSpec, dimension_keys, plan_flights
 from uavtool.sweep.plots import PlotsUnavailableError, write_plots
@@ -53,9 +55,11 @@ def run_sweep(
     resume: bool = False,
     plots: bool = True,
     progress: ProgressCallback | None = None,
+    window: int | None = None,
 ) -> SweepResult:
     """Fly every flight of ``spec``. ``exit_codes`` maps a mission status to the exit code
-    ``uavtool fly`` gives it (a table column). Raises SpecError, OutputExistsError, or
+    ``uavtool fly`` gives it (a table column); ``window`` caps the tasks on the scheduler at
+    once (default: a few per worker thread). Raises SpecError, OutputExistsError, or
     InputError for an unreachable scheduler; Ctrl-C returns what was done (``interrupted``)."""
     flights = plan_flights(spec)
     input_keys = dimension_keys(spec)
@@ -70,63 +74,83 @@ def run_sweep(
     layout.spec.write_text(spec.text, encoding="utf-8")
     rows: dict[int, dict[str, Any]] = {}
     if resume:
-        rows = {f.index: r for f in flights if (r := layout.finished_row(f)) is not None}
+        rows = {f.index: r for f in flights if (r := _kept(layout, f, spec)) is not None}
     todo = [f for f in flights if f.index not in rows]
     resumed = len(rows)
     interrupted = False
     if todo:
+        tasks = _Tasks(layout, spec, input_keys, exit_codes)
         try:
-            _fly_all(todo, rows, layout, spec, input_keys, exit_codes, scheduler, workers, progress)
+            _fly_all(todo, rows, tasks, scheduler, workers, window, progress)
         except KeyboardInterrupt:
             interrupted = True
+            # Flights the workers finished before the driver heard of them: the table must say
+            # what the folder holds.
+            late = (f for f in todo if f.index not in rows)
+            rows |= {f.index: r for f in late if (r := _kept(layout, f, spec)) is not None}
         layout.remove_partials()  # the workers are gone: what they left half-written
     return _finish(spec, layout, flights, rows, input_keys, resumed, interrupted, plots)
+
+
+def _kept(layout: SweepLayout, flight: FlightSpec, spec: SweepSpec) -> dict[str, Any] | None:
+    """The row of a flight already done, unless it was stopped under another time limit."""
+    row = layout.finished_row(flight)
+    if row is None:
+        return None
+    stopped = str(row.get("error") or "").startswith(FlightTimeoutError.__name__)
+    return None if stopped and row.get("timeout_s") != spec.timeout_s else row
+
+
+@dataclass(frozen=True, slots=True)
+class _Tasks:
+    """What every flight task of the sweep is given besides its flight."""
+
+    layout: SweepLayout
+    spec: SweepSpec
+    input_keys: tuple[str, ...]
+    exit_codes: Mapping[str, int]
+
+    def kwargs(self) -> dict[str, Any]:
+        return {
+            "input_keys": self.input_keys,
+            "exit_codes": dict(self.exit_codes),
+            "timeout_s": self.spec.timeout_s,
+        }
 
 
 def _fly_all(
     todo: list[FlightSpec],
     rows: dict[int, dict[str, Any]],
-    layout: SweepLayout,
-    spec: SweepSpec,
-    input_keys: tuple[str, ...],
-    exit_codes: Mapping[str, int],
+    tasks: _Tasks,
     scheduler: str | None,
     workers: int | None,
+    window: int | None,
     progress: ProgressCallback | None,
 ) -> None:
-    from distributed import as_completed  # noqa: PLC0415
-
     total, skipped = len(todo) + len(rows), len(rows)
     report = progress or (lambda _p: None)
     report(Progress(0, total, skipped))
+    root = str(tasks.layout.root.resolve())
     with open_client(scheduler, workers=workers) as client:
         t0 = time.perf_counter()
-        futures = {
-            client.submit(
-                run_flight,
-                flight,
-                str(layout.root.resolve()),
-                input_keys=input_keys,
-                exit_codes=dict(exit_codes),
-                key=f"flight-{flight.stem}",
-                retries=spec.retries,
-            ): flight
-            for flight in todo
-        }
-        done = errors = 0
-        try:
-            for future in as_completed(futures):
-                flight = futures.pop(future)
-                try:
-                    row = future.result()
-                except Exception as exc:  # out of retries: a row with the error
-                    row = input_row(flight, input_keys) | error_columns(exc)
-                rows[flight.index] = row
-                done += 1
-                errors += row.get("status") == ERROR
-                report(Progress(done, total, skipped, errors, time.perf_counter() - t0))
-        finally:
-            client.cancel(list(futures))
+        errors = 0
+        finished = run_tasks(
+            client,
+            run_flight,
+            [(flight, root) for flight in todo],
+            kwargs=tasks.kwargs(),
+            keys=[f"flight-{flight.stem}" for flight in todo],
+            retries=tasks.spec.retries,
+            window=window,
+        )
+        for done, task in enumerate(finished, start=1):
+            flight = todo[task.index]
+            row = task.result
+            if task.error is not None:  # out of retries: a row with the error
+                row = input_row(flight, tasks.input_keys) | error_columns(task.error)
+            rows[flight.index] = row
+            errors += row.get("status") == ERROR
+            report(Progress(done, total, skipped, errors, time.perf_counter() - t0))
 
 
 def _finish(

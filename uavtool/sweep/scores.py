@@ -15,10 +15,12 @@ from uavtool.world import Scene
 @dataclass(frozen=True, slots=True)
 class Scores:
     """Best recognition score at a point of interest on the target, and on any other building
-    (None: no such point photographed); ``margin`` is their difference."""
+    (None: no such point photographed); ``margin`` is their difference. ``target_looks``: the
+    target's score at each look, in the order the mission judged them."""
 
     target: float | None
     other: float | None
+    target_looks: tuple[float, ...] = ()
 
     @property
     def margin(self) -> float | None:
@@ -31,6 +33,7 @@ def recognition_scores(recording: Path, scene: Scene) -> Scores:
     """Scores of a lockstep recording of the built-in vehicle (its home is the scene's)."""
     pois: dict[int, tuple[float, float]] = {}
     best: dict[str, float] = {}
+    looks: list[float] = []
     with RecordingReader(recording) as reader:
         for entry in reader.entries([OUTPUTS]):
             if not isinstance(entry.value, JsonDocument):
@@ -41,5 +44,7 @@ def recognition_scores(recording: Path, scene: Scene) -> Scores:
             elif data.get("type") == "Recognition" and int(data.get("poi", -1)) in pois:
                 name = nearest_building(scene, pois[int(data["poi"])])
                 best[name] = max(best.get(name, float("-inf")), float(data["score"]))
+                if name == scene.target:
+                    looks.append(float(data["score"]))
     others = [s for name, s in best.items() if name != scene.target]
-    return Scores(best.get(scene.target), max(others) if others else None)
+    return Scores(best.get(scene.target), max(others) if others else None, tuple(looks))

@@ -7,6 +7,7 @@ Example (paths are relative to the spec file)::
     out = "sweeps/wind"           # default: sweeps/<spec name>, relative to the current folder
     format = "parquet"            # or "csv"
     retries = 2                   # re-runs of a task that raised outside the flight
+    timeout_s = 900               # vehicle seconds a flight may last (default: no limit)
 
     [scenes]
     builtin = ["paper", "blocked-front"]
@@ -23,12 +24,20 @@ Example (paths are relative to the spec file)::
     draws = 10
     rng_seed = 7
     wind_from_deg = { uniform = [0, 360] }
+
+    [[cases]]                     # optional: inputs that go together (each case crosses
+    seed = 11                     # the scenes, the grid and the draws)
+    wind_from_deg = 90
+    [[cases]]
+    seed = 12
+    "set.mission.max_looks" = 1
 """
 
 from __future__ import annotations
 
 import dataclasses
 import hashlib
+import re
 import tomllib
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, fields
@@ -41,8 +50,8 @@ from uavtool.sweep import dimensions
 from uavtool.sweep.errors import SpecError
 from uavtool.sweep.values import Distribution, distribution, value_list
 
-_TOP = ("sweep", "scenes", "grid", "random")
-_SWEEP_KEYS = ("out", "format", "retries")
+_TOP = ("sweep", "scenes", "grid", "random", "cases")
+_SWEEP_KEYS = ("out", "format", "retries", "timeout_s")
 _SCENE_KEYS = ("builtin", "files", "hard", "random")
 _RANDOM_SCENE_OPTIONS = ("buildings", "margin_m")
 
@@ -85,6 +94,10 @@ class SweepSpec:
     out: Path
     table_format: TableFormat
     retries: int
+    timeout_s: float | None = None
+    """Vehicle seconds a flight may last before it is stopped (a row with its error)."""
+    cases: tuple[tuple[tuple[str, Any], ...], ...] = ()
+    """Sets of inputs that go together; flights take every case (none: one empty case)."""
     text: str = ""
     """The spec file as read, with its overrides appended as comments (kept with the results)."""
 
@@ -127,6 +140,7 @@ def parse_spec(data: Mapping[str, Any], *, source: str, base: Path, default_out:
     taken = {k for k, _ in grid} & {k for k, _ in random}
     if taken:
         raise SpecError(source, f"random.{min(taken)}", "already a grid dimension")
+    cases = tuple(_cases(data.get("cases", []), {k for k, _ in (*grid, *random)}, source))
     return SweepSpec(
         source=source,
         scenes=tuple(_scenes(data.get("scenes", {"builtin": ["paper"]}), base, source)),
@@ -137,7 +151,30 @@ def parse_spec(data: Mapping[str, Any], *, source: str, base: Path, default_out:
         out=base / out if out is not None else default_out,
         table_format=TableFormat(fmt),
         retries=retries,
+        timeout_s=_timeout(sweep.get("timeout_s"), source),
+        cases=cases,
     )
+
+
+def _timeout(value: Any, source: str) -> float | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
+        raise SpecError(source, "sweep.timeout_s", f"expected vehicle seconds > 0, got {value!r}")
+    return float(value)
+
+
+def _cases(value: Any, taken: set[str], source: str) -> Iterator[tuple[tuple[str, Any], ...]]:
+    if not isinstance(value, list) or not all(isinstance(case, dict) for case in value):
+        raise SpecError(source, "cases", "expected an array of tables ([[cases]])")
+    for i, case in enumerate(value):
+        inputs = []
+        for key, raw in _flatten(case):
+            where = f"cases[{i}].{key}"
+            if key in taken:
+                raise SpecError(source, where, "already a grid or random dimension")
+            inputs.append((key, _checked(key, raw, where, source)))
+        yield tuple(inputs)
 
 
 def _apply_override(data: dict[str, Any], text: str, source: str) -> None:
@@ -190,7 +227,8 @@ def _checked(key: str, value: Any, where: str, source: str) -> Any:
     try:
         return dimensions.check(key, value)
     except KeyError as exc:
-        raise SpecError(source, where.split("[", maxsplit=1)[0], str(exc.args[0])) from None
+        # An unknown key is wrong in all its values: name the key, not one value.
+        raise SpecError(source, re.sub(r"\[\d+\]$", "", where), str(exc.args[0])) from None
     except ValueError as exc:
         raise SpecError(source, where, str(exc)) from None
 

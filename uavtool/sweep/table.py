@@ -2,8 +2,9 @@
 
 Columns: the flight's index, key and scene; its inputs; then outcome (status, exit code,
 reason, error), judgement (target and matched building, correct, scores and margin, model
-built, IoU, tunnel kept, closest clearance and building), times (flight, vehicle, wall),
-route, photos, worker and recording. Only ``wall_s`` and ``worker`` depend on the run.
+built, IoU, tunnel kept, closest clearance and building), times (flight, vehicle, the vehicle
+time limit, wall), route, photos, worker and recording. ``target_scores`` is a JSON list: the
+target's score at each look. Only ``wall_s`` and ``worker`` depend on the run.
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ _TYPES: dict[str, pa.DataType] = {
     "correct": pa.bool_(),
     "match_score": pa.float64(),
     "target_score": pa.float64(),
+    "target_scores": pa.string(),
     "other_score": pa.float64(),
     "margin": pa.float64(),
     "model_built": pa.bool_(),
@@ -50,6 +52,7 @@ _TYPES: dict[str, pa.DataType] = {
     "closest_building": pa.string(),
     "flight_time_s": pa.float64(),
     "vehicle_time_s": pa.float64(),
+    "timeout_s": pa.float64(),
     "route_length_m": pa.float64(),
     "frames": pa.int64(),
     "wall_s": pa.float64(),

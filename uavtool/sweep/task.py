@@ -1,7 +1,12 @@
 """One flight as a Dask task: fly it in lockstep on the built-in vehicle, judge it against the
 scene, and leave its recording and result row in the sweep's folder (each renamed into place
 whole). A flight that raises is a row with its error; only trouble outside the flight (a full
-disk) escapes, for Dask to retry."""
+disk) escapes, for Dask to retry.
+
+A flight may be given a timeout in *vehicle* seconds, not wall seconds: in lockstep a flight
+that never ends still moves the vehicle's clock (every wait for the vehicle advances it), so it
+is stopped at the same point on any machine and under any load, and the table stays the same
+for the same spec. A wall-clock limit would stop different flights on a busy machine."""
 
 from __future__ import annotations
 
@@ -10,12 +15,16 @@ import json
 import time
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from uavtool.errors import UavtoolError
+from uavtool.sweep.errors import FlightTimeoutError
 from uavtool.sweep.layout import SweepLayout, part_path, write_atomic
 from uavtool.sweep.plan import FlightSpec
 from uavtool.sweep.scenes import load_source_scene
+
+if TYPE_CHECKING:
+    from uavtool.mission import Telemetry
 
 ERROR = "error"
 """The status of a flight that raised."""
@@ -27,16 +36,18 @@ def run_flight(
     *,
     input_keys: tuple[str, ...],
     exit_codes: Mapping[str, int],
+    timeout_s: float | None = None,
 ) -> dict[str, Any]:
-    """Fly ``flight`` into the sweep folder ``root``; its result row (JSON types only)."""
+    """Fly ``flight`` into the sweep folder ``root``, stopped after ``timeout_s`` vehicle
+    seconds; its result row (JSON types only)."""
     layout = SweepLayout(Path(root))
     recording = layout.recording(flight)
     recording.parent.mkdir(parents=True, exist_ok=True)
     part = part_path(recording)
     wall0 = time.perf_counter()
-    row = input_row(flight, input_keys)
+    row = input_row(flight, input_keys) | {"timeout_s": timeout_s}
     try:
-        row.update(_fly(flight, part, row, exit_codes))
+        row.update(_fly(flight, part, row, exit_codes, timeout_s))
     except Exception as exc:  # a flight that raises is a row, not a lost sweep
         row.update(error_columns(exc))
     row["wall_s"] = time.perf_counter() - wall0
@@ -65,7 +76,11 @@ def error_columns(exc: BaseException) -> dict[str, Any]:
 
 
 def _fly(
-    flight: FlightSpec, record: Path, row: dict[str, Any], exit_codes: Mapping[str, int]
+    flight: FlightSpec,
+    record: Path,
+    row: dict[str, Any],
+    exit_codes: Mapping[str, int],
+    timeout_s: float | None,
 ) -> dict[str, Any]:
     from uavtool.mission.params import Params, with_overrides  # noqa: PLC0415
     from uavtool.runner.fly import FlyConfig, fly  # noqa: PLC0415
@@ -86,7 +101,7 @@ def _fly(
         wind=(float(flight.value("wind_speed_ms")), float(flight.value("wind_from_deg"))),
         link_outages_s=flight.link_outages_s(),
     )
-    s = fly(config)
+    s = fly(config, progress=None if timeout_s is None else VehicleDeadline(timeout_s))
     o, e = s.outcome, s.evaluation
     scores = recognition_scores(record, scene)
     return {
@@ -99,6 +114,7 @@ def _fly(
         "correct": bool(e.matched_building) and e.matched_building == scene.target,
         "match_score": o.match_score if o.matched_poi >= 0 else None,
         "target_score": scores.target,
+        "target_scores": json.dumps(scores.target_looks),
         "other_score": scores.other,
         "margin": scores.margin,
         "model_built": o.model_built,
@@ -111,6 +127,19 @@ def _fly(
         "route_length_m": s.route_length_m,
         "frames": s.frames,
     }
+
+
+class VehicleDeadline:
+    """A ``fly`` progress hook that stops the flight (FlightTimeoutError) at the first mission
+    event after the vehicle's clock passed ``timeout_s`` (the built-in vehicle boots as the
+    flight starts)."""
+
+    def __init__(self, timeout_s: float) -> None:
+        self.timeout_s = timeout_s
+
+    def __call__(self, _event: str, telemetry: Telemetry | None) -> None:
+        if telemetry is not None and telemetry.time_boot_ms > 1000.0 * self.timeout_s:
+            raise FlightTimeoutError(self.timeout_s)
 
 
 def _worker_name() -> str:
