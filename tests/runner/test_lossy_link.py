@@ -15,7 +15,7 @@ from uavtool.recording import summarize
 from uavtool.runner.fly import FlyConfig, fly
 from uavtool.runner.summary import format_summary
 
-SPEEDUP = 10.0
+SPEEDUP = 5.0
 ROUTE_TOLERANCE = 0.05
 
 

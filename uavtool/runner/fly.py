@@ -39,7 +39,7 @@ from uavtool.runner.params import set_vehicle_params
 from uavtool.runner.placement import SCENE_ORIGINS, place_scene
 from uavtool.runner.preflight import check_camera, check_gimbal, check_home
 from uavtool.runner.record import ClockNs, MissionRecorder
-from uavtool.runner.runner import Progress, Runner
+from uavtool.runner.runner import Progress, Runner, RunnerConfig
 from uavtool.world import Scene, load_scene, render, scene_to_dict
 
 if TYPE_CHECKING:
@@ -241,6 +241,11 @@ def fly(
             progress=progress,
             vehicle_says=vehicle_says,
             fixed_camera=config.no_gimbal,
+            # A real link may lose a command, its ACK or a position target: send them again
+            # each second (lockstep loses nothing, and its recordings stay byte for byte).
+            config=RunnerConfig(command_resend_s=1.0, target_resend_s=1.0)
+            if config.connect is not None
+            else RunnerConfig(),
         )
         flight_wall0, vehicle0 = time.perf_counter(), clock()
         flown.append(True)

@@ -9,6 +9,7 @@ heartbeat, and vehicle time for command acknowledgements.
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -22,6 +23,7 @@ from uavtool.mission import (
     Command,
     CommandResult,
     Event,
+    GoTo,
     Level,
     LinkLost,
     LinkRestored,
@@ -61,6 +63,15 @@ class RunnerConfig:
     link_report_s: float = 1.0
     heartbeat_s: float = 1.0
     poll_s: float = 0.02
+    command_resend_s: float | None = None
+    """Send a command again (same command, as MAVSDK and QGroundControl do) when its
+    COMMAND_ACK has not come this long (vehicle time) after it was last sent, until
+    ``ack_timeout_s`` is up: on a lossy link either may be lost. None: never (lockstep)."""
+    target_resend_s: float | None = None
+    """Send the current position target again this often while it is the latest command: a
+    position target has no ACK, so one lost on a lossy link would cost the move its timeout
+    (ArduPilot takes the same target again as no change). None: never — a lockstep link
+    loses nothing, and its recordings stay as they were."""
 
 
 class Runner:
@@ -104,12 +115,16 @@ class Runner:
         self.route: list[tuple[int, tuple[float, float, float]]] = []  # (time_boot_ms, ENU)
         self._queue: deque[Observation] = deque()
         self._pending: dict[int, tuple[int, int, int]] = {}
+        self._unacked: dict[int, tuple[Command, int]] = {}  # MAV_CMD -> (command, last sent ms)
         """MAV_CMD -> (action id, vehicle ms, warnings heard when sent)."""
         self._gimbal = (0.0, 0.0)
         self._last: Telemetry | None = None
         self._lost_reported = 0.0
         self._link_lost = False
         self._last_heartbeat: float | None = None
+        self._target: GoTo | None = None  # the position target to send again, and when sent
+        self._target_sent = 0.0
+        self._target_left = math.inf  # how far the vehicle was from it then
         self.scene_offset = (0.0, 0.0)  # vehicle home in the scene's frame (east, north)
 
     # --- the loop ---------------------------------------------------------------------------
@@ -142,8 +157,26 @@ class Runner:
                 self._check_silence(now, last_rx)
             if self._last_heartbeat is None or now - self._last_heartbeat > self.config.heartbeat_s:
                 self._heartbeat(now)
+            if self._resend_due(now):
+                assert self._target is not None
+                send_command(self.link, self._target, home)
         assert self.mission.outcome is not None
         return self.mission.outcome
+
+    def _resend_due(self, now: float) -> bool:
+        """Whether to send the position target again: its interval is up, and the vehicle
+        neither got there (within 1 m) nor came 0.5 m closer since it was last sent. A target
+        sent again while the vehicle flies to it could arrive late (reordered) after the next
+        one, and turn it back."""
+        resend = self.config.target_resend_s
+        if self._target is None or resend is None or now - self._target_sent < resend:
+            return False
+        if self._last is None:
+            return True
+        left = math.dist(self._last.pos_enu_m, self._target.pos_enu_m)
+        closer = left < self._target_left - 0.5
+        self._target_left, self._target_sent = left, now
+        return left >= 1.0 and not closer
 
     def _drain(self) -> None:
         while self._queue and self.mission.outcome is None:
@@ -208,9 +241,13 @@ class Runner:
     def _on_ack(self, msg: object) -> None:
         command, result = msg.command, msg.result  # type: ignore[attr-defined]
         pending = self._pending.get(command)
-        if pending is None or result == M.MAV_RESULT_IN_PROGRESS:
+        if pending is None:
+            return
+        if result == M.MAV_RESULT_IN_PROGRESS:
+            self._unacked.pop(command, None)  # it arrived: no need to send it again
             return
         del self._pending[command]
+        self._unacked.pop(command, None)
         accepted = result == M.MAV_RESULT_ACCEPTED
         detail = "" if accepted else f"refused ({RESULT_NAMES.get(result, result)})"
         if not accepted:
@@ -224,11 +261,18 @@ class Runner:
 
     def _expire_acks(self, now_ms: int) -> None:
         limit_ms = self.config.ack_timeout_s * 1000.0
+        resend = self.config.command_resend_s
         for command, (action_id, sent_ms, _) in list(self._pending.items()):
             if now_ms - sent_ms > limit_ms:
                 del self._pending[command]
+                self._unacked.pop(command, None)
                 detail = f"no COMMAND_ACK in {self.config.ack_timeout_s:g} s"
                 self._queue.append(CommandResult(action_id, False, detail))
+            elif resend is not None and command in self._unacked:
+                cmd, last_ms = self._unacked[command]
+                if now_ms - last_ms > resend * 1000.0:
+                    send_command(self.link, cmd, self.home)
+                    self._unacked[command] = (cmd, now_ms)
 
     def _check_silence(self, now: float, last_rx: float) -> None:
         c = self.config
@@ -251,12 +295,17 @@ class Runner:
     def _command(self, cmd: Command) -> None:
         if isinstance(cmd, SetGimbal):
             self._gimbal = (cmd.pitch_deg, cmd.yaw_deg)
+        elif isinstance(cmd, GoTo):
+            self._target, self._target_sent, self._target_left = cmd, self.link.clock(), math.inf
+        else:  # a mode change, arming, a take-off: the target is no longer what is flown
+            self._target = None
         sent = send_command(self.link, cmd, self.home)
         if sent.mav_cmd == 0:
             self._queue.append(CommandResult(cmd.id, True, "sent"))
         else:
             now_ms = self._last.time_boot_ms if self._last is not None else 0
             self._pending[sent.mav_cmd] = (cmd.id, now_ms, len(self._warnings))
+            self._unacked[sent.mav_cmd] = (cmd, now_ms)
 
     def _photo(self, cmd: TakePhoto) -> Photo:
         t = self._last
