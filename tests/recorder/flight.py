@@ -5,15 +5,20 @@ scene, flown in AUTO by a scripted ground station (upload, arm, MISSION_START), 
 from __future__ import annotations
 
 import socket
+import subprocess
+import sys
 from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from tests.sitl.client import Client
 from uavtool.geo import geo_from_enu
 from uavtool.mavlink import mavlink as M
 from uavtool.sitl import Sitl, SitlConfig
-from uavtool.world import Scene
+from uavtool.world import Scene, load_scene
 
+REPO = Path(__file__).resolve().parents[2]
 REL = M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
 PHOTO_ALT_M = 20.0
 # Above each building of the paper scene (ENU metres from home), in visiting order.
@@ -100,3 +105,47 @@ def fly_auto_mission(client: Client, scene: Scene) -> None:
         timeout=60,
         what="the end of the AUTO mission",
     )
+
+
+@dataclass(frozen=True)
+class Recorded:
+    path: Path
+    stdout: str
+    sent_to_vehicle: int
+    """Frames the vehicle received from the recorder's link (0: passive)."""
+
+
+def record_auto_flight(path: Path) -> Recorded:
+    """``uavtool record --camera sim --scene paper --until-landed`` (passive, on UDP) while a
+    scripted ground station flies the AUTO mission over TCP: ~10 s of wall time."""
+    scene = load_scene("paper")
+    port = free_udp_port()
+    counter = LinkCounter()
+    endpoints = ("tcpin:127.0.0.1:0", f"udpout:127.0.0.1:{port}")
+    with vehicle(scene, endpoints=endpoints, tap=counter) as sitl:
+        args = [
+            *("--connect", f"udpin:127.0.0.1:{port}", "-o", str(path)),
+            *("--camera", "sim", "--scene", "paper", "--rate", "0.5", "--until-landed"),
+        ]
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "uavtool", "record", *args],
+            cwd=REPO,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        try:
+            assert proc.stderr is not None
+            while "recording to" not in (line := proc.stderr.readline()):
+                assert line, f"record exited early: {proc.communicate()}"
+            client = Client.tcp(sitl.ports[0])
+            client.heartbeat()
+            fly_auto_mission(client, scene)
+            stdout, stderr = proc.communicate(timeout=30)
+            client.close()
+        finally:
+            proc.kill()
+        assert proc.returncode == 0, stderr
+        recorder_links = [name for name in counter.received if not name.startswith("tcp")]
+        sent = sum(counter.received[name] for name in recorder_links)
+    return Recorded(path, stdout, sent)

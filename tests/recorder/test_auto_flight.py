@@ -6,24 +6,13 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
-import sys
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from tests.recorder.flight import (
-    PHOTO_ALT_M,
-    STOPS,
-    LinkCounter,
-    fly_auto_mission,
-    free_udp_port,
-    vehicle,
-)
-from tests.sitl.client import Client
+from tests.recorder.flight import PHOTO_ALT_M, STOPS, Recorded
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.cli import cli
 from uavtool.images import png_decode
@@ -31,51 +20,6 @@ from uavtool.recording import CompressedImage, Direction, JsonDocument, LogEntry
 from uavtool.recording.topics import FRAMES, IMAGE, TELEMETRY, VEHICLE_EVENTS
 from uavtool.runner.fly import target_picture
 from uavtool.world import load_scene, render
-
-REPO = Path(__file__).resolve().parents[2]
-
-
-@dataclass(frozen=True)
-class Recorded:
-    path: Path
-    stdout: str
-    sent_to_vehicle: int
-
-
-@pytest.fixture(scope="module")
-def recorded(tmp_path_factory: pytest.TempPathFactory) -> Recorded:
-    scene = load_scene("paper")
-    port = free_udp_port()
-    counter = LinkCounter()
-    path = tmp_path_factory.mktemp("record") / "auto.mcap"
-    endpoints = ("tcpin:127.0.0.1:0", f"udpout:127.0.0.1:{port}")
-    with vehicle(scene, endpoints=endpoints, tap=counter) as sitl:
-        args = [
-            *("--connect", f"udpin:127.0.0.1:{port}", "-o", str(path)),
-            *("--camera", "sim", "--scene", "paper", "--rate", "0.5", "--until-landed"),
-        ]
-        proc = subprocess.Popen(
-            [sys.executable, "-m", "uavtool", "record", *args],
-            cwd=REPO,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-        )
-        try:
-            assert proc.stderr is not None
-            while "recording to" not in (line := proc.stderr.readline()):
-                assert line, f"record exited early: {proc.communicate()}"
-            client = Client.tcp(sitl.ports[0])
-            client.heartbeat()
-            fly_auto_mission(client, scene)
-            stdout, stderr = proc.communicate(timeout=30)
-            client.close()
-        finally:
-            proc.kill()
-        assert proc.returncode == 0, stderr
-        recorder_links = [name for name in counter.received if not name.startswith("tcp")]
-        sent = sum(counter.received[name] for name in recorder_links)
-    return Recorded(path, stdout, sent)
 
 
 def _read(path: Path) -> tuple[list[dict], list[tuple[dict, bytes]], list[str], int]:

@@ -91,6 +91,7 @@ def replay(
       uavtool replay --refly recordings/golden/paper.mcap   # vehicle, renderer and mission
       uavtool replay --check recordings/golden --out check.parquet  # a folder or a glob, on Dask
       uavtool replay --vision-only recorded.mcap --target red.png --out analysed.mcap
+      uavtool replay --vision-only 'flights/*.mcap' --target red.png --out photos.csv
     """
     from uavtool.cli.replay_batch import is_batch, replay_batch
 
@@ -103,6 +104,7 @@ def replay(
             settings=settings,
             params_file=params_file,
             vision_only=vision_only,
+            target=target,
             out=out,
             scheduler=scheduler,
             workers=workers,

@@ -25,13 +25,16 @@ def replay_batch(
     settings: tuple[str, ...],
     params_file: Path | None,
     vision_only: bool,
+    target: Path | None,
     out: Path | None,
     scheduler: str | None,
     workers: int | None,
     quiet: bool,
 ) -> None:
     """Replay every recording; write the table (``--out``, ``.parquet`` or ``.csv``) and its
-    summary beside it; exit 1 under ``--check`` unless every one is identical."""
+    summary beside it; exit 1 under ``--check`` unless every one is identical. Under
+    ``--vision-only``, the photos of recordings from ``uavtool record`` are matched against
+    ``target`` (required for them; a row says so when it is missing)."""
     from uavtool.cli.replay import _params_file
     from uavtool.mission.params import parse_settings
     from uavtool.sweep.progress import format_progress
@@ -43,6 +46,9 @@ def replay_batch(
         write_replay_table,
     )
 
+    if target is not None and not vision_only:
+        raise click.UsageError("--target is for --vision-only of recordings from uavtool record")
+    target_png = _read_target(target) if target is not None else None
     paths = find_recordings(str(pattern))
     overrides: dict[str, object] = _params_file(params_file) if params_file is not None else {}
     overrides.update(parse_settings(settings))
@@ -61,6 +67,7 @@ def replay_batch(
         paths,
         overrides=overrides,
         vision_only=vision_only,
+        target_png=target_png,
         scheduler=scheduler,
         workers=workers,
         progress=lambda p: draw(format_progress(p, noun="recordings")),
@@ -77,6 +84,18 @@ def replay_batch(
     whole = all(r.get("result") == IDENTICAL and r.get("status_before") for r in batch.rows)
     if check and not vision_only and not whole:
         sys.exit(1)
+
+
+def _read_target(target: Path) -> bytes:
+    from uavtool.errors import InputError
+    from uavtool.images import png_decode
+
+    try:
+        png = target.read_bytes()
+    except OSError as exc:
+        raise InputError(f"--target {target}: cannot read: {exc.strerror}") from None
+    png_decode(png, where=f"--target {target}")  # a bad picture is one error, not one per row
+    return png
 
 
 def _default_table() -> Path:

@@ -1,4 +1,5 @@
-"""What `uavtool info` reports: duration, topics, frames, mission outcome, file health."""
+"""What `uavtool info` reports: duration, topics, frames, file health, and how the recording
+ended: a mission's outcome (`uavtool fly`) or what stopped a `uavtool record`."""
 
 from __future__ import annotations
 
@@ -13,6 +14,8 @@ from uavtool.recording.topics import IMAGE
 from uavtool.recording.values import CompressedImage
 
 OUTCOME_METADATA = "outcome"  # the record the mission runner writes when it finishes
+RECORD_METADATA = "record"  # `uavtool record` writes it first: a flight it did not fly
+RECORD_RESULT_METADATA = "record_result"  # … and this one when it stops
 
 
 @dataclass(frozen=True, slots=True)
@@ -46,6 +49,8 @@ class RecordingInfo:
     damage: tuple[str, ...] = ()  # each corrupt chunk or damaged record, in words
     messages_lost: int = 0  # in the corrupt chunks, as far as their indexes tell
     other_images: tuple[tuple[str, int], ...] = ()  # (topic, count): e.g. the target picture
+    from_record: bool = False  # made by `uavtool record`: no mission, so no outcome to expect
+    record_result: dict[str, str] | None = None  # what stopped `uavtool record`, if it did stop
 
     @property
     def duration_s(self) -> float:
@@ -85,9 +90,8 @@ def summarize(path: str | Path, *, verify: bool = True) -> RecordingInfo:
             for topic, n in sorted(totals.items())
         )
         metadata = reader.metadata
-        outcome = next(
-            (dict(r) for name, r in reversed(metadata) if name == OUTCOME_METADATA), None
-        )
+        outcome = _last(metadata, OUTCOME_METADATA)
+        record_result = _last(metadata, RECORD_RESULT_METADATA)
         return RecordingInfo(
             path=str(path),
             size_bytes=health.size_bytes,
@@ -106,11 +110,18 @@ def summarize(path: str | Path, *, verify: bool = True) -> RecordingInfo:
             topics=topics,
             metadata_names=tuple(name for name, _ in metadata),
             outcome=outcome,
+            from_record=record_result is not None
+            or any(name == RECORD_METADATA for name, _ in metadata),
+            record_result=record_result,
             verified=verify,
             summary_problem=reader.summary_problem,
             damage=tuple(reader.describe(d) for d in damage),
             messages_lost=lost,
         )
+
+
+def _last(metadata: list[tuple[str, dict[str, str]]], name: str) -> dict[str, str] | None:
+    return next((dict(r) for n, r in reversed(metadata) if n == name), None)
 
 
 def damage_problem(info: RecordingInfo) -> str:
@@ -171,10 +182,7 @@ def format_info(info: RecordingInfo) -> str:
     lines.append(f"messages:  {info.message_count}{readable}")
     others = "".join(f"; {n} on {topic}" for topic, n in info.other_images)
     lines.append(f"frames:    {info.frame_count} on {IMAGE}{others}")
-    if info.outcome is None:
-        lines.append("outcome:   unknown (no 'outcome' record: the mission did not finish)")
-    else:
-        lines.append("outcome:   " + ", ".join(f"{k}={v}" for k, v in info.outcome.items()))
+    lines.append(_ending(info))
     if info.metadata_names:
         lines.append("metadata:  " + ", ".join(info.metadata_names))
     lines.append("topics:")
@@ -183,3 +191,25 @@ def format_info(info: RecordingInfo) -> str:
         kind = t.schema_name or t.message_encoding
         lines.append(f"  {t.topic:<{width}}  {t.count:>8} msgs  {t.rate_hz:9.2f} Hz  {kind}")
     return "\n".join(lines)
+
+
+def _ending(info: RecordingInfo) -> str:
+    """The line on how the recording ended: the mission's outcome, or why `record` stopped."""
+    if info.outcome is not None:
+        return "outcome:   " + ", ".join(f"{k}={v}" for k, v in info.outcome.items())
+    if not info.from_record:
+        return "outcome:   unknown (no 'outcome' record: the mission did not finish)"
+    r = info.record_result
+    if r is None:
+        return (
+            "recorded:  by uavtool record (no mission); no 'record_result': "
+            "the recorder was killed before it could write how it stopped"
+        )
+    known = ("stopped", "duration_s", "frames", "photos")
+    text = (
+        f"recorded:  by uavtool record (no mission), stopped: {r.get('stopped', '?')} after "
+        f"{r.get('duration_s', '?')} s; {r.get('frames', '?')} frames, "
+        f"{r.get('photos', '?')} photos"
+    )
+    rest = [f"{k}={v}" for k, v in r.items() if k not in known]
+    return text + (f" ({', '.join(rest)})" if rest else "")

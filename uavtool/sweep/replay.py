@@ -6,6 +6,10 @@ first differ, or at which step the mission's decisions left the recording and wh
 decision (which point of interest matched) before and after. When the mission diverged
 before it ended, the decision after is the per-frame one: the first photographed point of
 interest the re-analysed vision matches.
+
+A recording of ``uavtool record`` has no mission to replay: under ``--vision-only`` each of
+its photos is vectorized and judged against ``--target`` (:mod:`uavtool.replay.photos`, as
+for one such file) and its row counts the photos and names the frames that match.
 """
 
 from __future__ import annotations
@@ -50,6 +54,9 @@ _SCHEMA = pa.schema(
         ("decision_after_from", pa.string()),
         ("decision_changed", pa.bool_()),
         ("frames_changed", pa.int64()),
+        ("photos", pa.int64()),
+        ("photos_matched", pa.int64()),
+        ("matched_frames", pa.string()),
         ("error", pa.string()),
         ("wall_s", pa.float64()),
         ("worker", pa.string()),
@@ -74,12 +81,20 @@ def find_recordings(pattern: str) -> list[Path]:
     return found
 
 
-def replay_recording(path: str, overrides: Mapping[str, Any], vision_only: bool) -> dict[str, Any]:
-    """One row: the recording replayed with ``overrides`` (a Dask task; errors are rows)."""
+def replay_recording(
+    path: str, overrides: Mapping[str, Any], vision_only: bool, target_png: bytes | None = None
+) -> dict[str, Any]:
+    """One row: the recording replayed with ``overrides`` (a Dask task; errors are rows).
+    ``target_png``: the picture a recording of ``uavtool record`` is matched against."""
+    from uavtool.replay.photos import is_recorded_flight  # noqa: PLC0415
+
     wall0 = time.perf_counter()
     row: dict[str, Any] = {"recording": path}
     try:
-        row |= _replay(Path(path), overrides, vision_only)
+        if vision_only and is_recorded_flight(path):
+            row |= _photos(Path(path), overrides, target_png)
+        else:
+            row |= _replay(Path(path), overrides, vision_only)
     except Exception as exc:  # a recording that fails is a row
         row |= {"result": ERROR, "error": f"{type(exc).__name__}: {exc}"}
     try:
@@ -133,6 +148,27 @@ def _replay(path: Path, overrides: Mapping[str, Any], vision_only: bool) -> dict
     }
 
 
+def _photos(path: Path, overrides: Mapping[str, Any], target_png: bytes | None) -> dict[str, Any]:
+    from uavtool.mission import Params  # noqa: PLC0415
+    from uavtool.mission.params import with_overrides  # noqa: PLC0415
+    from uavtool.replay.photos import analyse_photos  # noqa: PLC0415
+
+    if target_png is None:
+        raise InputError(
+            "a recording of `uavtool record` has no mission and no target picture: "
+            "give one with --target PNG"
+        )
+    analysis = analyse_photos(path, target_png, with_overrides(Params(), dict(overrides)))
+    matched = analysis.matches
+    return {
+        "result": VISION_ONLY,
+        "decision_after_from": "all frames" if analysis.all_frames else "photos",
+        "photos": len(analysis.results),
+        "photos_matched": len(matched),
+        "matched_frames": ",".join(str(r.frame_index) for r in matched),
+    }
+
+
 def _outcome(outputs: Sequence[Mapping[str, Any]]) -> tuple[str | None, int]:
     for data in reversed(outputs):
         if data.get("type") == "Outcome":
@@ -164,11 +200,13 @@ def replay_many(
     *,
     overrides: Mapping[str, Any],
     vision_only: bool = False,
+    target_png: bytes | None = None,
     scheduler: str | None = None,
     workers: int | None = None,
     progress: ProgressCallback | None = None,
 ) -> BatchReplay:
-    """Replay every recording as a Dask task; Ctrl-C returns the rows done (``interrupted``)."""
+    """Replay every recording as a Dask task; Ctrl-C returns the rows done (``interrupted``).
+    ``target_png``: what the photos of ``uavtool record``'s recordings are matched against."""
     report = progress or (lambda _p: None)
     rows: dict[int, dict[str, Any]] = {}
     interrupted = False
@@ -181,7 +219,11 @@ def replay_many(
                 client,
                 replay_recording,
                 [(str(p),) for p in paths],
-                kwargs={"overrides": dict(overrides), "vision_only": vision_only},
+                kwargs={
+                    "overrides": dict(overrides),
+                    "vision_only": vision_only,
+                    "target_png": target_png,
+                },
             ):
                 row = task.result
                 if task.error is not None:  # e.g. its worker died too often
@@ -212,6 +254,14 @@ def format_replay_summary(batch: BatchReplay, *, total: int, changed_params: boo
     lines += [f"  {p}" for p in changed[:20]]
     if len(changed) > 20:
         lines.append(f"  … and {len(changed) - 20} more (see the table)")
+    recorded = [r for r in batch.rows if r.get("photos") is not None]
+    if recorded:
+        photos = sum(r["photos"] for r in recorded)
+        matched = sum(r["photos_matched"] for r in recorded)
+        lines.append(
+            f"photos         {matched} of {photos} match the target, in {len(recorded)} "
+            f"recording{'s' if len(recorded) != 1 else ''} of uavtool record"
+        )
     for r in batch.rows:
         if r.get("result") == ERROR:
             lines.append(f"error          {r['recording']}: {r.get('error')}")

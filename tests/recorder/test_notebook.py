@@ -1,0 +1,42 @@
+"""notebooks/analyze_record.ipynb runs top to bottom on a flight recorded by `uavtool record`
+(the session's recorded flight: no network, no committed recording)."""
+
+from __future__ import annotations
+
+import base64
+from pathlib import Path
+
+import pytest
+
+from tests.recorder.flight import STOPS, Recorded
+
+nbformat = pytest.importorskip("nbformat")
+nbclient = pytest.importorskip("nbclient")
+
+NOTEBOOK = Path(__file__).resolve().parents[2] / "notebooks" / "analyze_record.ipynb"
+
+
+def test_record_notebook_draws_route_photos_and_scores(
+    recorded: Recorded, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("UAVTOOL_RECORDED", str(recorded.path))
+    monkeypatch.delenv("UAVTOOL_TARGET", raising=False)  # the recorded scene's target
+    nb = nbformat.read(NOTEBOOK, as_version=4)
+    client = nbclient.NotebookClient(
+        nb,
+        timeout=120,
+        kernel_name="python3",
+        resources={"metadata": {"path": str(NOTEBOOK.parent)}},
+    )
+    client.execute()
+    outputs = [o for c in nb.cells for o in c.get("outputs", [])]
+    assert not [o for o in outputs if o["output_type"] == "error"]
+    figures = [o["data"]["image/png"] for o in outputs if "image/png" in o.get("data", {})]
+    assert len(figures) == 3  # route, photos with their shapes, scores
+    assert all(base64.b64decode(f).startswith(b"\x89PNG") for f in figures)
+    text = "".join(o.get("text", "") for o in outputs)
+    assert f"{len(STOPS)} photos" in text
+    assert "record_result: {'stopped': 'landed'" in text
+    assert "mode GUIDED → AUTO" in text and "armed" in text  # the events, in order
+    assert "1 match(es): [" in text  # the red building, as `replay --vision-only` finds it
+    assert text.count("MATCH") == 1
