@@ -320,12 +320,6 @@ BAD_RECORDINGS: dict[str, bytes] = {
     "empty.mcap": b"",
 }
 
-_NO_DIR_CHECK = pytest.mark.xfail(
-    reason="issue 19: click's dir_okay=False answers a directory with a usage message, not one "
-    "line (uavtool/cli/recording.py, owned by the recording-integrity work)",
-    strict=True,
-)
-
 
 def _recording_cases() -> list[Case]:
     commands: dict[str, Callable[[str], tuple[str, ...]]] = {
@@ -341,8 +335,7 @@ def _recording_cases() -> list[Case]:
         for label, argv in commands.items():
             cases.append(Case("recording", f"{label} {name}", argv(path)))
     for label, argv in commands.items():
-        marks = (_NO_DIR_CHECK,) if label in ("info", "export") else ()
-        cases.append(Case("recording", f"{label} a directory", argv(_p("out")), marks))
+        cases.append(Case("recording", f"{label} a directory", argv(_p("out"))))
     # A truncated file is recovered by design (info, replay, export and view read what it
     # holds); only --check, which needs a whole file, refuses it.
     cases += [

@@ -9,7 +9,9 @@ import click
 
 from uavtool.errors import InputError
 
-_PATH = click.Path(dir_okay=False, path_type=Path)
+# No dir_okay=False: click would answer a directory with a usage screen; the readers and
+# writers refuse one in a line of their own (what it is, and what was expected).
+_PATH = click.Path(path_type=Path)
 
 
 @click.command()
