@@ -17,7 +17,14 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+import numpy as np
 import pytest
+
+from uavtool.camera import CameraPose
+from uavtool.mission import Photo
+from uavtool.recording import RecordingReader
+from uavtool.replay import load_flight
+from uavtool.world import load_scene, render
 
 ARDUCOPTER = os.environ.get("UAVTOOL_ARDUCOPTER", "")
 pytestmark = pytest.mark.skipif(
@@ -37,7 +44,7 @@ def _copter_defaults() -> Path:
 
 
 @contextmanager
-def arducopter(tmp_path: Path, *, mount: bool) -> Iterator[int]:
+def arducopter(tmp_path: Path, *, mount: bool, home: str = HOME) -> Iterator[int]:
     defaults = [str(_copter_defaults())]
     if mount:
         parm = tmp_path / "mount.parm"
@@ -47,7 +54,7 @@ def arducopter(tmp_path: Path, *, mount: bool) -> Iterator[int]:
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
     cmd = [
-        ARDUCOPTER, "--model", "+", "--home", HOME, "--defaults", ",".join(defaults),
+        ARDUCOPTER, "--model", "+", "--home", home, "--defaults", ",".join(defaults),
         "--serial0", f"tcp:{port}", "--wipe", "-I0",
     ]  # fmt: skip
     proc = subprocess.Popen(cmd, cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT)
@@ -75,8 +82,51 @@ def test_without_a_mount_exit_2_on_the_ground(tmp_path: Path) -> None:
     assert "taking off" not in result.stdout
 
 
-def test_with_a_mount_the_mission_completes(tmp_path: Path) -> None:
+def test_with_a_mount_the_mission_completes_and_every_photo_is_where_its_pose_says(
+    tmp_path: Path,
+) -> None:
+    """Each photo's pose comes from ArduCopter's attitude and gimbal quaternion (its servo
+    mount reports pitch −90° with a little stabilising roll, where Euler angles are singular):
+    nadir photos point straight down, side photos level, headings in [0, 360), and the scene
+    rendered again at the pose recorded is the photo recorded — a heading off by 180° would
+    give another picture."""
     with arducopter(tmp_path, mount=True) as port:
         result = _fly(port, tmp_path)
     assert result.returncode == 0, result.stdout + result.stderr
     assert "outcome        completed" in result.stdout
+    flight = load_flight(tmp_path / "f.mcap")
+    scene = load_scene("paper")  # placed at the vehicle's home: its own frame
+    photos = [o for o in flight.observations if isinstance(o, Photo)]
+    assert len(photos) >= 9
+    for photo in photos:
+        pose = photo.pose
+        side = photo.tag.split("-")[0] in ("front", "right", "diagonal")
+        assert abs(pose.pitch_deg - (0.0 if side else -90.0)) < 1.0, (photo.tag, pose)
+        assert 0.0 <= pose.heading_deg < 360.0, (photo.tag, pose)
+        again = render(scene, pose, photo.intrinsics).astype(np.int16)
+        turned = CameraPose(pose.pos_enu_m, (pose.heading_deg + 180.0) % 360.0, pose.pitch_deg)
+        other = render(scene, turned, photo.intrinsics).astype(np.int16)
+        shot = photo.image_rgb.astype(np.int16)
+        same, flipped = np.abs(shot - again).mean(), np.abs(shot - other).mean()
+        assert same < 1.0 and (side or flipped > 5.0 * max(same, 0.2)), (photo.tag, same, flipped)
+
+
+@pytest.mark.xfail(
+    reason="the scene is placed right, but the recognizer misjudges red photographed within "
+    "about 1 degree of a multiple of 90 degrees of heading (a 2 px notch where the wall "
+    "between its two roofs shows): ArduCopter's WP_YAW_BEHAVIOR=2 turned the camera to "
+    "90.7 degrees over red on 2026-11-23 (score 0.29); see the closing note of that day",
+    strict=False,
+)
+def test_a_vehicle_elsewhere_flies_the_scene_at_its_home(tmp_path: Path) -> None:
+    """ArduPilot's own default home (Canberra), 16,000 km from the paper scene's origin: the
+    scene is placed at the vehicle's home (--scene-origin vehicle, the default) and the
+    mission completes; the recording says which origin it used."""
+    with arducopter(tmp_path, mount=True, home="-35.363261,149.165230,584,353") as port:
+        result = _fly(port, tmp_path)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "outcome        completed" in result.stdout
+    assert "placed at the vehicle's home" in result.stdout + result.stderr
+    with RecordingReader(tmp_path / "f.mcap") as reader:
+        vehicle = dict(reader.metadata)["vehicle"]
+    assert vehicle["scene_origin"] == "vehicle-home"

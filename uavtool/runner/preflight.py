@@ -89,6 +89,7 @@ def _mount_fix(link: VehicleLink, on_wait: Callable[[], None] | None) -> str:
         ),
         "PARAM_VALUE",
         on_wait,
+        lambda msg: _param_name(msg) == "MNT1_TYPE",
     )
     if value is not None and value.param_value != 0:
         return (
@@ -98,11 +99,21 @@ def _mount_fix(link: VehicleLink, on_wait: Callable[[], None] | None) -> str:
     return f"MNT1_TYPE=0; {SERVO_MOUNT_FIX}"
 
 
+def _param_name(msg: Any) -> str:
+    name = msg.param_id
+    return (name.decode(errors="replace") if isinstance(name, bytes) else str(name)).rstrip("\0")
+
+
 def _ask(
-    link: VehicleLink, request: Callable[[], None], kind: str, on_wait: Callable[[], None] | None
+    link: VehicleLink,
+    request: Callable[[], None],
+    kind: str,
+    on_wait: Callable[[], None] | None,
+    wanted: Callable[[Any], bool] = lambda _msg: True,
 ) -> Any:
-    """The first ``kind`` message after ``request``, asked again every :data:`RETRY_S` (a
-    lossy link may drop the question or the answer); None after :data:`ANSWER_S`."""
+    """The first ``kind`` message after ``request`` that is ``wanted`` (a parameter's value,
+    not another one's), asked again every :data:`RETRY_S` (a lossy link may drop the
+    question or the answer); None after :data:`ANSWER_S`."""
     deadline = link.clock() + ANSWER_S
     asked = -math.inf
     while link.clock() < deadline:
@@ -110,7 +121,7 @@ def _ask(
             request()
             asked = link.clock()
         for msg in link.poll(0.05):
-            if msg.get_type() == kind:
+            if msg.get_type() == kind and wanted(msg):
                 return msg
         if on_wait is not None:
             on_wait()
