@@ -16,6 +16,7 @@ from tests.sitl.client import Client
 from tests.sitl.pilot import Pilot
 from uavtool.mavlink import mavlink as M
 from uavtool.mavlink import new_encoder
+from uavtool.mavlink.fields import INT_RANGES
 from uavtool.sitl import Sitl, SitlConfig
 from uavtool.sitl.commands import HANDLERS
 from uavtool.sitl.params import PARAM_SPECS
@@ -140,16 +141,6 @@ HOSTILE_FLOATS = (
     -(2.0**31),
     2.0**32,
 )
-_INT_BOUNDS = {
-    "int8_t": (-(2**7), 2**7 - 1),
-    "uint8_t": (0, 2**8 - 1),
-    "int16_t": (-(2**15), 2**15 - 1),
-    "uint16_t": (0, 2**16 - 1),
-    "int32_t": (-(2**31), 2**31 - 1),
-    "uint32_t": (0, 2**32 - 1),
-    "int64_t": (-(2**63), 2**63 - 1),
-    "uint64_t": (0, 2**64 - 1),
-}
 ALL_COMMANDS = tuple(sorted(M.enums["MAV_CMD"]))
 HANDLED_COMMANDS = tuple(sorted(HANDLERS))
 
@@ -189,7 +180,7 @@ def _field(name: str, ftype: str, length: int) -> st.SearchStrategy[Any]:
     if ftype in ("float", "double"):
         scalar = _floats()
     else:
-        low, high = _INT_BOUNDS[ftype]
+        low, high = INT_RANGES[ftype]
         scalar = st.one_of(st.sampled_from([low, high, 0, 1]), st.integers(low, high))
     return st.lists(scalar, min_size=length, max_size=length) if length else scalar
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-_INT_RANGES = {
+INT_RANGES = {  # the range of each MAVLink integer wire type
     "int8_t": (-(2**7), 2**7 - 1),
     "uint8_t": (0, 2**8 - 1),
     "int16_t": (-(2**15), 2**15 - 1),
@@ -52,7 +52,7 @@ def _misfit_scalar(ftype: str, value: Any) -> str | None:
         if ftype == "float" and math.isfinite(value) and abs(value) > FLOAT32_MAX:
             return " (beyond float32)"
         return None
-    low, high = _INT_RANGES[ftype]
+    low, high = INT_RANGES[ftype]
     if not isinstance(value, int):
         return " (not an integer)"
     if not low <= value <= high:

@@ -91,32 +91,41 @@ def decode_observation(data: dict[str, Any], image_rgb: U8Array | None = None) -
         if kind == "Photo":
             if image_rgb is None:
                 raise MissionInputError(f"photo {data.get('frame_index')}: its image is missing")
-            pose = data["pose"]
-            k = data["intrinsics"]
+            pose, intrinsics = decode_camera(data)
             return Photo(
                 int(data["action_id"]),
                 int(data["frame_index"]),
                 str(data["tag"]),
                 int(data["time_boot_ms"]),
-                CameraPose(
-                    _vec3(pose["pos_enu_m"]),
-                    float(pose["heading_deg"]),
-                    float(pose["pitch_deg"]),
-                    float(pose.get("roll_deg", 0.0)),
-                ),
-                Intrinsics(
-                    int(k["width_px"]),
-                    int(k["height_px"]),
-                    float(k["fx_px"]),
-                    float(k["fy_px"]),
-                    float(k["cx_px"]),
-                    float(k["cy_px"]),
-                ),
+                pose,
+                intrinsics,
                 image_rgb,
             )
     except (KeyError, TypeError, ValueError) as exc:
         raise MissionInputError(f"observation {kind}: bad or missing field {exc}") from None
     raise MissionInputError(f"unknown observation type {kind!r}")
+
+
+def decode_camera(data: dict[str, Any]) -> tuple[CameraPose, Intrinsics]:
+    """The camera pose and intrinsics of an encoded photo or frame record (its ``pose`` and
+    ``intrinsics`` fields). Raises KeyError, TypeError or ValueError on a malformed one."""
+    pose, k = data["pose"], data["intrinsics"]
+    return (
+        CameraPose(
+            _vec3(pose["pos_enu_m"]),
+            float(pose["heading_deg"]),
+            float(pose["pitch_deg"]),
+            float(pose.get("roll_deg", 0.0)),
+        ),
+        Intrinsics(
+            int(k["width_px"]),
+            int(k["height_px"]),
+            float(k["fx_px"]),
+            float(k["fy_px"]),
+            float(k["cx_px"]),
+            float(k["cy_px"]),
+        ),
+    )
 
 
 def _vec3(value: Any) -> tuple[float, float, float]:

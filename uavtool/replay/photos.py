@@ -17,7 +17,7 @@ from uavtool.camera import CameraPose, Intrinsics
 from uavtool.images import png_decode
 from uavtool.mission import Params
 from uavtool.mission.analysis import Judgement, judge, nadir_shapes, side_shapes, target_shapes
-from uavtool.mission.codec import encode_output
+from uavtool.mission.codec import decode_camera, encode_output
 from uavtool.mission.outputs import Recognition, Shapes
 from uavtool.mission.params import to_dict
 from uavtool.recording import (
@@ -96,7 +96,7 @@ def analyse_photos(path: str | Path, target_png: bytes, params: Params) -> Photo
     chosen = photos or frames
     results = []
     for rec, png, t_ns in chosen:
-        pose, intrinsics = _pose(rec), _intrinsics(rec)
+        pose, intrinsics = _camera(rec)
         image = png_decode(png, where=f"{path}: frame {rec.get('frame_index')}")
         side = pose.pitch_deg > SIDE_PITCH_DEG
         shapes = side_shapes(params, image) if side else nadir_shapes(params, image)
@@ -195,25 +195,8 @@ def _frames(path: Path) -> list[tuple[dict[str, Any], bytes, int]]:
     return out
 
 
-def _pose(rec: dict[str, Any]) -> CameraPose:
+def _camera(rec: dict[str, Any]) -> tuple[CameraPose, Intrinsics]:
     try:
-        p = rec["pose"]
-        x, y, z = (float(v) for v in p["pos_enu_m"])
-        return CameraPose((x, y, z), float(p["heading_deg"]), float(p["pitch_deg"]))
+        return decode_camera(rec)
     except (KeyError, TypeError, ValueError) as exc:
         raise ReplayInputError(f"frame {rec.get('frame_index')}: bad pose: {exc}") from None
-
-
-def _intrinsics(rec: dict[str, Any]) -> Intrinsics:
-    try:
-        k = rec["intrinsics"]
-        return Intrinsics(
-            int(k["width_px"]),
-            int(k["height_px"]),
-            float(k["fx_px"]),
-            float(k["fy_px"]),
-            float(k["cx_px"]),
-            float(k["cy_px"]),
-        )
-    except (KeyError, TypeError, ValueError) as exc:
-        raise ReplayInputError(f"frame {rec.get('frame_index')}: bad intrinsics: {exc}") from None

@@ -62,13 +62,18 @@ def log_recorded_flight(path: str | Path, reader: RecordingReader, logger: Missi
     logger.flush()
 
 
-def _setup(path: str | Path, metadata: dict[str, dict[str, str]], logger: MissionLogger) -> None:
+def log_scene(path: str | Path, metadata: dict[str, dict[str, str]], logger: MissionLogger) -> None:
+    """The scene in a recording's ``scene`` metadata, if any, to ``logger``."""
     scene_json = metadata.get("scene", {}).get("json")
     if scene_json:
         try:
             logger.scene(scene_from_dict(json.loads(scene_json), source=f"{path}: scene metadata"))
         except (ValueError, SceneError) as exc:
             raise ViewError(f"{path}: scene metadata unreadable: {exc}") from None
+
+
+def _setup(path: str | Path, metadata: dict[str, dict[str, str]], logger: MissionLogger) -> None:
+    log_scene(path, metadata, logger)
     origin = metadata.get("record", {}).get("origin")
     if origin:
         try:

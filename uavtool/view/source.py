@@ -16,8 +16,7 @@ from uavtool.geo import GeoPoint
 from uavtool.recording import CompressedImage, JsonDocument, LogEntry, RecordingReader
 from uavtool.view.errors import ViewError
 from uavtool.view.logger import MissionLogger
-from uavtool.view.recorded import is_recorded_flight, log_recorded_flight
-from uavtool.world import SceneError, scene_from_dict
+from uavtool.view.recorded import is_recorded_flight, log_recorded_flight, log_scene
 
 OBSERVATIONS = "/mission/observations"
 OUTPUTS = "/mission/outputs"
@@ -74,12 +73,7 @@ def _setup(
     metadata: dict[str, dict[str, str]],
     logger: MissionLogger,
 ) -> None:
-    scene_json = metadata.get("scene", {}).get("json")
-    if scene_json:
-        try:
-            logger.scene(scene_from_dict(json.loads(scene_json), source=f"{path}: scene metadata"))
-        except (ValueError, SceneError) as exc:
-            raise ViewError(f"{path}: scene metadata unreadable: {exc}") from None
+    log_scene(path, metadata, logger)
     params_json = metadata.get("mission", {}).get("params")
     if params_json:
         try:
