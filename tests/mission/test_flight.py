@@ -21,6 +21,7 @@ from uavtool.mission import (
     Plan,
     Recognition,
     SetMode,
+    Shapes,
     Status,
     Viewpoints,
 )
@@ -28,7 +29,8 @@ from uavtool.mission.search import look_altitude_m
 from uavtool.mission.survey import search_altitude_m
 from uavtool.nav import Viewpoint, ViewpointFailure
 from uavtool.runner.evaluate import model_iou
-from uavtool.world import Scene, building_footprint, load_scene
+from uavtool.world import Scene, building_footprint, load_scene, scene_from_dict, scene_to_dict
+from uavtool.world.hard import generate_hard_scene_with_info
 
 Point = tuple[float, float]
 
@@ -248,3 +250,29 @@ def test_blocked_viewpoint_is_reported_and_the_flight_completes(
     assert f"model not built: no {' or '.join(impossible)} photo" in flight.texts()
     assert not flight.of_type(ModelBuilt)
     assert_home_safely(flown)
+
+
+def test_a_building_cut_by_the_overview_border_is_visited_however_little_shows() -> None:
+    """Hard scene 85 with the vehicle facing 290.5°: of the target, an arched L 40 m out,
+    the higher overview shows a sliver cut by its border (92 px, less than the smallest
+    building the overview keeps whole). What shows of a building reaching out of the frame
+    says nothing of its size: it is a point of interest, visited, and matched."""
+    scene, info = generate_hard_scene_with_info(seed=85)
+    data = scene_to_dict(scene)
+    data["origin"]["heading_deg"] = 290.5
+    flown = fly(scene_from_dict(data, source="test"))
+    flight = flown.flight
+    (plan,) = flight.of_type(Plan)
+    shapes = {s.frame_index: s.shapes for s in flight.of_type(Shapes)}
+    overview = shapes[plan.frame_index]
+    small = [p for p in plan.pois if overview[p.shape_index].area_px < 150.0]
+    assert small and all(overview[p.shape_index].cut_by_border for p in small)
+    assert flown.outcome.status is Status.COMPLETED, flown.outcome.reason
+    matched = plan.pois[flown.outcome.matched_poi]
+    assert matched in small
+    target = building_footprint(scene.building(info.target))
+    (look,) = [
+        o for o in flight.observations if isinstance(o, Photo) and o.tag == f"poi-{matched.index}"
+    ]
+    x, y, _ = look.pose.pos_enu_m
+    assert target.distance(shapely.Point(x, y)) < 15.0

@@ -50,3 +50,21 @@ def test_a_wall_strip_is_no_courtyard() -> None:
     assert merged.holes_px == ()
     plain = Shape.from_rings(colour_rgb=(197, 38, 38), polygon_px=ring)
     assert merge_touching((plain,), gap_px=6.0) == (plain,)
+
+
+def test_a_slit_into_one_roof_is_closed_and_a_wide_notch_kept() -> None:
+    """The wall between two roofs of one building may show as a slit one or two pixels wide
+    into its outline: closed like the gap between two roofs. A notch wider than the gap is
+    part of the shape."""
+    slit = np.array(
+        [[0, 0], [200, 0], [200, 100], [101, 100], [101, 70], [99.5, 70], [99.5, 100], [0, 100]],
+        dtype=np.float64,
+    )
+    (out,) = merge_touching(
+        (Shape.from_rings(colour_rgb=(197, 38, 38), polygon_px=slit),), gap_px=6.0
+    )
+    assert len(out.polygon_px) == 4 and out.area_px == 200 * 100
+    notch = slit.copy()
+    notch[[3, 4], 0] = 110.0  # 10.5 px wide
+    shape = Shape.from_rings(colour_rgb=(197, 38, 38), polygon_px=notch)
+    assert merge_touching((shape,), gap_px=6.0) == (shape,)

@@ -123,3 +123,24 @@ def test_a_shape_cut_by_the_border_is_not_judged() -> None:
     assert matches[c].score > matches[1 - c].score  # scored, but a cut outline proves nothing
     assert best == 1 - c
     assert best_match(reference, shapes[c : c + 1]) == (-1, matches[c : c + 1])
+
+
+def test_a_step_in_an_edge_costs_its_depth_whatever_corner_it_is_read_from() -> None:
+    """Two roofs of one building at different heights: seen from above, the nearer roof is
+    drawn a little larger, so a long edge gets a step of a few pixels, two sharp corners
+    joined by a short edge. Dropping them costs how far they stand off the edge, so the L
+    still matches; and it does whichever corner the outline starts at, though the step's
+    corners are its sharpest."""
+    ell = np.array([[0, 0], [200, 0], [200, 80], [80, 80], [80, 200], [0, 200]], float)
+    # A 4 px step halfway along the top edge, its corners turning 92°.
+    stepped = np.array(
+        [[0, 0], [100, 0], [100.14, 4], [200, 4], [200, 80], [80, 80], [80, 200], [0, 200]],
+        float,
+    )
+    for start in range(len(stepped)):
+        m = match(ell, np.roll(stepped, -start, axis=0))
+        assert m.score > 0.9, start
+        assert sorted(len(c) for _, c in m.pairs) == [1, 1, 1, 1, 1, 3]
+    # A real wing dropped is no step: an L against the rectangle round it.
+    box = np.array([[0, 0], [200, 0], [200, 200], [0, 200]], float)
+    assert match(ell, box).score < THRESHOLD

@@ -99,3 +99,21 @@ def test_bad_input_raises_one_line_errors() -> None:
         VectorizeParams(denoise_px=4)
     with pytest.raises(VisionParamError, match="straight_tolerance_px"):
         VectorizeParams(straight_tolerance_px=-0.5)
+
+
+def test_from_above_a_hole_showing_only_the_buildings_own_walls_is_no_hole() -> None:
+    """With ``roof_only``, the darker shade of a roof's colour (a wall seen in perspective)
+    is left out. A strip of wall inside a roof (a higher block's, seen from above) is not a
+    courtyard: filled. A courtyard shows the ground: kept."""
+    roof = np.array([[40, 40], [360, 40], [360, 260], [40, 260]], float)
+    wall = np.array([[80, 200], [320, 200], [320, 214], [80, 214]], float)  # 14 px wide
+    yard = np.array([[150, 80], [250, 80], [250, 150], [150, 150]], float)
+    dark = tuple(int(c * 0.6) for c in RED)
+    image = draw([(roof, RED), (wall, dark)], size=(400, 300), holes=[yard], shade=False)
+    (shape,) = vectorize(image, VectorizeParams(roof_only=True))
+    assert len(shape.holes_px) == 1
+    assert shape.holes_px[0].min(axis=0) == pytest.approx((150, 80), abs=1.5)
+    walled = draw([(roof, RED), (wall, dark)], size=(400, 300), shade=False)
+    (plain,) = vectorize(walled, VectorizeParams(roof_only=True))
+    assert plain.holes_px == ()
+    assert plain.area_px == pytest.approx(320 * 220, rel=0.02)

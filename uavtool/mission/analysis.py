@@ -60,10 +60,35 @@ class Judgement:
     """Whether the mirror rule holds."""
 
 
+def aimed_shape(
+    params: Params,
+    shapes: tuple[Shape, ...],
+    intrinsics: Intrinsics,
+    colour_rgb: tuple[int, int, int] | None,
+) -> Shape | None:
+    """The shape a photo aimed at a building of ``colour_rgb`` (None: of any colour) shows it
+    as: the one the photo is centred on among the shapes of that colour (hues no further
+    apart than the vectorizer's own tolerance), or among all when none has it. The photo was
+    aimed from an estimate; a larger building of another colour beside it may lie nearer
+    the centre."""
+    if colour_rgb is not None:
+        tol = params.vectorize.hue_tolerance_deg
+        same = tuple(s for s in shapes if hue_distance_deg(s.colour_rgb, colour_rgb) <= tol)
+        if same:
+            return central_shape(same, intrinsics)
+    return central_shape(shapes, intrinsics)
+
+
 def judge(
-    params: Params, target: Shape, shapes: tuple[Shape, ...], intrinsics: Intrinsics
+    params: Params,
+    target: Shape,
+    shapes: tuple[Shape, ...],
+    intrinsics: Intrinsics,
+    aimed_rgb: tuple[int, int, int] | None = None,
 ) -> Judgement:
-    centre = central_shape(shapes, intrinsics)
+    """The photo's shapes against the target; the candidate is :func:`aimed_shape`'s (the
+    photo was aimed at a building of ``aimed_rgb``, None when not known)."""
+    centre = aimed_shape(params, shapes, intrinsics, aimed_rgb)
     candidate = next((i for i, s in enumerate(shapes) if s is centre), -1)
     if centre is None or candidate < 0:
         return Judgement((), -1, 0.0, False)

@@ -82,7 +82,8 @@ class MissionParams:
     """A candidate whose colour's hue is further than this from the target's is not a match,
     whatever its shape (0 = judge by shape alone)."""
     min_poi_area_px: float = 150.0
-    """Overview shapes smaller than this (square pixels) are not visited."""
+    """Overview shapes smaller than this (square pixels) are not visited, unless cut by the
+    photo's border (a building reaching out of the frame shows any part of itself)."""
     max_looks: int = 3
     """Photos taken at most at one point of interest. When a look is doubtful — the candidate
     has the target's hue but its outline is cut by the image border, or it scores between

@@ -67,8 +67,8 @@ def survey(m: Mission) -> Wait[Survey]:
     )
     pois: list[PointOfInterest] = []
     for i, shape in enumerate(shapes):
-        if shape.area_px < p.min_poi_area_px:
-            continue
+        if shape.area_px < p.min_poi_area_px and not shape.cut_by_border:
+            continue  # too small for a building; one cut by the border may be any size
         u, v = shape.centroid_px
         pos = ground_point(u, v, high.pose, high.intrinsics, plane_z_m=planes[i])
         extent = _extent_m(footprints[i])

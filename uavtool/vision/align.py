@@ -61,26 +61,21 @@ NO_MATCH = Match(0.0, math.inf, (), 0.0, 0.0, False)
 
 
 def align(ref: Symbols, cand: Symbols, p: RecognizeParams, *, mirrored: bool) -> Match:
-    """The best alignment, reading the candidate from a corner that surely starts a group.
+    """The best alignment, reading the candidate from each of its corners in turn.
 
     The reference is doubled, so its groups may start anywhere; the candidate is read once
-    round, so a group of its corners cannot wrap past its first corner. Reading from its
-    sharpest corner — and also from just before it when the corners before it are weak
-    (small turn or short edge, i.e. candidates for merging) — avoids that. The first start
-    wins ties.
+    round, so a group of its corners cannot wrap past its first corner. Reading it from
+    every corner (all in the same array calls) lets a group start anywhere too. Starts are
+    tried from the sharpest corner on; the first wins ties.
     """
     n_a, n_b = len(ref.turn_deg), len(cand.turn_deg)
     if n_b < 3:
         return NO_MATCH
     turns = [abs(t) for t in cand.turn_deg.tolist()]
-    lengths = cand.length_rel.tolist()
     sharpest = max(range(n_b), key=lambda i: (turns[i], -i))
-    starts = [sharpest]
-    for back in range(1, min(p.max_merge, n_b)):
-        prev = (sharpest - back) % n_b
-        if not (turns[prev] < 0.5 * p.angle_scale_deg or lengths[prev] * n_b < 0.5):
-            break
-        starts.append(prev)
+    # Every corner may be where a group starts (a step in an edge makes its sharpest
+    # corners ones to drop), so the candidate is read from each, sharpest first.
+    starts = [(sharpest + i) % n_b for i in range(n_b)]
     if n_a < 3:
         return Match(0.0, math.inf, (), 0.0, 0.0, False)
     mean_n = 0.5 * (n_a + n_b)
@@ -171,17 +166,28 @@ def _group_tables(
     length2 = np.concatenate([sym.length_rel, sym.length_rel])
     turn = sym.turn_deg
     length = sym.length_rel
-    penalty = np.zeros(n)
+    if k == 1:
+        return turn, length, np.zeros(n)
     for j in range(1, k):
-        nxt_turn = turn2[j : j + n]
-        prev_len = length2[j - 1 : j - 1 + n]
-        turn = turn + nxt_turn
+        turn = turn + turn2[j : j + n]
         length = length + length2[j : j + n]
-        dropped = np.minimum(
-            np.abs(nxt_turn) / p.angle_scale_deg, prev_len * mean_n / p.length_scale
-        )
-        penalty = penalty + (p.merge_cost + dropped)
-    return turn, length, penalty
+    # The k − 1 inner corners are dropped: the outline then runs straight from the group's
+    # first corner to the corner after it. That changes the shape by the area between the
+    # dropped path and that chord (summed as a fan of triangles from the first corner, so a
+    # step's two sides do not cancel), and losing a share of the shape's area costs that
+    # share of the score: nothing for a vertex on a straight edge, little for a corner that
+    # simplification split or a step in an edge, a wing's share for a real corner.
+    ring = sym.ring_px
+    ring2 = np.concatenate([ring, ring])
+    x, y = ring[:, 0], ring[:, 1]
+    area = 0.5 * abs(math.fsum((x * np.roll(y, -1) - np.roll(x, -1) * y).tolist()))
+    changed = np.zeros(n)
+    for j in range(1, k):
+        a = ring2[j : j + n] - ring
+        b = ring2[j + 1 : j + 1 + n] - ring
+        changed = changed + 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+    dropped = changed / area * mean_n if area > 0.0 else np.full(n, math.inf)
+    return turn, length, (k - 1) * p.merge_cost + dropped
 
 
 def _backtrack(

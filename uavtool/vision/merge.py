@@ -17,9 +17,10 @@ def merge_touching(
     shapes: tuple[Shape, ...], *, gap_px: float, colour_tolerance_dn: float = 0.0
 ) -> tuple[Shape, ...]:
     """Shapes of one colour less than ``gap_px`` apart become one shape (union closed by
-    ``gap_px / 2``, mitred so corners stay sharp); others are returned in order, without
-    their holes thinner than the gap (the wall strip around a higher block is a hole in
-    the roof of the lower one).
+    ``gap_px / 2``, mitred so corners stay sharp). Every shape is closed so, alone or not:
+    a wall between two roofs of one building may show as a slit into its outline, or as a
+    strip of hole in the roof of the lower block (holes thinner than the gap go too).
+    Shapes are returned in order.
     Two colours are one when they differ by at most ``colour_tolerance_dn`` in every RGB
     channel (0–255). The merged shape takes the place and the colour of its first member."""
     if gap_px <= 0.0:
@@ -44,14 +45,15 @@ def merge_touching(
         members.setdefault(root(i), []).append(i)
     out: list[Shape] = []
     for first, idx in sorted(members.items()):
-        if len(idx) == 1:
-            out.append(_without_strips(shapes[first], gap_px))
-            continue
         half = gap_px / 2.0
         union = shapely.union_all([polys[i].buffer(half, join_style="mitre") for i in idx])
         closed = union.buffer(-half, join_style="mitre")
         if not isinstance(closed, shapely.Polygon) or closed.is_empty:
-            out.extend(shapes[i] for i in idx)  # did not close into one outline: keep apart
+            # did not close into one outline: keep apart
+            out.extend(_without_strips(shapes[i], gap_px) for i in idx)
+            continue
+        if len(idx) == 1 and _same_outline(closed, polys[first]):
+            out.append(_without_strips(shapes[first], gap_px))  # nothing to close
             continue
         closed = closed.simplify(0.5, preserve_topology=True)
         holes = [r for r in closed.interiors if not _strip(shapely.Polygon(r), gap_px)]
@@ -64,6 +66,13 @@ def merge_touching(
             )
         )
     return tuple(out)
+
+
+def _same_outline(closed: shapely.Polygon, original: shapely.Polygon) -> bool:
+    """Whether ``closed``, a closing of ``original``, has its outer outline, but for
+    rounding (a closing only adds: the areas tell)."""
+    area = shapely.Polygon(original.exterior).area
+    return bool(abs(shapely.Polygon(closed.exterior).area - area) <= 1e-6 * area)
 
 
 def _strip(hole: shapely.Polygon, gap_px: float) -> bool:

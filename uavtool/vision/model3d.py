@@ -19,6 +19,7 @@ whose output is always a closed 2-manifold, so the mesh is watertight by constru
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -270,15 +271,16 @@ def _to_trimesh(solid: Any) -> trimesh.Trimesh:
 
 def central_shape(shapes: tuple[Shape, ...], intrinsics: Intrinsics) -> Shape | None:
     """The shape a photo is centred on: the one whose centroid is nearest the principal
-    point, among shapes at least a quarter as large as the largest."""
+    point for its size (the distance over the square root of its area), so a building the
+    photo was aimed at wins over a larger one beside it, and a small one near the centre
+    over a large one's far-off centroid."""
     if not shapes:
         return None
-    largest = max(s.area_px for s in shapes)
-    big = [s for s in shapes if s.area_px >= 0.25 * largest]
     return min(
-        big,
+        shapes,
         key=lambda s: (
-            (s.centroid_px[0] - intrinsics.cx_px) ** 2 + (s.centroid_px[1] - intrinsics.cy_px) ** 2
+            math.hypot(s.centroid_px[0] - intrinsics.cx_px, s.centroid_px[1] - intrinsics.cy_px)
+            / math.sqrt(max(s.area_px, 1.0))
         ),
     )
 

@@ -102,9 +102,10 @@ class RecognizeParams:
     perimeter). A matched pair of symbols costs ``|Δangle| / angle_scale_deg + |Δlength| ·
     n / length_scale`` (``n`` the mean corner count, so a length error is relative to the
     mean edge); merging ``k`` consecutive corners of one outline into one corner of the other
-    (a corner that simplification split, or an extra vertex on a straight edge) costs
-    ``merge_cost`` each plus the smaller of the dropped turn and the dropped edge, in the
-    same units. The score is ``1 − total / n`` clipped to [0, 1].
+    (a corner that simplification split, an extra vertex on a straight edge, a step in an
+    edge) costs ``merge_cost`` for each dropped corner plus how far it stands off the
+    straight edge that replaces it, relative to the perimeter as lengths are. The score is
+    ``1 − total / n`` clipped to [0, 1].
     """
 
     angle_scale_deg: float = 90.0

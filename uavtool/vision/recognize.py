@@ -5,8 +5,9 @@ corner and the length of the edge leaving it, relative to the perimeter. The ref
 sequence is doubled, so aligning the candidate against every window of ``n`` consecutive
 reference symbols tries every starting corner. The alignment is an edit distance whose
 edits are merges: ``k`` consecutive corners of one outline may stand for one corner of the
-other (their turns and edges add up), cheap when the dropped corner barely turns (a vertex
-left on a straight edge) or the dropped edge is short (a corner that simplification split).
+other (their turns and edges add up), cheap when the dropped corners stand close to the
+straight edge that replaces them (a vertex left on a straight edge, a corner that
+simplification split, the step between two roofs of one building seen in perspective).
 
 The alignment itself is in :mod:`uavtool.vision.align`.
 """

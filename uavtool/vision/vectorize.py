@@ -73,9 +73,10 @@ def vectorize(frame_rgb: U8Array, params: VectorizeParams | None = None) -> tupl
             continue
         sub = (slice(by, by + bh), slice(bx, bx + bw))
         mask = mask[sub]
+        every = mask
         if p.roof_only:
             mask = brightest_shade(val[sub], mask, p)
-        regions.extend(_regions(mask, (x0 + bx, y0 + by), frame.shape[:2], k, p))
+        regions.extend(_regions(mask, every, (x0 + bx, y0 + by), frame.shape[:2], k, p))
     rings = simplify_rings([c for r in regions for c in (r.outer, *r.holes)], p)
     shapes: list[tuple[int, float, int, Shape]] = []
     at = 0
@@ -113,9 +114,18 @@ class _Region(NamedTuple):
 
 
 def _regions(
-    mask: CvArray, origin: tuple[int, int], frame_hw: tuple[int, int], k: int, p: VectorizeParams
+    mask: CvArray,
+    colour: CvArray,
+    origin: tuple[int, int],
+    frame_hw: tuple[int, int],
+    k: int,
+    p: VectorizeParams,
 ) -> list[_Region]:
-    """The regions of a colour mask large enough to keep, with their holes."""
+    """The regions of a colour mask large enough to keep, with their holes. ``colour`` is
+    every pixel of the colour, ``mask`` those that count (with ``roof_only``, the roofs): a
+    hole must show at least ``min_hole_area_px`` pixels of something else. A hole in a roof
+    that shows only the building's own walls (a higher block's, seen in perspective) is
+    filled; a courtyard or a tunnel shows the ground."""
     contours, hierarchy = cv2.findContours(
         mask, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_NONE, offset=origin
     )
@@ -135,11 +145,24 @@ def _regions(
         child = tree[i][2]
         while child != -1:
             hole = contours[child]
-            if cv2.contourArea(hole) - 0.5 * len(hole) >= p.min_hole_area_px:
+            if cv2.contourArea(hole) - 0.5 * len(hole) >= p.min_hole_area_px and (
+                colour is mask or _shows_other(hole, colour, origin, p.min_hole_area_px)
+            ):
                 holes.append(hole[:, 0, :])
             child = tree[child][0]
         out.append(_Region(k, contour, contour[:, 0, :], tuple(holes), cut, mask, origin))
     return out
+
+
+def _shows_other(hole: CvArray, colour: CvArray, origin: tuple[int, int], least: float) -> bool:
+    """Whether at least ``least`` pixels inside ``hole`` (frame pixels) are not ``colour``'s
+    (a mask over the box at ``origin``)."""
+    x, y, w, h = cv2.boundingRect(hole)
+    inside = np.zeros((h, w), np.uint8)
+    cv2.drawContours(inside, [hole], 0, 255, cv2.FILLED, offset=(-x, -y))
+    bx, by = x - origin[0], y - origin[1]
+    other = cv2.bitwise_and(inside, cv2.bitwise_not(colour[by : by + h, bx : bx + w]))
+    return cv2.countNonZero(other) >= least
 
 
 def _offset_shape(
