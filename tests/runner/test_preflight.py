@@ -3,6 +3,7 @@ and the vehicle's refusals in the terminal and the summary (issue 18)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -16,6 +17,7 @@ from uavtool.mission.scenario import NO_GIMBAL_REASON
 from uavtool.runner.fly import FlyConfig, flight_metadata, fly
 from uavtool.runner.placement import place_scene
 from uavtool.runner.preflight import PreflightError
+from uavtool.runner.summary import format_summary
 from uavtool.world import load_scene
 
 
@@ -61,6 +63,14 @@ def test_a_vehicle_that_refuses_is_heard_and_summarised(monkeypatch: pytest.Monk
     assert any("Arm: Mount: check TYPE" in h for h in heard)
     assert "Arm: Mount: check TYPE" in summary.last_refusal
     assert "COMPONENT_ARM_DISARM" in summary.last_refusal
+    lines = format_summary(summary).splitlines()
+    assert f"last refusal   {summary.last_refusal}" in lines
+    # A flight that got past a refusal (arming retried) mentions it as such.
+    went_on = replace(summary, outcome=replace(summary.outcome, status=Status.COMPLETED))
+    assert (
+        f"refused        {summary.last_refusal} (the mission retried and went on)"
+        in format_summary(went_on).splitlines()
+    )
 
 
 def test_the_scene_goes_where_the_vehicle_is() -> None:

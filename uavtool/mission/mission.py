@@ -386,6 +386,7 @@ class Mission:
     def arm_and_take_off(self, alt_m: float) -> Wait[None]:
         """GUIDED, arm (retrying while pre-arm checks fail) and climb to ``alt_m``."""
         p = self.params.mission
+        self.event(Level.INFO, "arming in GUIDED")
         yield from self.set_mode("GUIDED")
         start_ms = self.now_ms()
         refused = 0
@@ -406,6 +407,7 @@ class Mission:
         ok = yield from self.wait_until(lambda t: t.armed, p.move_slack_s)
         if not ok:
             raise _End(Status.ABORTED, "the vehicle accepted arming but never showed armed")
+        self.event(Level.INFO, f"armed; taking off to {alt_m:g} m")
         # A take-off whose ACK was lost is flying: the vehicle refuses it again, and that is no
         # failure.
         yield from self.command(

@@ -29,7 +29,6 @@ def fly(m: Mission) -> Wait[None]:
         yield from m.set_mode("GUIDED")
         m.airborne()
     else:
-        m.event(Level.INFO, f"taking off to {p.overview_alt_m:g} m")
         yield from m.arm_and_take_off(p.overview_alt_m)
     here = m.last.pos_enu_m if m.last else (0.0, 0.0, 0.0)
     yield from m.move((here[0], here[1], p.overview_alt_m), None, "overview position")

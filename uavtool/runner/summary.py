@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from uavtool.mission import Telemetry
+from uavtool.mission import Status, Telemetry
 
 if TYPE_CHECKING:
     from uavtool.runner.fly import FlightSummary
@@ -58,6 +58,12 @@ def format_summary(s: FlightSummary) -> str:
             f"(older than one already received: {kinds})"
         )
     if s.last_refusal:
-        lines.append(f"last refusal   {s.last_refusal}")
+        # A refusal the mission got past (a retried arming) is a remark; one it did not is
+        # likely why it stopped.
+        done = o.status in (Status.COMPLETED, Status.PARTIAL, Status.NO_MATCH)
+        if done:
+            lines.append(f"refused        {s.last_refusal} (the mission retried and went on)")
+        else:
+            lines.append(f"last refusal   {s.last_refusal}")
     lines.append(f"recording      {s.recording if s.recording else '(not recorded)'}")
     return "\n".join(lines)
