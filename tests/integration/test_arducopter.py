@@ -111,13 +111,6 @@ def test_with_a_mount_the_mission_completes_and_every_photo_is_where_its_pose_sa
         assert same < 1.0 and (side or flipped > 5.0 * max(same, 0.2)), (photo.tag, same, flipped)
 
 
-@pytest.mark.xfail(
-    reason="the scene is placed right, but the recognizer misjudges red photographed within "
-    "about 1 degree of a multiple of 90 degrees of heading (a 2 px notch where the wall "
-    "between its two roofs shows): ArduCopter's WP_YAW_BEHAVIOR=2 turned the camera to "
-    "90.7 degrees over red on 2026-11-23 (score 0.29); see the closing note of that day",
-    strict=False,
-)
 def test_a_vehicle_elsewhere_flies_the_scene_at_its_home(tmp_path: Path) -> None:
     """ArduPilot's own default home (Canberra), 16,000 km from the paper scene's origin: the
     scene is placed at the vehicle's home (--scene-origin vehicle, the default) and the
