@@ -276,3 +276,16 @@ def test_a_building_cut_by_the_overview_border_is_visited_however_little_shows()
     ]
     x, y, _ = look.pose.pos_enu_m
     assert target.distance(shapely.Point(x, y)) < 15.0
+
+
+def test_a_neighbour_of_a_close_colour_is_no_part_of_the_side_silhouette() -> None:
+    """Hard scene 216: from the right viewpoint a blue building of a close hue stands beside
+    the blue target, cut by the photo's border. Only the shapes in the columns where the
+    target's footprint projects are its silhouette: the model is built (the whole blue of
+    the photo touched the border, and backing away never helped)."""
+    scene, _ = generate_hard_scene_with_info(seed=216)
+    flown = fly(scene)
+    assert flown.outcome.status is Status.COMPLETED, flown.outcome.reason
+    (model,) = flown.flight.of_type(ModelBuilt)
+    assert model_iou(model.vertices_m, model.faces, scene) > 0.8
+    assert not any("touches the image border" in t for t in flown.flight.texts())

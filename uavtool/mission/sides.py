@@ -23,12 +23,16 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from uavtool.camera import Intrinsics
+import numpy as np
+
+from uavtool.camera import Intrinsics, project
 from uavtool.mission.analysis import cut_edges
+from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level
 from uavtool.mission.search import photo_shapes
 from uavtool.nav import Rect, Viewpoint, ViewpointFailure, ViewpointParams, plan_towards
 from uavtool.nav.geometry import point_polygon_distance
+from uavtool.vision import Shape
 from uavtool.vision.model3d import View, same_colour
 
 if TYPE_CHECKING:
@@ -134,7 +138,11 @@ def side_view(
         yield from m.move((x, y, z), vp.heading_deg, f"{vp.name} viewpoint")
         photo = yield from m.photo(vp.name if attempt == 1 else f"{vp.name}-{attempt}", 0.0)
         shapes = photo_shapes(m, photo, nadir=False)
-        silhouette = same_colour(shapes, colour_rgb, hue_tolerance_deg=SIDE_HUE_TOLERANCE_DEG)
+        silhouette = _in_line(
+            same_colour(shapes, colour_rgb, hue_tolerance_deg=SIDE_HUE_TOLERANCE_DEG),
+            plan.rect,
+            photo,
+        )
         edges = cut_edges(silhouette, photo.intrinsics)
         if not edges or attempt == p.max_looks:
             break
@@ -151,6 +159,24 @@ def side_view(
         yield from m.travel((x, y, z), vp.heading_deg, plan.transit_m, f"{vp.name} viewpoint")
     yield from m.move((x, y, plan.transit_m), vp.heading_deg, f"climb from the {vp.name} viewpoint")
     return View(silhouette, photo.pose, photo.intrinsics), vp
+
+
+def _in_line(shapes: tuple[Shape, ...], rect: Rect, photo: Photo) -> tuple[Shape, ...]:
+    """The shapes across the image columns where the building stands (its footprint's corners
+    projected, a tenth of that span to spare): a building of a close colour beside or far
+    behind it is not part of its silhouette. All of them when none is there."""
+    corners = np.array([(x, y, photo.pose.pos_enu_m[2]) for x, y in rect.corners()])
+    uvz = project(corners, photo.pose, photo.intrinsics)
+    if np.any(uvz[:, 2] <= 0.0):
+        return shapes  # the camera stands over the footprint: no columns to tell by
+    lo, hi = float(uvz[:, 0].min()), float(uvz[:, 0].max())
+    spare = 0.1 * (hi - lo)
+    kept = tuple(
+        s
+        for s in shapes
+        if s.polygon_px[:, 0].max() >= lo - spare and s.polygon_px[:, 0].min() <= hi + spare
+    )
+    return kept or shapes
 
 
 def _taller_view(m: Mission, plan: SidePlan, vp: Viewpoint, camera_z_m: float) -> Viewpoint | None:
