@@ -52,12 +52,17 @@ def reanalyse_frames(flight: RecordedFlight, params: Params) -> list[FrameChange
     results."""
     recorded_shapes: dict[int, int] = {}
     recorded_judgement: dict[int, dict[str, Any]] = {}
+    poi_colours: dict[int, tuple[int, int, int]] = {}  # what each look was aimed at
     for out in flight.outputs:
         kind = out.data.get("type")
         if kind == "Shapes":
             recorded_shapes[int(out.data["frame_index"])] = len(out.data["shapes"])
         elif kind == "Recognition":
             recorded_judgement[int(out.data["frame_index"])] = out.data
+        elif kind == "Plan":
+            for poi in out.data["pois"]:
+                r, g, b = poi["colour_rgb"]
+                poi_colours[int(poi["index"])] = (int(r), int(g), int(b))
     _, target = target_shapes(params, flight.target_rgb)
     changes = []
     for obs in flight.observations:
@@ -66,8 +71,11 @@ def reanalyse_frames(flight: RecordedFlight, params: Params) -> list[FrameChange
         side = obs.tag.split("-")[0] in _SIDE_TAGS  # "front", or "front-2" for a retake
         shapes = side_shapes(params, obs.image_rgb) if side else nadir_shapes(params, obs.image_rgb)
         score_after = matched_after = score_before = matched_before = None
-        if obs.tag.startswith("poi-"):
-            j = judge(params, target, shapes, obs.intrinsics)
+        # The looks ("poi-3", "poi-3-2") are judged; "poi-3-roof" only measures a height.
+        kind, *numbers = obs.tag.split("-")
+        if kind == "poi" and numbers and all(n.isdigit() for n in numbers):
+            aimed = poi_colours.get(int(numbers[0]))
+            j = judge(params, target, shapes, obs.intrinsics, aimed)
             score_after, matched_after = j.score, j.matched
             before = recorded_judgement.get(obs.frame_index)
             if before is not None:
