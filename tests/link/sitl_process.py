@@ -18,23 +18,11 @@ def free_udp_port() -> int:
 
 
 @contextmanager
-def sitl_udpin(*, speedup: float, scene: str = "paper") -> Iterator[int]:
-    """A vehicle listening on ``udpin:127.0.0.1:PORT`` (yields the port), stopped on exit."""
-    port = free_udp_port()
-    endpoint = f"udpin:127.0.0.1:{port}"
-    # With a mount (ArduCopter, and `uavtool sitl`, boot without one).
-    command = [
-        "uavtool",
-        "sitl",
-        "--speedup",
-        str(speedup),
-        "--scene",
-        scene,
-        "--param",
-        "MNT1_TYPE=1",
-    ]
+def sitl_process(endpoint: str, *args: str) -> Iterator[None]:
+    """``uavtool sitl ARGS --endpoint ENDPOINT`` in its own process, bound and serving once
+    this yields; stopped on exit, and its output must hold no traceback."""
     proc = subprocess.Popen(
-        [sys.executable, "-m", *command, "--endpoint", endpoint],
+        [sys.executable, "-m", "uavtool", "sitl", *args, "--endpoint", endpoint],
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
@@ -44,8 +32,18 @@ def sitl_udpin(*, speedup: float, scene: str = "paper") -> Iterator[int]:
         assert proc.stdout is not None
         banner = proc.stdout.readline() + proc.stdout.readline()
         assert endpoint in banner, banner  # bound and serving
-        yield port
+        yield
     finally:
         proc.terminate()
         out, _ = proc.communicate(timeout=10)
         assert "Traceback" not in out, out
+
+
+@contextmanager
+def sitl_udpin(*, speedup: float, scene: str = "paper") -> Iterator[int]:
+    """A vehicle listening on ``udpin:127.0.0.1:PORT`` (yields the port), stopped on exit,
+    with a mount (ArduCopter, and `uavtool sitl`, boot without one)."""
+    port = free_udp_port()
+    args = ("--speedup", str(speedup), "--scene", scene, "--param", "MNT1_TYPE=1")
+    with sitl_process(f"udpin:127.0.0.1:{port}", *args):
+        yield port

@@ -4,16 +4,11 @@
 from __future__ import annotations
 
 import base64
-from pathlib import Path
 
 import pytest
 
+from tests.notebook import run_notebook
 from tests.recorder.flight import STOPS, Recorded
-
-nbformat = pytest.importorskip("nbformat")
-nbclient = pytest.importorskip("nbclient")
-
-NOTEBOOK = Path(__file__).resolve().parents[2] / "notebooks" / "analyze_record.ipynb"
 
 
 def test_record_notebook_draws_route_photos_and_scores(
@@ -21,15 +16,7 @@ def test_record_notebook_draws_route_photos_and_scores(
 ) -> None:
     monkeypatch.setenv("UAVTOOL_RECORDED", str(recorded.path))
     monkeypatch.delenv("UAVTOOL_TARGET", raising=False)  # the recorded scene's target
-    nb = nbformat.read(NOTEBOOK, as_version=4)
-    client = nbclient.NotebookClient(
-        nb,
-        timeout=120,
-        kernel_name="python3",
-        resources={"metadata": {"path": str(NOTEBOOK.parent)}},
-    )
-    client.execute()
-    outputs = [o for c in nb.cells for o in c.get("outputs", [])]
+    outputs = run_notebook("analyze_record.ipynb", timeout_s=120)
     assert not [o for o in outputs if o["output_type"] == "error"]
     figures = [o["data"]["image/png"] for o in outputs if "image/png" in o.get("data", {})]
     assert len(figures) == 3  # route, photos with their shapes, scores

@@ -42,6 +42,7 @@ from pathlib import Path
 
 import pytest
 
+from tests.link.sitl_process import sitl_process
 from uavtool.mavlink import FrameParser
 from uavtool.mavlink import mavlink as M
 from uavtool.sitl.params import PARAM_SPECS
@@ -170,29 +171,12 @@ class MavProxy:
 def session(tmp_path: Path) -> Iterator[MavProxy]:
     """``uavtool sitl --speedup 5`` and MAVProxy connected to it, as the README shows."""
     port = _free_port()
-    sitl = subprocess.Popen(
-        [
-            *(sys.executable, "-m", "uavtool", "sitl"),
-            *("--speedup", str(SPEEDUP), "--endpoint", f"tcpin:127.0.0.1:{port}"),
-        ],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-        env={**os.environ, "PYTHONUNBUFFERED": "1"},
-    )
-    try:
-        assert sitl.stdout is not None
-        banner = sitl.stdout.readline() + sitl.stdout.readline()
-        assert f"tcpin:127.0.0.1:{port}" in banner, banner
+    with sitl_process(f"tcpin:127.0.0.1:{port}", "--speedup", str(SPEEDUP)):
         mavproxy = MavProxy(port, tmp_path)
         try:
             yield mavproxy
         finally:
             mavproxy.close()
-    finally:
-        sitl.terminate()
-        out, _ = sitl.communicate(timeout=10)
-    assert "Traceback" not in out, out
 
 
 def _altitude_m(mavproxy: MavProxy) -> float:
