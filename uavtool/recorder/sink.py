@@ -4,33 +4,22 @@ mission's observations (README, "Recording flights you don't fly")."""
 
 from __future__ import annotations
 
-from uavtool.geo import GeoPoint, geo_from_enu
+from uavtool.geo import GeoPoint
 from uavtool.mission import Telemetry
 from uavtool.mission.codec import encode, encode_observation
 from uavtool.recorder.frames import Frame
 from uavtool.recorder.watch import Event
 from uavtool.recording import (
-    CameraCalibration,
-    CompressedImage,
     Direction,
-    FrameTransform,
-    LocationFix,
     LogEntry,
-    Pose,
-    PosesInFrame,
     RecordingWriter,
 )
 from uavtool.recording.topics import (
-    CALIBRATION,
-    CAMERA_POSE,
-    FIX,
     FRAMES,
-    IMAGE,
-    POSE,
     TELEMETRY,
     VEHICLE_EVENTS,
 )
-from uavtool.runner.record import ClockNs
+from uavtool.runner.record import ClockNs, write_camera_frame, write_vehicle
 
 TELEMETRY_SCHEMA = {
     "title": "uavtool.Telemetry",
@@ -91,21 +80,14 @@ class PassiveRecorder:
         now = self.clock_ns()
         self.counts["telemetry"] += 1
         self.writer.write_json(TELEMETRY, encode_observation(t), log_time_ns=now)
-        pose = Pose.from_enu_heading(t.pos_enu_m, t.heading_deg)
-        self.writer.write(POSE, PosesInFrame((pose,)), log_time_ns=now)
-        geo = geo_from_enu(self.origin, *t.pos_enu_m)
-        fix = LocationFix(geo.lat_deg, geo.lon_deg, geo.alt_amsl_m)
-        self.writer.write(FIX, fix, log_time_ns=now)
+        write_vehicle(self.writer, t.pos_enu_m, t.heading_deg, self.origin, now)
 
     def frame(self, f: Frame) -> None:
         now = self.clock_ns()
         self.counts["frames"] += 1
         self.counts["photos"] += f.photo >= 0
         self.max_pose_dt_ms = max(self.max_pose_dt_ms, abs(f.pose_dt_ms))
-        self.writer.write(IMAGE, CompressedImage(f.png), log_time_ns=now)
-        calibration = CameraCalibration.from_intrinsics(f.intrinsics)
-        self.writer.write(CALIBRATION, calibration, log_time_ns=now)
-        self.writer.write(CAMERA_POSE, FrameTransform.from_camera_pose(f.pose), log_time_ns=now)
+        write_camera_frame(self.writer, f.png, f.intrinsics, f.pose, now)
         record = {
             "type": "Photo",
             "action_id": -1,

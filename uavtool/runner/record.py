@@ -21,6 +21,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+from uavtool.camera import CameraPose, Intrinsics
 from uavtool.geo import GeoPoint, geo_from_enu
 from uavtool.images import png_encode
 from uavtool.mission import Level, ModelBuilt, Observation, Output, Photo, Telemetry
@@ -62,6 +63,37 @@ ClockNs = Callable[[], int]
 """The recording's clock, integer ns since the Unix epoch (``time.time_ns`` for a real vehicle)."""
 
 
+def write_camera_frame(
+    writer: RecordingWriter,
+    png: bytes,
+    intrinsics: Intrinsics,
+    pose: CameraPose,
+    log_time_ns: int,
+) -> None:
+    """One camera frame on ``/camera/image``, with its calibration and its pose."""
+    t = log_time_ns
+    writer.write(IMAGE, CompressedImage(png), log_time_ns=t)
+    writer.write(CALIBRATION, CameraCalibration.from_intrinsics(intrinsics), log_time_ns=t)
+    writer.write(CAMERA_POSE, FrameTransform.from_camera_pose(pose), log_time_ns=t)
+
+
+def write_vehicle(
+    writer: RecordingWriter,
+    pos_enu_m: tuple[float, float, float],
+    heading_deg: float,
+    origin: GeoPoint | None,
+    log_time_ns: int,
+) -> None:
+    """The vehicle's pose on ``/vehicle/pose`` and, when the local frame's ``origin`` is
+    known, its WGS-84 fix on ``/vehicle/fix``."""
+    pose = Pose.from_enu_heading(pos_enu_m, heading_deg)
+    writer.write(POSE, PosesInFrame((pose,)), log_time_ns=log_time_ns)
+    if origin is not None:
+        geo = geo_from_enu(origin, *pos_enu_m)
+        fix = LocationFix(geo.lat_deg, geo.lon_deg, geo.alt_amsl_m)
+        writer.write(FIX, fix, log_time_ns=log_time_ns)
+
+
 class MissionRecorder:
     """Writes a flight into ``writer``, each message stamped by ``clock_ns``. ``home`` is the
     vehicle's home (for WGS-84 fixes)."""
@@ -93,34 +125,12 @@ class MissionRecorder:
         """Record one observation; a photo's frame as ``png`` if the caller encoded it."""
         t = self.clock_ns()
         if isinstance(obs, Photo):
-            self.writer.write(
-                IMAGE,
-                CompressedImage(png if png is not None else png_encode(obs.image_rgb)),
-                log_time_ns=t,
-            )
-            self.writer.write(
-                CALIBRATION,
-                CameraCalibration.from_intrinsics(obs.intrinsics),
-                log_time_ns=t,
-            )
-            self.writer.write(
-                CAMERA_POSE,
-                FrameTransform.from_camera_pose(obs.pose),
-                log_time_ns=t,
-            )
+            image = png if png is not None else png_encode(obs.image_rgb)
+            write_camera_frame(self.writer, image, obs.intrinsics, obs.pose, t)
             self._scene(self._markers.photo(obs.pose), t)
         elif isinstance(obs, Telemetry):
             self._markers.telemetry(obs.pos_enu_m)
-            pose = Pose.from_enu_heading(obs.pos_enu_m, obs.heading_deg)
-            self.writer.write(POSE, PosesInFrame((pose,)), log_time_ns=t)
-            if self.home is not None:
-                x, y, z = obs.pos_enu_m
-                geo = geo_from_enu(self.home, x, y, z)
-                self.writer.write(
-                    FIX,
-                    LocationFix(geo.lat_deg, geo.lon_deg, geo.alt_amsl_m),
-                    log_time_ns=t,
-                )
+            write_vehicle(self.writer, obs.pos_enu_m, obs.heading_deg, self.home, t)
         payload = {"step": step, **encode_observation(obs)}
         self.writer.write_json(OBSERVATIONS, payload, log_time_ns=t)
 
