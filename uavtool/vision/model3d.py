@@ -125,8 +125,24 @@ def open_beneath(model: Model, *, ground_z_m: float = 0.0, above_m: float = 0.5)
 
 
 def model_glb(model: Model) -> bytes:
-    """The model's mesh as binary glTF bytes."""
-    data = model.mesh.export(file_type="glb")
+    """The model's mesh as binary glTF bytes, shaded as flat light-grey faces.
+
+    Each face gets its own vertices and their normal, and the mesh a matte material:
+    viewers built on three.js (Foxglove's and Lichtblick's 3D panels) compute no normals for
+    a glTF mesh that has none and draw it black."""
+    m = model.mesh
+    visual: Any = trimesh.visual  # its constructors are untyped
+    matte = visual.material.PBRMaterial(
+        name="model", baseColorFactor=[190, 190, 190, 255], metallicFactor=0.0, roughnessFactor=1.0
+    )
+    mesh = trimesh.Trimesh(
+        vertices=m.vertices[m.faces].reshape(-1, 3),
+        faces=np.arange(3 * len(m.faces)).reshape(-1, 3),
+        vertex_normals=np.repeat(m.face_normals, 3, axis=0),
+        visual=visual.TextureVisuals(material=matte),
+        process=False,
+    )
+    data = mesh.export(file_type="glb", include_normals=True)
     if not isinstance(data, bytes):  # trimesh returns bytes for binary formats
         raise TypeError(f"trimesh returned {type(data).__name__} for GLB")
     return data
