@@ -76,6 +76,7 @@ def test_no_traceback_or_warning_from_any_command(tmp_path: Path) -> None:
         *(("info", str(p)) for p in sorted((ROOT / "recordings" / "golden").glob("*.mcap"))),
         ("info", "--json", PAPER),
         ("export", PAPER, "--tlog", str(tmp_path / "paper.tlog")),
+        ("export", PAPER, "--layout", str(tmp_path / "paper.layout.json")),
         ("import", str(tmp_path / "paper.tlog"), "-o", str(tmp_path / "back.mcap")),
         ("view", PAPER, "--save", str(tmp_path / "paper.rrd")),
         ("replay", "--check", PAPER),

@@ -99,3 +99,10 @@ def test_vision_only_finds_the_red_building_and_view_shows_it(
     assert sidecar["tag"] == f"photo-{list(STOPS).index('red')}"
     assert (out / f"frame_{red[0]:04d}.png").read_bytes() == frames[red[0]][1]
     assert (out / "target.png").read_bytes() == target.read_bytes()
+
+    layout = tmp_path / "layout.json"
+    result = runner.invoke(cli, ["export", str(recorded.path), "--layout", str(layout)])
+    assert result.exit_code == 0, result.output
+    config = json.loads(layout.read_text())["configById"]
+    assert config["RosOut!events"]["topicToRender"] == VEHICLE_EVENTS
+    assert config["Image!camera"]["imageMode"]["imageTopic"] == IMAGE

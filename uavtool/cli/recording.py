@@ -79,18 +79,30 @@ def info(rec: Path, verify: bool, recover: bool, output: Path | None, as_json: b
     help="Write every camera frame as DIR/frame_NNNN.png with a .json sidecar of its pose "
     "(and DIR/target.png when the recording holds a target picture).",
 )
-def export(rec: Path, tlog: Path | None, frames_dir: Path | None) -> None:
-    """Export a recording's MAVLink frames to a telemetry log, or its camera frames to PNG.
+@click.option(
+    "--layout",
+    "layout",
+    type=_PATH,
+    default=None,
+    help="Write a Foxglove / Lichtblick layout for the recording (JSON): a 3D view of the "
+    "route, photo poses and model, the camera image, the target, attitude plots and the log.",
+)
+def export(rec: Path, tlog: Path | None, frames_dir: Path | None, layout: Path | None) -> None:
+    """Export a recording's MAVLink frames to a telemetry log, its camera frames to PNG, or
+    a Foxglove / Lichtblick layout that shows it.
 
-    The .tlog opens in MAVProxy, MAVExplorer and mavlogdump.py.
+    The .tlog opens in MAVProxy, MAVExplorer and mavlogdump.py. The layout is imported in
+    Foxglove or Lichtblick with Layouts → Import from file; it switches on the 3D topics
+    and aims the 3D view at the flown path.
 
     \b
     Example:
       uavtool export flight.mcap --tlog flight.tlog && mavlogdump.py flight.tlog
       uavtool export flight.mcap --frames frames/     # frame_0000.png + frame_0000.json …
+      uavtool export recordings/golden/paper.mcap --layout paper.layout.json
     """
-    if tlog is None and frames_dir is None:
-        raise click.UsageError("say what to export: --tlog FILE and/or --frames DIR")
+    if tlog is None and frames_dir is None and layout is None:
+        raise click.UsageError("say what to export: --tlog FILE, --frames DIR and/or --layout FILE")
     if tlog is not None:
         from uavtool.recording.tlog import export_tlog
 
@@ -104,6 +116,11 @@ def export(rec: Path, tlog: Path | None, frames_dir: Path | None) -> None:
         click.echo(
             f"wrote {frames.frames} frames ({frames.with_pose} with a pose){target} to {frames_dir}"
         )
+    if layout is not None:
+        from uavtool.recording.foxglove_layout import export_layout
+
+        panels = export_layout(rec, layout)["configById"]
+        click.echo(f"wrote a layout of {len(panels)} panels to {layout}")
 
 
 @click.command(name="import")
