@@ -29,22 +29,28 @@ def checkout() -> Path | None:
     if not named:
         return None
     path = Path(named)
-    return path if _git(path, "cat-file", "-e", f"HEAD:{_SRC}/package.json") is not None else None
+    return path if git(path, "cat-file", "-e", f"HEAD:{_SRC}/package.json") is not None else None
+
+
+def cache_folder(repo: Path, kind: str) -> Path:
+    """Where ``kind`` built from ``repo``'s HEAD is kept (``$UAVTOOL_NPM_CACHE``, default
+    ``~/.cache/uavtool/npm``)."""
+    head = (git(repo, "rev-parse", "--short", "HEAD") or b"").decode().strip()
+    default = Path.home() / ".cache" / "uavtool" / "npm"
+    return Path(os.environ.get("UAVTOOL_NPM_CACHE", default)) / f"{kind}-{head}"
 
 
 def build(repo: Path) -> Path:
     """The bundled harness for ``repo``'s HEAD (built on first use)."""
-    head = (_git(repo, "rev-parse", "--short", "HEAD") or b"").decode().strip()
-    default = Path.home() / ".cache" / "uavtool" / "npm"
-    folder = Path(os.environ.get("UAVTOOL_NPM_CACHE", default)) / f"lichtblick-{head}"
+    folder = cache_folder(repo, "lichtblick")
     bundle = folder / "lichtblick_parse.cjs"
     if bundle.is_file():
         return bundle
     folder.mkdir(parents=True, exist_ok=True)
-    tar = _git(repo, "archive", "HEAD", f"{_SRC}/src")
+    tar = git(repo, "archive", "HEAD", f"{_SRC}/src")
     subprocess.run(["tar", "-x", "-C", str(folder)], input=tar, check=True)
     shutil.copytree(folder / _SRC / "src", folder / "src", dirs_exist_ok=True)
-    manifest = json.loads(_git(repo, "show", f"HEAD:{_SRC}/package.json") or b"{}")
+    manifest = json.loads(git(repo, "show", f"HEAD:{_SRC}/package.json") or b"{}")
     specs = []
     for name, pinned in manifest["dependencies"].items():
         # "patch:protobufjs@7.2.5#../../patches/protobufjs.patch": the version, patched below
@@ -56,7 +62,7 @@ def build(repo: Path) -> Path:
          "esbuild@0.24"],
         check=True, capture_output=True, timeout=600,
     )  # fmt: skip
-    patch = _git(repo, "show", "HEAD:patches/protobufjs.patch")
+    patch = git(repo, "show", "HEAD:patches/protobufjs.patch")
     if patch:
         subprocess.run(
             ["patch", "-p1", "-d", str(folder / "node_modules" / "protobufjs")],
@@ -85,6 +91,7 @@ def parse(bundle: Path, recording: Path) -> dict[str, Any]:
     return result
 
 
-def _git(repo: Path, *args: str) -> bytes | None:
+def git(repo: Path, *args: str) -> bytes | None:
+    """``git -C repo args``'s output, or None if it fails."""
     done = subprocess.run(["git", "-C", str(repo), *args], capture_output=True, check=False)
     return done.stdout if done.returncode == 0 else None

@@ -1,0 +1,110 @@
+"""Every golden recording opened in Lichtblick's own web app, in headless Chromium, with the
+layout ``uavtool export --layout`` writes: no problem reported for any channel, no console
+error, and each panel shows the recording's data — the camera frame and the target picture as
+recorded, a plotted ``ATTITUDE.roll``, the last mission event in the log, and in 3D the route,
+the photo poses and the model.
+
+Lichtblick publishes its app on no registry, so this runs when ``UAVTOOL_LICHTBLICK`` names a
+checkout of its repository (the app is built from it on first use, `lichtblick_app`) and
+Chromium is installed; it is skipped otherwise (CI reaches package registries only)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from datetime import UTC, datetime
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from tests.viewer.lichtblick import checkout
+from tests.viewer.lichtblick_app import LichtblickApp, build_app, has_app
+from uavtool.recording.foxglove_layout import export_layout
+from uavtool.recording.reader import RecordingReader
+from uavtool.recording.topics import EVENTS, IMAGE, MODEL, TARGET
+from uavtool.recording.values import CompressedImage, LogEntry
+
+GOLDEN = sorted((Path(__file__).parents[2] / "recordings" / "golden").glob("*.mcap"))
+_ROUTE_RGB = (255, 140, 0)  # uavtool.runner.markers: the route's colour
+_SERIES_RGB = (78, 152, 226)  # the colour of a Lichtblick plot's first series
+
+
+@pytest.fixture(scope="module")
+def app() -> LichtblickApp:
+    repo = checkout()
+    if repo is None or not has_app(repo):
+        pytest.skip("UAVTOOL_LICHTBLICK does not name a checkout of Lichtblick's repository")
+    if not (shutil.which("node") and shutil.which("npm") and Path("/usr/bin/chromium").exists()):
+        pytest.skip("node, npm or Debian's chromium not installed")
+    return build_app(repo)
+
+
+def _recorded(recording: Path) -> tuple[str, bytes, bytes, str]:
+    """The time the app is seeked to (the last message's), the last camera frame, the target
+    picture and the last mission event's text."""
+    frames: dict[str, bytes] = {}
+    event = ""
+    with RecordingReader(recording) as reader:
+        end_ns = reader.time_range_ns[1]
+        for entry in reader.entries([IMAGE, TARGET, EVENTS]):
+            if isinstance(entry.value, CompressedImage):
+                frames[entry.topic] = entry.value.data
+            elif isinstance(entry.value, LogEntry):
+                event = entry.value.message
+    seconds, nanos = divmod(end_ns, 1_000_000_000)
+    time = f"{datetime.fromtimestamp(seconds, UTC):%Y-%m-%dT%H:%M:%S}.{nanos:09d}Z"
+    return time, frames[IMAGE], frames[TARGET], event
+
+
+def _rgb(png: Path | bytes) -> np.ndarray:
+    data = np.frombuffer(png.read_bytes() if isinstance(png, Path) else png, np.uint8)
+    return np.asarray(cv2.imdecode(data, cv2.IMREAD_COLOR)[:, :, ::-1], dtype=np.int32)
+
+
+def _share_in(panel: np.ndarray, picture: np.ndarray) -> float:
+    """The share of ``panel``'s pixels whose exact colour ``picture`` has (a rendered frame's
+    flat sky, ground and walls keep their colour when the panel scales the image)."""
+
+    def keys(a: np.ndarray) -> np.ndarray:
+        return np.asarray((a[..., 0] << 16) | (a[..., 1] << 8) | a[..., 2]).ravel()
+
+    return float(np.isin(keys(panel), np.unique(keys(picture))).mean())
+
+
+def _near(panel: np.ndarray, rgb: tuple[int, int, int]) -> int:
+    return int((np.abs(panel - np.array(rgb)).sum(axis=-1) < 60).sum())
+
+
+@pytest.mark.parametrize("recording", GOLDEN, ids=[p.stem for p in GOLDEN])
+def test_lichtblick_shows_every_channel_of_the_golden(
+    app: LichtblickApp, recording: Path, tmp_path: Path
+) -> None:
+    time, frame, target, event = _recorded(recording)
+    layout = tmp_path / "layout.json"
+    export_layout(recording, layout)
+    seen = app.open(recording, layout, time, tmp_path / "shown")
+    shown = tmp_path / "shown"
+
+    assert seen["errors"] == []
+    assert (seen["badge"], seen["problems"]) == ("", "No problems found")
+    assert _share_in(_rgb(shown / "Image_camera.png"), _rgb(frame)) > 0.4
+    assert _share_in(_rgb(shown / "Image_target.png"), _rgb(target)) > 0.4
+    legend = seen["panels"]["Plot!attitude"].split("\n")
+    roll = legend[legend.index("/mavlink/in/ATTITUDE.roll") + 1]
+    assert np.isfinite(float(roll))  # the legend's value at the playhead: a number
+    assert _near(_rgb(shown / "Plot_attitude.png"), _SERIES_RGB) > 200  # the roll line
+    assert event and event in seen["panels"]["RosOut!events"].replace("\xa0", " ")
+    three_d = _rgb(shown / "3D_uavtool.png")
+    assert _near(three_d, _ROUTE_RGB) > 300
+
+    with RecordingReader(recording) as reader:
+        has_model = MODEL in reader.topics()
+    if has_model:  # the model draws: hiding its topic changes the 3D view
+        hidden = json.loads(layout.read_text())
+        hidden["configById"]["3D!uavtool"]["topics"][MODEL]["visible"] = False
+        layout.write_text(json.dumps(hidden))
+        app.open(recording, layout, time, tmp_path / "no-model")
+        without = _rgb(tmp_path / "no-model" / "3D_uavtool.png")
+        assert (np.abs(three_d - without).sum(axis=-1) > 30).sum() > 500
