@@ -38,6 +38,33 @@ def test_ground_level_and_ill_conditioned_pairs() -> None:
     assert roof_height_m(area1_px=0.0, alt1_m=45.0, area2_px=900.0, alt2_m=60.0) is None
     # A roof that would be above the cameras: nonsense, not a height.
     assert roof_height_m(area1_px=400.0, alt1_m=45.0, area2_px=900.0, alt2_m=60.0) is None
+    # Two sizes from one altitude (a look taken as high as the overview, seeing the roof
+    # nearer the centre): they tell nothing of the height.
+    assert roof_height_m(area1_px=900.0, alt1_m=97.1, area2_px=1000.0, alt2_m=97.1) is None
+
+
+def test_two_photos_from_one_altitude_give_the_height_by_triangulation_alone() -> None:
+    """Two photos from one altitude tell the height by triangulation alone. (Hard scene 240
+    with home turned, `--random-home`, looked at a roof from as high as the overview; sizes
+    that differed by rounding gave a size estimate of no variance, and the weighting divided
+    by zero: the assertion on `roof_height_m` above.)"""
+    roof_m, alt_m, side_m = 12.0, 97.1, 10.0
+    poses = [CameraPose((0.0, 0.0, alt_m), 0.0, -90.0), CameraPose((20.0, 0.0, alt_m), 0.0, -90.0)]
+    seen = []
+    for pose in poses:  # a roof at (20, 0): 20 m east of the first camera, below the second
+        u = K.cx_px + K.fx_px * (20.0 - pose.pos_enu_m[0]) / (alt_m - roof_m)
+        side_px = K.fx_px * side_m / (alt_m - roof_m) * (1.0 if u == K.cx_px else 0.9)
+        seen.append(((u, K.cy_px), side_px**2))
+    h = roof_from_photos(
+        centroid1_px=seen[0][0],
+        area1_px=seen[0][1],
+        pose1=poses[0],
+        centroid2_px=seen[1][0],
+        area2_px=seen[1][1],
+        pose2=poses[1],
+        intrinsics=K,
+    )
+    assert h == pytest.approx(roof_m, abs=0.01)
 
 
 @pytest.mark.parametrize(("name", "tolerance_m"), [("red", 1.0), ("yellow", 2.5), ("blue", 2.5)])

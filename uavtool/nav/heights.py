@@ -32,12 +32,13 @@ def roof_height_m(
 ) -> float | None:
     """The roof height of one building seen whole in two nadir photos from ``alt1_m`` and
     ``alt2_m`` (its outline's area in each, square pixels). None when the two sizes differ by
-    less than ``min_ratio`` (the altitudes are too close for the sizes to tell) or the result
-    is not below both cameras."""
+    less than ``min_ratio`` (the altitudes are too close for the sizes to tell), when the
+    roof is not larger from the lower camera (from one altitude, sizes tell nothing) or the
+    result is not below both cameras."""
     if area1_px <= 0.0 or area2_px <= 0.0:
         return None
     s1, s2 = math.sqrt(area1_px), math.sqrt(area2_px)
-    if max(s1, s2) < min_ratio * min(s1, s2):
+    if max(s1, s2) < min_ratio * min(s1, s2) or (s2 - s1) * (alt1_m - alt2_m) <= 0.0:
         return None
     h = (s2 * alt2_m - s1 * alt1_m) / (s2 - s1)
     if not math.isfinite(h) or h >= min(alt1_m, alt2_m):
