@@ -4,7 +4,7 @@ scaled and turned copy, a near-identical shape, spread past one overview, home b
 building), each flown on the built-in vehicle by today's mission and by the baseline's.
 
     python benchmarks/bench_mission_generalization.py [--scenes 200] [--first-seed 1]
-        [--baseline 863e7d7] [--workers 2] [--variants new,baseline]
+        [--baseline 863e7d7] [--workers 2] [--variants new,baseline] [--random-home]
 
 The baseline is the code of commit ``BASELINE`` (the mission before roof heights, chosen
 altitudes, the mirror rule and collisions: fixed 45/20 m, a 5 m roof plane), extracted with
@@ -48,7 +48,7 @@ from uavtool.recording.topics import OBSERVATIONS, OUTPUTS
 from uavtool.runner.evaluate import closest_clearance, model_iou, nearest_building, tunnel_kept
 from uavtool.sitl import SitlConfig
 from uavtool.world import Scene, scene_to_dict
-from uavtool.world.hard import HardSceneInfo, generate_hard_scene_with_info
+from uavtool.world.hard import HardOptions, HardSceneInfo, generate_hard_scene_with_info
 
 ROOT = Path(__file__).resolve().parents[1]
 BASELINE = "863e7d7"
@@ -320,20 +320,27 @@ def main() -> None:
     parser.add_argument("--variants", default="new,baseline")
     parser.add_argument("--seeds", default=None, help="comma-separated seeds (instead of a range)")
     parser.add_argument("--keep", type=Path, default=None, help="keep recordings and scenes here")
+    parser.add_argument(
+        "--random-home",
+        action="store_true",
+        help="each scene's home anywhere within 60° of the equator, the vehicle facing any way",
+    )
     args = parser.parse_args()
+    options = HardOptions(random_home=args.random_home)
     variants = args.variants.split(",")
     seeds = (
         [int(x) for x in args.seeds.split(",")]
         if args.seeds
         else list(range(args.first_seed, args.first_seed + args.scenes))
     )
-    print(f"{len(seeds)} hard scenes, seeds {seeds[0]}..{seeds[-1]}; variants {variants}")
+    homes = "; random homes" if args.random_home else ""
+    print(f"{len(seeds)} hard scenes, seeds {seeds[0]}..{seeds[-1]}{homes}; variants {variants}")
     with tempfile.TemporaryDirectory() as tmp_text:
         tmp = args.keep or Path(tmp_text)
         tmp.mkdir(parents=True, exist_ok=True)
         scenes: dict[int, tuple[Scene, HardSceneInfo, Path]] = {}
         for seed in seeds:
-            scene, info = generate_hard_scene_with_info(seed=seed)
+            scene, info = generate_hard_scene_with_info(seed=seed, options=options)
             path = tmp / f"hard-{seed}.json"
             path.write_text(json.dumps(scene_to_dict(scene)))
             scenes[seed] = (scene, info, path)

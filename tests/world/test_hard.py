@@ -119,6 +119,25 @@ def test_description_is_the_command() -> None:
     assert hard_command(3, HardOptions(mirror_decoy_p=1.0)).endswith(
         "--seed 3 (HardOptions: mirror_decoy_p=1)"
     )
+    assert hard_command(3, HardOptions(random_home=True)).endswith("--seed 3 --random-home")
+
+
+def test_a_random_home_moves_and_turns_home_and_keeps_the_buildings() -> None:
+    """`--random-home`: the seed's own buildings around a home anywhere within 60° of the
+    equator, the vehicle facing any way; drawn last, so the rest of the scene is the same."""
+    homes = []
+    for seed in SEEDS:
+        plain, info = generate_hard_scene_with_info(seed=seed)
+        moved, moved_info = generate_hard_scene_with_info(
+            seed=seed, options=HardOptions(random_home=True)
+        )
+        assert moved.buildings == plain.buildings and moved_info == info
+        assert -60.0 <= moved.home.lat_deg <= 60.0 and -180.0 <= moved.home.lon_deg <= 180.0
+        assert 0.0 <= moved.home_heading_deg < 360.0
+        homes.append((moved.home.lat_deg, moved.home.lon_deg, moved.home_heading_deg))
+    assert len(set(homes)) == len(SEEDS)
+    headings = sorted(h for _, _, h in homes)
+    assert headings[0] < 90.0 and headings[-1] > 270.0  # spread all round
 
 
 # --------------------------------------------------------------------------- every scene
@@ -381,6 +400,7 @@ def test_cli_writes_a_hard_scene_that_loads_and_renders(tmp_path: Path) -> None:
     [
         (("--seed", "1", "--spread", "40"), "--spread needs --hard"),
         (("--seed", "1", "--overhang"), "--overhang needs --hard"),
+        (("--seed", "1", "--random-home"), "--random-home needs --hard"),
         (("--hard", "--seed", "1", "--buildings", "40"), "--buildings must be in 1..16"),
         (("--hard", "--seed", "1", "--spread", "1"), "spread must be"),
         (("--hard", "--seed", "1", "--margin", "-1"), "margin must be"),

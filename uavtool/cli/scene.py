@@ -228,6 +228,12 @@ def show(scene_ref: str, size: str, output: Path) -> None:
 )
 @click.option("--overhang", is_flag=True, help="With --hard: home under an arch 5-7 m up.")
 @click.option(
+    "--random-home",
+    is_flag=True,
+    help="With --hard: home anywhere within 60° of the equator, the vehicle facing any way "
+    "(the buildings around home are the seed's own).",
+)
+@click.option(
     "-o",
     "--output",
     required=True,
@@ -241,6 +247,7 @@ def random_scene(
     hard: bool,
     spread: float | None,
     overhang: bool,
+    random_home: bool,
     output: Path,
 ) -> None:
     """Generate a random scene file from a seed.
@@ -261,11 +268,15 @@ def random_scene(
     if suffix not in (".yaml", ".yml", ".json"):
         raise InputError(f"{output}: output must end in .yaml, .yml or .json")
     if hard:
-        s, info = _hard_scene(seed, buildings, margin, spread, overhang)
+        s, info = _hard_scene(seed, buildings, margin, spread, overhang, random_home)
     else:
         from uavtool.world.generator import generate_scene
 
-        for flag, given in (("--spread", spread is not None), ("--overhang", overhang)):
+        for flag, given in (
+            ("--spread", spread is not None),
+            ("--overhang", overhang),
+            ("--random-home", random_home),
+        ):
             if given:
                 raise InputError(f"{flag} needs --hard")
         s = generate_scene(
@@ -281,7 +292,12 @@ def random_scene(
 
 
 def _hard_scene(
-    seed: int, buildings: int | None, margin: float, spread: float | None, overhang: bool
+    seed: int,
+    buildings: int | None,
+    margin: float,
+    spread: float | None,
+    overhang: bool,
+    random_home: bool,
 ) -> tuple[Scene, HardSceneInfo]:
     from uavtool.world.hard import MAX_HARD_BUILDINGS, HardOptions, generate_hard_scene_with_info
 
@@ -297,5 +313,6 @@ def _hard_scene(
         margin_m=margin,
         spread_m=default.spread_m if spread is None else spread,
         home_overhang_p=1.0 if overhang else default.home_overhang_p,
+        random_home=random_home,
     )
     return generate_hard_scene_with_info(seed=seed, options=options)

@@ -76,6 +76,8 @@ class HardOptions:
     near_decoy_p: float = 0.5  # the target's outline with one vertex moved
     home_beside_p: float = 0.3  # one building's footprint 1–3 m from home
     home_overhang_p: float = 0.0  # an arch over home; wins over home_beside_p
+    random_home: bool = False  # home anywhere within ±60° latitude, the vehicle turned any
+    # way (drawn after everything else: the buildings around home are the seed's own)
 
     def __post_init__(self) -> None:
         if not 1 <= self.min_buildings <= self.max_buildings <= MAX_HARD_BUILDINGS:
@@ -228,10 +230,15 @@ def generate_hard_scene_with_info(
         beside_home=None if beside_index is None else name_of[beside_index],
         over_home=named("over_home"),
     )
+    home, heading_deg = HOME, 0.0
+    if o.random_home:
+        lat, lon = uniform(rng, -60.0, 60.0), uniform(rng, -180.0, 180.0)
+        home = GeoPoint(round(lat, 7), round(lon, 7), HOME.alt_amsl_m)
+        heading_deg = round(uniform(rng, 0.0, 360.0), 1) % 360.0
     scene = Scene(
         name=f"hard-{seed}",
-        home=HOME,
-        home_heading_deg=0.0,
+        home=home,
+        home_heading_deg=heading_deg,
         buildings=buildings,
         target=info.target,
         description=f"{hard_command(seed, o)}: {info.summary()}",
@@ -370,6 +377,8 @@ def hard_command(seed: int, options: HardOptions = HardOptions()) -> str:
             words.append(f"{flags[f.name]} {value:g}")
         elif f.name == "home_overhang_p" and value == 1.0:
             words.append("--overhang")
+        elif f.name == "random_home":
+            words.append("--random-home")
         else:
             rest.append(f"{f.name}={value:g}")
     line = " ".join(words)
