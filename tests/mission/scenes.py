@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import Any
 
 from uavtool.mission import MissionParams, Params
@@ -49,6 +50,26 @@ def walled(sides: tuple[str, ...]) -> Scene:
     return scene_from_dict(data, source="walled")
 
 
+def rotated(angle_deg: float, name: str = "paper") -> Scene:
+    """A built-in scene with every building turned ``angle_deg`` anticlockwise about home:
+    from a vehicle facing north, its photos show what a vehicle facing ``angle_deg`` (east
+    of north) would see of the scene as it is. (The overviews face the nearest of north,
+    east, south and west, and the looks keep that heading, so turning the vehicle turns
+    the photos by multiples of 90° only.)"""
+    data = rotate_buildings(scene_to_dict(load_scene(name)), angle_deg)
+    data.update(name=f"{name}-rotated-{angle_deg:g}")
+    return scene_from_dict(data, source="rotated")
+
+
+def rotate_buildings(data: dict[str, Any], angle_deg: float) -> dict[str, Any]:
+    """Scene ``data`` with every footprint turned ``angle_deg`` anticlockwise about home."""
+    c, s = math.cos(math.radians(angle_deg)), math.sin(math.radians(angle_deg))
+    for building in data["buildings"]:
+        for block in building["blocks"]:
+            block["footprint"] = [[x * c - y * s, x * s + y * c] for x, y in block["footprint"]]
+    return data
+
+
 def cross_target() -> Scene:
     """Paper with the red building replaced by a red cross: its picture matches nothing."""
     data = _paper()
@@ -69,8 +90,9 @@ def out_of_view() -> Scene:
 
 
 def turned(heading_deg: float, name: str = "paper") -> Scene:
-    """A built-in scene whose vehicle starts facing ``heading_deg`` (it keeps that heading
-    over the points of interest, so their photos see the roofs rotated)."""
+    """A built-in scene whose vehicle starts facing ``heading_deg`` (the overviews and looks
+    face the nearest of north, east, south and west: their photos see the roofs turned by
+    that multiple of 90°)."""
     data = scene_to_dict(load_scene(name))
     data["origin"]["heading_deg"] = heading_deg
     data.update(name=f"{name}-heading-{heading_deg:g}")

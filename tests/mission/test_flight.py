@@ -29,8 +29,8 @@ from uavtool.mission.search import look_altitude_m
 from uavtool.mission.survey import search_altitude_m
 from uavtool.nav import Viewpoint, ViewpointFailure
 from uavtool.runner.evaluate import model_iou
-from uavtool.world import Scene, building_footprint, load_scene, scene_from_dict, scene_to_dict
-from uavtool.world.hard import generate_hard_scene_with_info
+from uavtool.world import Scene, building_footprint, load_scene
+from uavtool.world.hard import HardOptions, generate_hard_scene_with_info
 
 Point = tuple[float, float]
 
@@ -253,14 +253,12 @@ def test_blocked_viewpoint_is_reported_and_the_flight_completes(
 
 
 def test_a_building_cut_by_the_overview_border_is_visited_however_little_shows() -> None:
-    """Hard scene 85 with the vehicle facing 290.5°: of the target, an arched L 40 m out,
-    the higher overview shows a sliver cut by its border (92 px, less than the smallest
-    building the overview keeps whole). What shows of a building reaching out of the frame
-    says nothing of its size: it is a point of interest, visited, and matched."""
-    scene, info = generate_hard_scene_with_info(seed=85)
-    data = scene_to_dict(scene)
-    data["origin"]["heading_deg"] = 290.5
-    flown = fly(scene_from_dict(data, source="test"))
+    """Hard scene 10 spread over ±45 m, past the ±40 m search square: of the target, the
+    higher overview shows a sliver cut by its border (60 px, less than the smallest building
+    the overview keeps whole). What shows of a building reaching out of the frame says
+    nothing of its size: it is a point of interest, visited, and matched."""
+    scene, info = generate_hard_scene_with_info(seed=10, options=HardOptions(spread_m=45.0))
+    flown = fly(scene)
     flight = flown.flight
     (plan,) = flight.of_type(Plan)
     shapes = {s.frame_index: s.shapes for s in flight.of_type(Shapes)}

@@ -57,10 +57,10 @@ def test_noisy_roofs_of_one_building_are_one_shape(paper: Scene, seed: int) -> N
 
 
 def test_a_cut_roof_is_looked_at_again_from_higher_over_its_roof() -> None:
-    """Facing north-east, looking from where the roof just fills the photo's height, the red
+    """Paper turned 45°, looking from where the roof just fills the photo's height, the red
     roof is cut by the border: the mission climbs 10 m over the roof's centre, looks again
     and matches; with one look it misses."""
-    scene = scenes.turned(45.0)
+    scene = scenes.rotated(45.0)
     close = scenes.with_mission(look_fill=1.0)
     flown = fly(scene, close)
     flight = flown.flight
@@ -107,7 +107,7 @@ def test_looks_climb_until_a_match_and_replay(turned_flight: Flown) -> None:
 
 def test_looks_never_climb_above_the_second_overview() -> None:
     params = scenes.with_mission(look_fill=1.0, recheck_climb_m=200.0)
-    flown = fly(scenes.turned(45.0), params)
+    flown = fly(scenes.rotated(45.0), params)
     k = flown.outcome.matched_poi
     heights = [p.pose.pos_enu_m[2] for p, _ in _looks(flown.flight, k)]
     overviews = [o for o in flown.flight.observations if isinstance(o, Photo)][:2]

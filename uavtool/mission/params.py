@@ -52,7 +52,9 @@ class MissionParams:
     which gives every building's roof height …"""
     search_radius_m: float = 40.0
     """… and high enough to see the whole search area: a square this many metres from home
-    east, west, north and south (straight down, the photo's shorter side spans it)."""
+    east, west, north and south (both overviews are taken straight down, facing whichever of
+    north, east, south and west is nearest the vehicle's heading; the photo's shorter side
+    spans the square)."""
     assumed_roof_m: float = 25.0
     """Roof height assumed for a building whose height the overview photos could not measure
     (cut by the border, or seen in one photo only): the tallest expected. A look measures it."""

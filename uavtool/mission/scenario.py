@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 from uavtool.mission.modelling import photograph_and_model
 from uavtool.mission.outputs import Level, Plan, Status
 from uavtool.mission.search import search
-from uavtool.mission.survey import survey
+from uavtool.mission.survey import overview_heading_deg, survey
 from uavtool.nav import route_length_m, visit_order
 
 if TYPE_CHECKING:
@@ -31,7 +31,8 @@ def fly(m: Mission) -> Wait[None]:
     else:
         yield from m.arm_and_take_off(p.overview_alt_m)
     here = m.last.pos_enu_m if m.last else (0.0, 0.0, 0.0)
-    yield from m.move((here[0], here[1], p.overview_alt_m), None, "overview position")
+    heading = overview_heading_deg(m.last.heading_deg if m.last else 0.0)
+    yield from m.move((here[0], here[1], p.overview_alt_m), heading, "overview position")
 
     seen = yield from survey(m)
     pois = seen.pois

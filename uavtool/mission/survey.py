@@ -50,7 +50,8 @@ def survey(m: Mission) -> Wait[Survey]:
     low_shapes = photo_shapes(m, low)
     x, y, _ = low.pose.pos_enu_m
     high_alt = max(p.overview_alt_m + p.overview_climb_m, search_altitude_m(m, low.intrinsics))
-    yield from m.move((x, y, high_alt), None, "second overview position")
+    heading = overview_heading_deg(m.last.heading_deg if m.last else 0.0)
+    yield from m.move((x, y, high_alt), heading, "second overview position")
     high = yield from m.photo("overview-2", -90.0)
     shapes = photo_shapes(m, high)
     found = [_measure(m, shape, high, low, low_shapes) for shape in shapes]
@@ -86,10 +87,23 @@ def survey(m: Mission) -> Wait[Survey]:
     return Survey(high, shapes, tuple(roofs), tuple(measured), footprints, tuple(pois))
 
 
+def overview_heading_deg(heading_deg: float) -> float:
+    """The heading the overviews are taken facing: the one of north, east, south and west
+    nearest ``heading_deg``. The photo's sides then run along the search square's (east,
+    west, north and south of home), whichever way the vehicle faced at take-off; turned
+    45°, a photo would leave the square's corners out."""
+    return (round(heading_deg / 90.0) % 4) * 90.0
+
+
 def search_altitude_m(m: Mission, intrinsics: Intrinsics) -> float:
-    """The altitude from which a nadir photo over home sees the whole search area."""
+    """The altitude from which a nadir photo over home, facing `overview_heading_deg`, sees
+    the whole search area up to the tallest roof expected (``mission.assumed_roof_m``): a
+    roof at the square's edge is that much nearer the camera than the ground, so it leaves
+    the frame first. (Turned by the heading tolerance, a few degrees, the photo cuts a
+    sliver off the square's corners: a building there is still seen, cut by the border.)"""
+    p = m.params.mission
     half_fov = math.radians(min(intrinsics.hfov_deg, intrinsics.vfov_deg)) / 2.0
-    return m.params.mission.search_radius_m / math.tan(half_fov)
+    return p.search_radius_m / math.tan(half_fov) + p.assumed_roof_m
 
 
 def _measure(
