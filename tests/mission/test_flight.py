@@ -26,7 +26,7 @@ from uavtool.mission import (
     Viewpoints,
 )
 from uavtool.mission.search import look_altitude_m
-from uavtool.mission.survey import search_altitude_m
+from uavtool.mission.survey import overview_ceiling_m
 from uavtool.nav import Viewpoint, ViewpointFailure
 from uavtool.runner.evaluate import model_iou
 from uavtool.world import Scene, building_footprint, load_scene
@@ -124,10 +124,7 @@ def test_photos_are_taken_where_planned(paper_flight: Flown) -> None:
     (plan,) = flight.of_type(Plan)
     (views,) = flight.of_type(Viewpoints)
     assert isinstance(views.front, Viewpoint) and isinstance(views.right, Viewpoint)
-    high = max(
-        p.overview_alt_m + p.overview_climb_m,
-        search_altitude_m(paper_flight.mission, photos["overview"].intrinsics),
-    )
+    high = overview_ceiling_m(p, photos["overview"].intrinsics)
     expected: dict[str, tuple[tuple[float, float, float], float | None, float]] = {
         "overview": ((0.0, 0.0, p.overview_alt_m), None, -90.0),
         "overview-2": ((0.0, 0.0, high), None, -90.0),

@@ -38,6 +38,27 @@ def test_no_mount_is_exit_2_with_one_line() -> None:
     assert len(result.output.strip().splitlines()) == 1
 
 
+def test_an_altitude_fence_below_the_second_overview_stops_on_the_ground(tmp_path: Path) -> None:
+    """ArduCopter's default FENCE_ALT_MAX (100 m), switched on, is below the 117.4 m the second
+    overview climbs to (the search square at the tallest expected roof): the run stops before
+    arming with the fix; a fence above it, or a lower search square, flies."""
+    path = tmp_path / "f.mcap"
+    fence = (("FENCE_ENABLE", 1.0),)
+    with pytest.raises(PreflightError) as exc:
+        fly(FlyConfig(record=path, vehicle_params=fence))
+    text = str(exc.value)
+    assert "FENCE_ALT_MAX=100 m" in text and "117.4 m" in text and "set FENCE_ALT_MAX=123" in text
+    assert not path.exists()
+    high = fly(FlyConfig(no_record=True, vehicle_params=(*fence, ("FENCE_ALT_MAX", 123.0))))
+    assert high.outcome.status == Status.COMPLETED
+    low = with_overrides(
+        Params(), {"mission.search_radius_m": "30", "mission.assumed_roof_m": "20"}
+    )
+    assert fly(FlyConfig(no_record=True, params=low, vehicle_params=fence)).outcome.status == (
+        Status.COMPLETED
+    )
+
+
 def test_no_gimbal_flies_the_search_and_ends_partial(tmp_path: Path) -> None:
     summary = fly(FlyConfig(record=tmp_path / "f.mcap", no_gimbal=True))
     o = summary.outcome

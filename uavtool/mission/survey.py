@@ -16,6 +16,7 @@ from uavtool.camera import Intrinsics
 from uavtool.mission.analysis import cut_edges, roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
+from uavtool.mission.params import MissionParams
 from uavtool.mission.search import photo_shapes
 from uavtool.nav import NavError, ground_point, ground_polygon, min_area_rect
 from uavtool.nav.geometry import convex_hull, point_polygon_distance
@@ -49,7 +50,7 @@ def survey(m: Mission) -> Wait[Survey]:
     low = yield from m.photo("overview", -90.0)
     low_shapes = photo_shapes(m, low)
     x, y, _ = low.pose.pos_enu_m
-    high_alt = max(p.overview_alt_m + p.overview_climb_m, search_altitude_m(m, low.intrinsics))
+    high_alt = overview_ceiling_m(p, low.intrinsics)
     heading = overview_heading_deg(m.last.heading_deg if m.last else 0.0)
     yield from m.move((x, y, high_alt), heading, "second overview position")
     high = yield from m.photo("overview-2", -90.0)
@@ -95,13 +96,17 @@ def overview_heading_deg(heading_deg: float) -> float:
     return (round(heading_deg / 90.0) % 4) * 90.0
 
 
-def search_altitude_m(m: Mission, intrinsics: Intrinsics) -> float:
+def overview_ceiling_m(p: MissionParams, intrinsics: Intrinsics) -> float:
+    """The second overview's altitude above home (looks never climb above it)."""
+    return max(p.overview_alt_m + p.overview_climb_m, search_altitude_m(p, intrinsics))
+
+
+def search_altitude_m(p: MissionParams, intrinsics: Intrinsics) -> float:
     """The altitude from which a nadir photo over home, facing `overview_heading_deg`, sees
     the whole search area up to the tallest roof expected (``mission.assumed_roof_m``): a
     roof at the square's edge is that much nearer the camera than the ground, so it leaves
     the frame first. (Turned by the heading tolerance, a few degrees, the photo cuts a
     sliver off the square's corners: a building there is still seen, cut by the border.)"""
-    p = m.params.mission
     half_fov = math.radians(min(intrinsics.hfov_deg, intrinsics.vfov_deg)) / 2.0
     return p.search_radius_m / math.tan(half_fov) + p.assumed_roof_m
 

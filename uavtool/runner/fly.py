@@ -30,6 +30,7 @@ from uavtool.mavlink.dialect import COPTER_MODES
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mission import Level, Mission, Outcome, Params
 from uavtool.mission.params import to_dict
+from uavtool.mission.survey import overview_ceiling_m
 from uavtool.recording import RecordingError, RecordingWriter
 from uavtool.recording.files import atomic_output
 from uavtool.runner.camera import open_camera
@@ -37,7 +38,7 @@ from uavtool.runner.evaluate import Evaluation, closest_clearance, evaluate
 from uavtool.runner.live import LiveView
 from uavtool.runner.params import set_vehicle_params
 from uavtool.runner.placement import SCENE_ORIGINS, place_scene
-from uavtool.runner.preflight import check_camera, check_gimbal, check_home
+from uavtool.runner.preflight import check_camera, check_fence, check_gimbal, check_home
 from uavtool.runner.record import ClockNs, MissionRecorder
 from uavtool.runner.runner import Progress, Runner, RunnerConfig
 from uavtool.world import Scene, load_scene, render, scene_to_dict
@@ -227,6 +228,7 @@ def fly(
             check_camera(camera)
         if not config.no_gimbal:
             check_gimbal(link)
+        check_fence(link, overview_ceiling_m(config.params.mission, camera.intrinsics))
         origin = scene.home
         if config.camera == "sim" and config.connect is not None:
             origin = place_scene(scene, home, config.scene_origin, say)

@@ -2,7 +2,9 @@
 
 The vehicle is asked what it has (GIMBAL_MANAGER_INFORMATION, and ArduPilot's ``MNT1_TYPE``)
 so that a missing mount stops the run before take-off with the fix, not at 45 m with a
-refused DO_MOUNT_CONTROL. Every wait is on the link's clock (vehicle time in lockstep).
+refused DO_MOUNT_CONTROL; and ArduPilot's altitude fence, so that a fence below the second
+overview stops it too, not at the fence with an RTL. Every wait is on the link's clock
+(vehicle time in lockstep).
 """
 
 from __future__ import annotations
@@ -75,25 +77,57 @@ def check_gimbal(
     return info
 
 
-def _mount_fix(link: VehicleLink, on_wait: Callable[[], None] | None) -> str:
-    """What to do, from ArduPilot's MNT1_TYPE when it answers."""
+def check_fence(
+    link: VehicleLink, climb_to_m: float, *, on_wait: Callable[[], None] | None = None
+) -> None:
+    """PreflightError when ArduPilot's altitude fence is on and below ``climb_to_m`` (above
+    home), which the mission flies to: the vehicle would refuse the climb or breach the fence
+    and return home mid-mission. Other autopilots, or parameters that do not answer, pass."""
+    if not _ardupilot(link):
+        return
+    names = ("FENCE_ENABLE", "FENCE_TYPE", "FENCE_ALT_MAX")
+    values = [_param(link, name, on_wait) for name in names]
+    if None in values:
+        return
+    enabled, types, alt_max = (float(v) for v in values if v is not None)
+    if enabled and int(types) & 1 and alt_max < climb_to_m:  # AC_FENCE_TYPE_ALT_MAX
+        raise PreflightError(
+            f"the altitude fence is on at FENCE_ALT_MAX={alt_max:g} m but the mission climbs "
+            f"to {climb_to_m:.1f} m above home for its second overview: set FENCE_ALT_MAX="
+            f"{math.ceil(climb_to_m) + 5}, or lower mission.search_radius_m or "
+            "mission.assumed_roof_m"
+        )
+
+
+def _ardupilot(link: VehicleLink) -> bool:
     heartbeat = link.state.heartbeat
-    if heartbeat is None or heartbeat.autopilot != M.MAV_AUTOPILOT_ARDUPILOTMEGA:
-        return "configure a gimbal on the autopilot (gimbal protocol v2)"
+    return heartbeat is not None and heartbeat.autopilot == M.MAV_AUTOPILOT_ARDUPILOTMEGA
+
+
+def _param(link: VehicleLink, name: str, on_wait: Callable[[], None] | None) -> float | None:
+    """The vehicle's parameter ``name``, or None if it does not answer."""
     value = _ask(
         link,
         lambda: link.send(
             M.MAVLink_param_request_read_message(
-                link.target_system, link.target_component, b"MNT1_TYPE", -1
+                link.target_system, link.target_component, name.encode(), -1
             )
         ),
         "PARAM_VALUE",
         on_wait,
-        lambda msg: _param_name(msg) == "MNT1_TYPE",
+        lambda msg: _param_name(msg) == name,
     )
-    if value is not None and value.param_value != 0:
+    return None if value is None else float(value.param_value)
+
+
+def _mount_fix(link: VehicleLink, on_wait: Callable[[], None] | None) -> str:
+    """What to do, from ArduPilot's MNT1_TYPE when it answers."""
+    if not _ardupilot(link):
+        return "configure a gimbal on the autopilot (gimbal protocol v2)"
+    value = _param(link, "MNT1_TYPE", on_wait)
+    if value is not None and value != 0:
         return (
-            f"MNT1_TYPE is {value.param_value:g} but no mount started: reboot the autopilot "
+            f"MNT1_TYPE is {value:g} but no mount started: reboot the autopilot "
             "(ArduPilot reads MNT1_TYPE only at boot)"
         )
     return f"MNT1_TYPE=0; {SERVO_MOUNT_FIX}"
