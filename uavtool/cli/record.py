@@ -36,8 +36,9 @@ import click
     default="none",
     show_default=True,
     metavar="none|sim|opencv:N|URL",
-    help="sim renders --scene at the vehicle's reported pose; opencv:N or a stream URL (or a "
-    "video file) reads a real camera.",
+    help="sim renders --scene at the vehicle's reported pose; opencv:N or a stream URL reads a "
+    "live camera (its newest frame, read on a thread of its own); file://VIDEO reads a video "
+    "file a frame at a time.",
 )
 @click.option("--scene", default="paper", show_default=True, help="The scene --camera sim renders.")
 @click.option(

@@ -9,10 +9,11 @@ with the gimbal attitude last reported) nearest its capture in vehicle time.
   at most one telemetry period plus the link's latency (≤ 0.1 s at 10 Hz, i.e. ≤ 1 m at
   10 m/s).
 * A real camera's capture time is estimated in vehicle time from the newest sample and the
-  wall time elapsed since it arrived; the frame waits (≤ ``POSE_WAIT_S``) for the next sample
-  so the nearer of the two around it is chosen. ``pose_dt_ms`` records the gap; it is at most
-  half a telemetry period (50 ms at 10 Hz) plus the link's latency jitter, so the position
-  error is ≤ speed × |pose_dt|.
+  wall time elapsed between its arrival and the frame's (a live camera's frames arrive on a
+  thread of their own: `uavtool.runner.camera.LatestFrame`); the frame waits (at most
+  ``POSE_WAIT_S``) for the next sample so the nearer of the two around it is chosen.
+  ``pose_dt_ms`` records the gap; it is at most half a telemetry period (50 ms at 10 Hz)
+  plus the link's latency jitter, so the position error is ≤ speed × |pose_dt|.
 """
 
 from __future__ import annotations
@@ -106,6 +107,7 @@ class FrameTaker:
         self.events: list[Event] = []
         self._next_frame_s: float | None = None
         self._next_photo_s: float | None = None
+        self._last_taken_s: float | None = None
         # (index, png, intrinsics, capture vehicle ms, photo, trigger, taken at link time)
         self._pending: deque[tuple[int, bytes, Intrinsics, int, int, str, float]] = deque()
 
@@ -146,15 +148,21 @@ class FrameTaker:
             self.events.append(Event(LogLevel.ERROR, f"{exc}; no more frames", "camera"))
             self.camera = None
             return
+        # A live camera's frame arrived on its own thread, maybe before this tick.
+        taken_s = self.camera.captured_at_s
+        if taken_s is not None and taken_s == self._last_taken_s and not trigger:
+            return  # the same frame as last time: the camera is slower than the frame rate
+        self._last_taken_s = taken_s
+        taken_s = now_s if taken_s is None else taken_s
         photo = -1
         if trigger:
             photo = self.photos
             self.photos += 1
             self.events.append(Event(LogLevel.INFO, f"photo {photo} ({trigger})", "camera"))
-        taken_ms = t.time_boot_ms if self.renders else track.vehicle_ms(now_s)
+        taken_ms = t.time_boot_ms if self.renders else track.vehicle_ms(taken_s)
         png = png_encode(image)
         self._pending.append(
-            (self.frames, png, self.camera.intrinsics, taken_ms, photo, trigger, now_s)
+            (self.frames, png, self.camera.intrinsics, taken_ms, photo, trigger, taken_s)
         )
         self.frames += 1
 

@@ -1,9 +1,16 @@
 """Camera sources behind one small protocol: the simulated camera renders the scene at the
 pose the vehicle reports; an OpenCV camera grabs a real frame (the pose is then only
-recorded). ``--camera sim | opencv:N | URL`` picks one from :data:`SOURCES`."""
+recorded). ``--camera sim | opencv:N | URL`` picks one from :data:`SOURCES`.
+
+A live camera (a device, a network stream) is read by `LatestFrame` on a thread of its own:
+it buffers frames, so a frame read on demand can be seconds old, and a read that stalls
+would hold up the MAVLink loop. A video file is read a frame per request, as a file has no
+"now"."""
 
 from __future__ import annotations
 
+import threading
+import time
 from collections.abc import Callable
 from typing import Any, Protocol
 
@@ -26,6 +33,9 @@ class CameraSource(Protocol):
 
     name: str
     intrinsics: Intrinsics
+    captured_at_s: float | None
+    """When the frame the last `capture` returned was taken (``time.monotonic``), or None:
+    during that call."""
 
     def capture(self, pose: CameraPose) -> U8Array:
         """A (H, W, 3) uint8 RGB frame taken now (simulated ones at ``pose``)."""
@@ -39,6 +49,7 @@ class SimCamera:
 
     def __init__(self, scene: Scene, intrinsics: Intrinsics, *, noise_seed: int | None) -> None:
         self.name = "sim"
+        self.captured_at_s: float | None = None
         self.scene = scene
         self.intrinsics = intrinsics
         self.noise_seed = noise_seed
@@ -61,6 +72,7 @@ class OpenCvCamera:
         import cv2  # noqa: PLC0415
 
         self.name = f"opencv:{source}"
+        self.captured_at_s: float | None = None
         self._cap: Any = cv2.VideoCapture(source)
         ok, frame = self._cap.read() if self._cap.isOpened() else (False, None)
         if not ok or frame is None:
@@ -82,6 +94,75 @@ class OpenCvCamera:
         self._cap.release()
 
 
+FIRST_FRAME_S = 5.0
+"""How long `LatestFrame` waits for a live camera's first frame."""
+STALE_S = 2.0
+"""A live camera whose newest frame is older than this has stopped giving frames."""
+
+
+class LatestFrame:
+    """Reads ``camera`` on a thread of its own, as fast as it gives frames, and hands out the
+    newest one with the time it arrived (``captured_at_s``). `capture` raises CameraError
+    when the camera failed, gave no frame in :data:`FIRST_FRAME_S`, or none for
+    :data:`STALE_S`."""
+
+    def __init__(self, camera: CameraSource, *, clock: Callable[[], float] = time.monotonic):
+        self.name = camera.name
+        self.intrinsics = camera.intrinsics
+        self.captured_at_s: float | None = None
+        self._camera = camera
+        self._clock = clock
+        self._changed = threading.Condition()
+        self._newest: tuple[U8Array, float] | None = None
+        self._error: CameraError | None = None
+        self._stop = False
+        self._thread = threading.Thread(target=self._read, name=f"camera {camera.name}")
+        self._thread.daemon = True  # a read that never returns must not keep the process up
+        self._thread.start()
+
+    def _read(self) -> None:
+        anywhere = CameraPose((0.0, 0.0, 0.0), 0.0, -90.0)  # a real camera ignores the pose
+        while not self._stop:
+            try:
+                frame = self._camera.capture(anywhere)
+            except CameraError as exc:
+                error: CameraError | None = exc
+            except Exception as exc:  # any failure of the camera's library ends the frames
+                error = CameraError(f"camera {self.name}: {exc}")
+            else:
+                error = None
+            with self._changed:
+                if error is not None:
+                    self._error = error
+                else:
+                    self._newest = (frame, self._clock())
+                self._changed.notify_all()
+            if error is not None:
+                return
+
+    def capture(self, pose: CameraPose) -> U8Array:
+        del pose
+        with self._changed:
+            self._changed.wait_for(
+                lambda: self._newest is not None or self._error is not None, FIRST_FRAME_S
+            )
+            if self._error is not None:
+                raise self._error
+            if self._newest is None:
+                raise CameraError(f"camera {self.name}: no frame in {FIRST_FRAME_S:g} s")
+            frame, at = self._newest
+        if self._clock() - at > STALE_S:
+            raise CameraError(f"camera {self.name}: no new frame for {STALE_S:g} s")
+        self.captured_at_s = at
+        return frame
+
+    def close(self) -> None:
+        self._stop = True
+        self._thread.join(timeout=STALE_S)
+        if not self._thread.is_alive():  # else it is stuck in a read: leave the camera to it
+            self._camera.close()
+
+
 Opener = Callable[[str, Scene, Intrinsics, int | None], CameraSource]
 
 
@@ -96,11 +177,16 @@ def _opencv(arg: str, _scene: Scene, intrinsics: Intrinsics, _seed: int | None) 
         raise CameraError(
             f"--camera opencv:{arg}: expected a device number, e.g. opencv:0"
         ) from None
-    return OpenCvCamera(source, hfov_deg=intrinsics.hfov_deg)
+    return LatestFrame(OpenCvCamera(source, hfov_deg=intrinsics.hfov_deg))
+
+
+_FILE_SCHEMES = ("file",)
 
 
 def _url(arg: str, _scene: Scene, intrinsics: Intrinsics, _seed: int | None) -> CameraSource:
-    return OpenCvCamera(arg, hfov_deg=intrinsics.hfov_deg)
+    camera = OpenCvCamera(arg, hfov_deg=intrinsics.hfov_deg)
+    live = arg.partition("://")[0].lower() not in _FILE_SCHEMES
+    return LatestFrame(camera) if live else camera
 
 
 SOURCES: dict[str, Opener] = {"sim": _sim, "opencv": _opencv}
