@@ -78,6 +78,16 @@ def test_bad_input_is_one_line_exit_2(
     assert message in lines[0]
 
 
+def test_an_output_that_cannot_be_created_is_named_as_asked(rec: Path, tmp_path: Path) -> None:
+    """The error names the file the user asked for, not its temporary ``NAME.PID.partial``."""
+    out = tmp_path / "missing" / "out.tlog"
+    result = CliRunner().invoke(cli, ["export", str(rec), "--tlog", str(out)])
+    assert result.exit_code == 2, result.output
+    assert result.output.strip().splitlines() == [
+        f"uavtool: error: {out}: cannot create: No such file or directory"
+    ]
+
+
 def test_recover_needs_an_output(rec: Path) -> None:
     result = CliRunner().invoke(cli, ["info", "--recover", str(rec)])
     assert result.exit_code == 2

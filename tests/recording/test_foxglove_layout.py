@@ -68,10 +68,16 @@ def test_export_writes_a_layout_for_a_recording_without_a_mission(tmp_path: Path
     assert "Image!target" not in layout["configById"]
 
 
-def test_export_never_writes_over_the_recording(tmp_path: Path) -> None:
+def test_export_never_writes_over_the_recording_nor_leaves_a_traceback(tmp_path: Path) -> None:
     rec = tmp_path / "rec.mcap"
     write_sample(rec, seconds=1.0)
     before = rec.read_bytes()
     result = CliRunner().invoke(cli, ["export", str(rec), "--layout", str(rec)])
     assert result.exit_code == 2, result.output
     assert rec.read_bytes() == before
+    nowhere = tmp_path / "no" / "such" / "folder" / "layout.json"
+    result = CliRunner().invoke(cli, ["export", str(rec), "--layout", str(nowhere)])
+    assert result.exit_code == 2, result.output
+    assert result.output.strip().splitlines() == [
+        f"uavtool: error: {nowhere}: cannot write: No such file or directory"
+    ]

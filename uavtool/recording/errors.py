@@ -6,6 +6,7 @@ Messages start with the file name and say what is wrong with it.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import BinaryIO
 
@@ -48,11 +49,13 @@ class TlogError(RecordingError):
 
 
 def create_file(path: str | Path) -> BinaryIO:
-    """Open ``path`` for writing; a `RecordingError` naming it if the OS refuses."""
+    """Open ``path`` for writing; a `RecordingError` naming it if the OS refuses (the file
+    the user asked for, when ``path`` is its temporary ``NAME.PID.partial``)."""
     try:
         return Path(path).open("wb")
     except OSError as exc:
-        raise RecordingError(path, f"cannot create: {exc.strerror}") from exc
+        asked = re.sub(r"\.\d+\.partial$", "", str(path))
+        raise RecordingError(asked, f"cannot create: {exc.strerror}") from exc
 
 
 def write_failed(path: str | Path, exc: OSError) -> RecordingError:

@@ -16,6 +16,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from uavtool.recording.errors import RecordingError
 from uavtool.recording.files import atomic_output
 from uavtool.recording.reader import RecordingReader
 from uavtool.recording.topics import (
@@ -76,7 +77,10 @@ def export_layout(rec: str | Path, out: str | Path) -> dict[str, Any]:
     """Write `layout_for` ``rec`` to ``out`` (whole, or not at all) and return it."""
     layout = layout_for(rec)
     with atomic_output(out, inputs=[rec]) as tmp:
-        tmp.write_text(json.dumps(layout, indent=2) + "\n")
+        try:
+            tmp.write_text(json.dumps(layout, indent=2) + "\n")
+        except OSError as exc:
+            raise RecordingError(out, f"cannot write: {exc.strerror or exc}") from None
     return layout
 
 
