@@ -59,6 +59,18 @@ def test_an_altitude_fence_below_the_second_overview_stops_on_the_ground(tmp_pat
     )
 
 
+def test_a_circle_fence_inside_the_search_square_stops_on_the_ground(tmp_path: Path) -> None:
+    """FENCE_RADIUS 50 m is inside the ±40 m search square (its corners 56.6 m out)."""
+    circle = (("FENCE_ENABLE", 1.0), ("FENCE_ALT_MAX", 150.0), ("FENCE_RADIUS", 50.0))
+    with pytest.raises(PreflightError) as exc:
+        fly(FlyConfig(record=tmp_path / "f.mcap", vehicle_params=circle))
+    assert "FENCE_RADIUS=50 m" in str(exc.value) and "56.6 m from home" in str(exc.value)
+    only_altitude = (*circle, ("FENCE_TYPE", 1.0))  # the circle is not in force
+    assert fly(FlyConfig(no_record=True, vehicle_params=only_altitude)).outcome.status == (
+        Status.COMPLETED
+    )
+
+
 def test_no_gimbal_flies_the_search_and_ends_partial(tmp_path: Path) -> None:
     summary = fly(FlyConfig(record=tmp_path / "f.mcap", no_gimbal=True))
     o = summary.outcome

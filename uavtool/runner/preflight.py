@@ -2,9 +2,9 @@
 
 The vehicle is asked what it has (GIMBAL_MANAGER_INFORMATION, and ArduPilot's ``MNT1_TYPE``)
 so that a missing mount stops the run before take-off with the fix, not at 45 m with a
-refused DO_MOUNT_CONTROL; and ArduPilot's altitude fence, so that a fence below the second
-overview stops it too, not at the fence with an RTL. Every wait is on the link's clock
-(vehicle time in lockstep).
+refused DO_MOUNT_CONTROL; and ArduPilot's fence, so that a fence below the second overview
+or inside the search square stops it too, not at the fence with an RTL. Every wait is on
+the link's clock (vehicle time in lockstep).
 """
 
 from __future__ import annotations
@@ -78,24 +78,39 @@ def check_gimbal(
 
 
 def check_fence(
-    link: VehicleLink, climb_to_m: float, *, on_wait: Callable[[], None] | None = None
+    link: VehicleLink,
+    climb_to_m: float,
+    reach_m: float,
+    *,
+    on_wait: Callable[[], None] | None = None,
 ) -> None:
-    """PreflightError when ArduPilot's altitude fence is on and below ``climb_to_m`` (above
-    home), which the mission flies to: the vehicle would refuse the climb or breach the fence
-    and return home mid-mission. Other autopilots, or parameters that do not answer, pass."""
+    """PreflightError when ArduPilot's fence is on and keeps the vehicle from where the
+    mission must fly: an altitude fence below ``climb_to_m`` (the second overview, above
+    home), or a circle fence closer than ``reach_m`` (the search square's corners). The
+    vehicle would refuse the move or breach the fence and return home mid-mission. Other
+    autopilots, or parameters that do not answer, pass."""
     if not _ardupilot(link):
         return
-    names = ("FENCE_ENABLE", "FENCE_TYPE", "FENCE_ALT_MAX")
+    names = ("FENCE_ENABLE", "FENCE_TYPE", "FENCE_ALT_MAX", "FENCE_RADIUS")
     values = [_param(link, name, on_wait) for name in names]
     if None in values:
         return
-    enabled, types, alt_max = (float(v) for v in values if v is not None)
-    if enabled and int(types) & 1 and alt_max < climb_to_m:  # AC_FENCE_TYPE_ALT_MAX
+    enabled, types, alt_max, radius = (float(v) for v in values if v is not None)
+    if not enabled:
+        return
+    if int(types) & 1 and alt_max < climb_to_m:  # AC_FENCE_TYPE_ALT_MAX
         raise PreflightError(
             f"the altitude fence is on at FENCE_ALT_MAX={alt_max:g} m but the mission climbs "
             f"to {climb_to_m:.1f} m above home for its second overview: set FENCE_ALT_MAX="
             f"{math.ceil(climb_to_m) + 5}, or lower mission.search_radius_m or "
             "mission.assumed_roof_m"
+        )
+    if int(types) & 2 and radius < reach_m:  # AC_FENCE_TYPE_CIRCLE
+        raise PreflightError(
+            f"the circle fence is on at FENCE_RADIUS={radius:g} m but the search square's "
+            f"corners are {reach_m:.1f} m from home: set FENCE_RADIUS above "
+            f"{math.ceil(reach_m)} (more for side photos of a building at the edge), or lower "
+            "mission.search_radius_m"
         )
 
 
