@@ -1,6 +1,8 @@
 """The flight as 3D markers (``/mission/scene``): the route flown, each photo's pose, the
 points of interest and the viewpoints, which Foxglove's and Lichtblick's 3D panels draw
-without setup. Each update replaces its entity, so the last message holds the whole route."""
+without setup. Every update carries every entity known so far (route, photos, and the points
+of interest and viewpoints once planned): a viewer that seeks shows only the last message of
+a topic before the playhead, and that one then holds the whole picture."""
 
 from __future__ import annotations
 
@@ -34,6 +36,7 @@ class RouteMarkers:
     def __init__(self) -> None:
         self._route: list[Vec3] = []
         self._photos: list[Pose] = []
+        self._planned: dict[str, SceneEntity] = {}  # "pois", "viewpoints": the latest
 
     def telemetry(self, pos_enu_m: Vec3) -> None:
         if not self._route or math.dist(self._route[-1], pos_enu_m) >= _ROUTE_STEP_M:
@@ -50,18 +53,20 @@ class RouteMarkers:
             pois = data.get("pois", [])
             at = [(*p["pos_en_m"], p["roof_m"]) for p in pois]
             labels = tuple((a, f"POI {p['index']}") for a, p in zip(at, pois, strict=True))
-            return SceneMarkers(
-                (SceneEntity("pois", _POI, spheres_m=tuple(at), texts=labels, size_m=3.0),)
+            self._planned["pois"] = SceneEntity(
+                "pois", _POI, spheres_m=tuple(at), texts=labels, size_m=3.0
             )
+            return self._flight()
         if kind == "Viewpoints":
             views = [data[k] for k in ("top", "front", "right") if "pos_enu_m" in data.get(k, {})]
             arrows = tuple(
                 view_pose(tuple(v["pos_enu_m"]), v["heading_deg"], v["pitch_deg"]) for v in views
             )
             texts = tuple((tuple(v["pos_enu_m"]), str(v["name"])) for v in views)
-            return SceneMarkers(
-                (SceneEntity("viewpoints", _VIEWPOINT, arrows=arrows, texts=texts, size_m=4.0),)
+            self._planned["viewpoints"] = SceneEntity(
+                "viewpoints", _VIEWPOINT, arrows=arrows, texts=texts, size_m=4.0
             )
+            return self._flight()
         if kind == "Outcome":
             return self._flight()
         return None
@@ -71,5 +76,6 @@ class RouteMarkers:
             (
                 SceneEntity("route", _ROUTE, line_m=tuple(self._route)),
                 SceneEntity("photos", _PHOTO, arrows=tuple(self._photos), size_m=3.0),
+                *self._planned.values(),
             )
         )
