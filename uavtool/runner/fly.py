@@ -228,9 +228,9 @@ def fly(
             check_camera(camera)
         if not config.no_gimbal:
             check_gimbal(link)
-        need = config.params.mission
-        corner_m = need.search_radius_m * math.sqrt(2.0)  # the search square's corners
-        check_fence(link, overview_ceiling_m(need, camera.intrinsics), corner_m)
+        search = config.params.mission
+        corner_m = search.search_radius_m * math.sqrt(2.0)  # the search square's corners
+        check_fence(link, overview_ceiling_m(search, camera.intrinsics), corner_m)
         origin = scene.home
         if config.camera == "sim" and config.connect is not None:
             origin = place_scene(scene, home, config.scene_origin, say)

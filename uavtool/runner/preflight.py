@@ -29,6 +29,9 @@ SERVO_MOUNT_FIX = (
     "MNT1_TYPE only at boot)"
 )
 
+_FENCE_ALT_MAX, _FENCE_CIRCLE = 1, 2
+"""FENCE_TYPE bits (ArduPilot's AC_FENCE_TYPE_ALT_MAX and AC_FENCE_TYPE_CIRCLE)."""
+
 
 class PreflightError(InputError):
     """The vehicle or the camera lacks what the mission needs; raised before arming."""
@@ -98,14 +101,14 @@ def check_fence(
     enabled, types, alt_max, radius = (float(v) for v in values if v is not None)
     if not enabled:
         return
-    if int(types) & 1 and alt_max < climb_to_m:  # AC_FENCE_TYPE_ALT_MAX
+    if int(types) & _FENCE_ALT_MAX and alt_max < climb_to_m:
         raise PreflightError(
             f"the altitude fence is on at FENCE_ALT_MAX={alt_max:g} m but the mission climbs "
             f"to {climb_to_m:.1f} m above home for its second overview: set FENCE_ALT_MAX="
             f"{math.ceil(climb_to_m) + 5}, or lower mission.search_radius_m or "
             "mission.assumed_roof_m"
         )
-    if int(types) & 2 and radius < reach_m:  # AC_FENCE_TYPE_CIRCLE
+    if int(types) & _FENCE_CIRCLE and radius < reach_m:
         raise PreflightError(
             f"the circle fence is on at FENCE_RADIUS={radius:g} m but the search square's "
             f"corners are {reach_m:.1f} m from home: set FENCE_RADIUS above "
