@@ -34,17 +34,43 @@ class _NestedError(Exception):
     """A type with no schema Foxglove accepts (an array of arrays)."""
 
 
+def _unalias(tp: Any) -> Any:
+    """What a type alias stands for, its parameters substituted.
+
+    ``type X[T] = ...`` (and numpy's ``NDArray`` on Python 3.12+, a ``typing.TypeAliasType``)
+    is opaque to ``typing.get_origin``: ``NDArray[np.float64]`` has the alias as its origin,
+    not ``np.ndarray``. Its ``__value__`` is the aliased type, generic in ``__type_params__``.
+    """
+    origin, args = typing.get_origin(tp), typing.get_args(tp)
+    if _is_alias(tp):
+        return _unalias(tp.__value__)
+    if _is_alias(origin):
+        value, params = origin.__value__, origin.__type_params__
+        if params and args:
+            value = value[args if len(args) > 1 else args[0]]
+        return _unalias(value)
+    return tp
+
+
+def _is_alias(tp: Any) -> bool:
+    # typing.TypeAliasType (3.12+) or typing_extensions' backport of it, by what they carry
+    return hasattr(tp, "__value__") and hasattr(tp, "__type_params__") and not isinstance(tp, type)
+
+
 def _variants(tp: Any) -> tuple[Any, ...]:
+    tp = _unalias(tp)
     if typing.get_origin(tp) in (typing.Union, types.UnionType):
-        return typing.get_args(tp)
+        return tuple(_unalias(a) for a in typing.get_args(tp))
     return (tp,)
 
 
 def _is_array(tp: Any) -> bool:
+    tp = _unalias(tp)
     return typing.get_origin(tp) is tuple or tp is np.ndarray or typing.get_origin(tp) is np.ndarray
 
 
 def _item_type(tp: Any) -> Any:
+    tp = _unalias(tp)
     args = [a for a in typing.get_args(tp) if a is not Ellipsis]
     if tp is np.ndarray or typing.get_origin(tp) is np.ndarray:
         raise _NestedError  # arrays of the mission are 2-D (polygons, point lists)
@@ -68,6 +94,7 @@ def _schema(tp: Any) -> dict[str, Any]:
 
 
 def _one(tp: Any) -> dict[str, Any]:
+    tp = _unalias(tp)
     if tp in _SCALARS:
         return {"type": _SCALARS[tp]}
     if tp is bytes:
