@@ -64,7 +64,8 @@ def test_small_aliases_are_still_allowed() -> None:
 @pytest.mark.parametrize(
     ("name", "match"),
     [
-        ("deep.yaml", r"^deep.yaml:2: nested deeper than 16 levels"),
+        # libyaml (PyYAML >= 6.0.4) may refuse the nesting first, in its own words
+        ("deep.yaml", r"^deep.yaml(:\d+)?: .*nest(ed|ing)"),
         ("deep.json", r"^deep.json: nested deeper than 16 levels"),
         ("deep.toml", r"^deep.toml: nested deeper than 16 levels"),
         (
