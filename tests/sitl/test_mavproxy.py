@@ -28,13 +28,11 @@ refusals.
 
 from __future__ import annotations
 
-import importlib
 import os
 import queue
 import re
 import socket
 import subprocess
-import sys
 import threading
 import time
 from collections.abc import Iterator
@@ -43,14 +41,10 @@ from pathlib import Path
 import pytest
 
 from tests.link.sitl_process import sitl_process
+from tests.sitl.mavproxy_env import mavproxy_command
 from uavtool.mavlink import FrameParser
 from uavtool.mavlink import mavlink as M
 from uavtool.sitl.params import PARAM_SPECS
-
-if os.environ.get("CI") == "true":  # in the test extra: under CI a missing MAVProxy fails
-    importlib.import_module("MAVProxy")
-else:
-    pytest.importorskip("MAVProxy")
 
 SPEEDUP = 5
 BOOT_REFUSALS = ("Gyros inconsistent", "Need Position Estimate")
@@ -94,14 +88,12 @@ def _free_port() -> int:
 class MavProxy:
     """A headless ``mavproxy.py`` whose stdin we type into and whose lines we read."""
 
-    def __init__(self, port: int, home: Path) -> None:
+    def __init__(self, command: list[str], port: int, home: Path) -> None:
         env = {**os.environ, "PYTHONUNBUFFERED": "1", "HOME": str(home)}  # no ~/.mavinit.scr
         env.pop("DISPLAY", None)
         self.proc = subprocess.Popen(
             [
-                sys.executable,
-                "-m",
-                "MAVProxy.mavproxy",
+                *command,
                 f"--master=tcp:127.0.0.1:{port}",
                 f"--state-basedir={home}",
             ],
@@ -170,9 +162,10 @@ class MavProxy:
 @pytest.fixture
 def session(tmp_path: Path) -> Iterator[MavProxy]:
     """``uavtool sitl --speedup 5`` and MAVProxy connected to it, as the README shows."""
+    command = mavproxy_command()  # MAVProxy's own environment (see mavproxy_env)
     port = _free_port()
     with sitl_process(f"tcpin:127.0.0.1:{port}", "--speedup", str(SPEEDUP)):
-        mavproxy = MavProxy(port, tmp_path)
+        mavproxy = MavProxy(command, port, tmp_path)
         try:
             yield mavproxy
         finally:
