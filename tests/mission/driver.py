@@ -269,7 +269,7 @@ def fly(
 def assert_home_safely(flown: Flown) -> None:
     """After the mission's end it flies home over the roofs it knows (straight up, across to
     above home at the transit altitude) then commands RTL once at most, and the vehicle lands
-    at home."""
+    at home; a vehicle that never left the ground gets LAND instead (it disarms in place)."""
     flight = flown.flight
     end = next(
         i
@@ -279,7 +279,9 @@ def assert_home_safely(flown: Flown) -> None:
     after = [o for o in flight.outputs[end:] if isinstance(o, Command)]
     moves = [c for c in after if isinstance(c, GoTo)]
     modes = [c for c in after if not isinstance(c, GoTo)]
-    assert all(c == SetMode(c.id, "RTL") for c in modes) and len(modes) <= 1
+    on_ground = any(t.startswith("still on the ground") for t in flight.texts())
+    landing = "LAND" if on_ground else "RTL"
+    assert all(c == SetMode(c.id, landing) for c in modes) and len(modes) <= 1
     assert after[len(moves) :] == modes  # the moves come first
     transit = flown.mission.transit_m
     assert all(g.pos_enu_m[2] == transit for g in moves)

@@ -65,7 +65,9 @@ def _commands(outputs: Sequence[object]) -> list[Command]:
 @pytest.mark.parametrize("answer", ["refuse", "ignore"])
 def test_command_failing_four_times_aborts_with_rtl(paper: Scene, kind: str, answer: str) -> None:
     """Refused (COMMAND_ACK not accepted) or unanswered (the runner's ACK timeout) four times:
-    the mission gives up, sends RTL and watches the vehicle land."""
+    the mission gives up and watches the vehicle land: in the air it sends RTL; still on the
+    ground (a take-off refused: say, an obstacle above) LAND, which disarms it where it is,
+    where RTL would climb into what the take-off was refused for."""
     always = {kind: 10**6}
     flown = fly(paper, refuse=always) if answer == "refuse" else fly(paper, ignore=always)
     detail = REFUSED if answer == "refuse" else NO_ACK
@@ -79,8 +81,13 @@ def test_command_failing_four_times_aborts_with_rtl(paper: Scene, kind: str, ans
     assert all(b - a >= wait_ms for a, b in itertools.pairwise(sent))
     warnings = [t for t in flown.flight.texts() if t.endswith(" of 4)")]
     assert [w.split("(attempt ")[1] for w in warnings] == [f"{k} of 4)" for k in range(1, 5)]
-    assert flown.flight.of_type(SetMode)[-1].mode == "RTL"
+    modes = [c.mode for c in flown.flight.of_type(SetMode)]
+    assert modes == (["GUIDED", "LAND"] if kind == "Takeoff" else [*modes[:-1], "RTL"])
     assert_home_safely(flown)
+    if kind == "Takeoff":
+        assert (
+            max(o.pos_enu_m[2] for o in flown.flight.observations if isinstance(o, Telemetry)) == 0
+        )
 
 
 def test_transient_refusals_and_silence_are_retried(paper: Scene) -> None:

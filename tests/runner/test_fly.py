@@ -166,6 +166,58 @@ def test_a_collision_crashes_the_vehicle_and_ends_the_mission(tmp_path: Path) ->
     assert "Crash: collision with building 'mast'" in texts
 
 
+def _paper_with(tmp_path: Path, name: str, blocks: list[dict[str, object]], grey: bool) -> Path:
+    data = scene_to_dict(load_scene("paper"))
+    colour = list(data["ground"]["color"]) if grey else [60, 160, 60]
+    data["buildings"].append({"name": name, "color": colour, "blocks": blocks})
+    scene = tmp_path / f"{name}.json"
+    scene.write_text(json.dumps(data))
+    return scene
+
+
+def _square(x: float, y: float, r: float) -> list[list[float]]:
+    return [[x - r, y - r], [x + r, y - r], [x + r, y + r], [x - r, y + r]]
+
+
+def test_a_crash_on_the_way_home_is_a_crash_whatever_came_before(tmp_path: Path) -> None:
+    """The search and the model done, a mast the mission cannot see stands on the way home:
+    the flight is 'crashed' (exit 5) in the summary and the recording's outcome, the mission
+    sends nothing into the wreck afterwards, and the model built before is still counted."""
+    scene = _paper_with(
+        tmp_path, "mast", [{"footprint": _square(20, -18.3, 0.4), "top_m": 14}], True
+    )
+    rec = tmp_path / "home-crash.mcap"
+    result = CliRunner().invoke(cli, ["fly", "-q", "--scene", str(scene), "--record", str(rec)])
+    assert result.exit_code == 5, result.output
+    assert "outcome        crashed: the vehicle disarmed in the air" in result.output
+    assert "after 'completed: model built'" in result.output
+    info = summarize(rec)
+    assert info.outcome is not None and info.outcome["status"] == "crashed"
+    with RecordingReader(rec) as reader:
+        outputs = [e.value.payload for e in reader.entries(["/mission/outputs"])]  # type: ignore[union-attr]
+    last = outputs[-1]
+    assert last["type"] == "Outcome" and last["status"] == "crashed" and last["model_built"]
+    crash = next(i for i, o in enumerate(outputs) if "disarmed in the air" in str(o.get("text")))
+    assert not [o for o in outputs[crash:] if o["type"] in ("GoTo", "SetMode", "Takeoff")]
+
+
+def test_a_refused_take_off_ends_disarmed_on_the_ground(tmp_path: Path) -> None:
+    """Home under a deck: the vehicle refuses the take-off; the mission does not send RTL
+    (its climb would hit the deck) but LAND, which disarms the vehicle where it stands."""
+    deck = [
+        {"footprint": _square(-2.5, -2.5, 0.5), "top_m": 7},
+        {"footprint": _square(0, 0, 3), "base_m": 7, "top_m": 8},
+    ]
+    scene = _paper_with(tmp_path, "deck", deck, False)
+    result = CliRunner().invoke(cli, ["fly", "--scene", str(scene), "--no-record"])
+    assert result.exit_code == 1, result.output
+    assert "outcome        aborted: take-off to 45 m failed 4 times" in result.output
+    assert "Takeoff: obstacle above at 7.0 m" in result.output
+    assert "still on the ground: LAND to disarm" in result.output
+    assert "returning home (RTL)" not in result.output
+    assert "landed and disarmed" in result.output
+
+
 def test_an_arch_gets_a_diagonal_photo_and_its_model_keeps_the_tunnels(tmp_path: Path) -> None:
     """Red in the `arch` scene is an L-shaped deck on two pillars: the front and right photos
     see through under its legs but not under its corner (a pillar stands behind it from both

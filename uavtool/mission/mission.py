@@ -66,6 +66,9 @@ class _End(Exception):  # noqa: N818 - control flow inside the generator, never 
         self.reason = reason
 
 
+_HOME_HEIGHT_TOLERANCE_M = 2.0
+"""How far from home's height a vehicle that landed and disarmed after RTL may report itself:
+more than an altimeter drifts in a flight, less than a storey (a roof is no landing)."""
 _FLIES_HOME = frozenset({Status.COMPLETED, Status.PARTIAL, Status.NO_MATCH})
 """Outcomes after which the mission still flies the way home itself before RTL."""
 
@@ -98,7 +101,8 @@ class Mission:
         self._frames_seen = 0
         self._expected_modes: frozenset[str] = frozenset()
         self._link_was_lost = False
-        self._airborne = False  # from take-off until the return: disarming now is a crash
+        self._airborne = False  # from take-off until landed: disarming in the air is a crash
+        self._landing = False  # RTL or LAND sent: a disarm on the ground at home is the landing
         self.no_model = "unknown"
         """Why no model was built (for a PARTIAL outcome)."""
         self._deferred: list[Observation] = []
@@ -167,6 +171,9 @@ class Mission:
             yield from self._finish(end.status)
         except _End as exc:
             self.event(Level.ERROR, f"while finishing: {exc.reason}")
+            if exc.status is Status.CRASHED:  # whatever was achieved before, a crash is a crash
+                end = _End(exc.status, f"{exc.reason}, after '{end.status.value}: {end.reason}'")
+                self.event(Level.ERROR, f"mission ends: {end.status.value}: {end.reason}")
         self.outcome = Outcome(
             end.status,
             end.reason,
@@ -178,20 +185,29 @@ class Mission:
         self.emit(self.outcome)
 
     def _finish(self, status: Status) -> Wait[None]:
-        """Bring the vehicle home (or watch someone else do it) until it has landed."""
-        self._airborne = False
+        """Bring the vehicle home (or watch someone else do it) until it has landed.
+
+        Until then a disarm in the air, or anywhere but on the ground at home, is a crash
+        (raised as CRASHED). A vehicle still on the ground lands where it is: RTL would climb.
+        """
         if status in (Status.LINK_LOST, Status.CRASHED) or self.last is None:
             return
         landed = self._landed_and_disarmed
         if status is Status.TAKEOVER:
+            self._airborne = False  # the pilot lands where they choose
             self._expected_modes = frozenset()
             self.event(Level.INFO, "no more commands; watching until the vehicle lands")
+        elif self.last.landed and self.last.armed:
+            self._airborne = False
+            self.event(Level.INFO, "still on the ground: LAND to disarm (RTL would climb)")
+            yield from self.set_mode("LAND")
         elif not landed(self.last):
             if self.transit_m is not None and status in _FLIES_HOME:
                 # The vehicle's RTL flies straight home at its own altitude: go home over
                 # every known roof first.
                 yield from self.travel((0.0, 0.0, self.transit_m), None, self.transit_m, "home")
             self.event(Level.INFO, "returning home (RTL)")
+            self._landing = True
             yield from self.set_mode("RTL", also=("LAND",))
         ok = yield from self.wait_until(landed, self.params.mission.land_timeout_s)
         if ok:
@@ -202,6 +218,11 @@ class Mission:
     @staticmethod
     def _landed_and_disarmed(t: Telemetry) -> bool:
         return t.landed and not t.armed
+
+    def _landed_at_home(self, t: Telemetry) -> bool:
+        """A disarm that ends the landing the mission asked for: on the ground at home's
+        height, not on a roof nor falling."""
+        return self._landing and t.landed and abs(t.pos_enu_m[2]) <= _HOME_HEIGHT_TOLERANCE_M
 
     # --- waiting: every observation passes through here ---------------------------------------
 
@@ -219,7 +240,7 @@ class Mission:
                 continue
             if isinstance(obs, Telemetry):
                 self.last = obs
-                if self._airborne and not obs.armed:
+                if self._airborne and not obs.armed and not self._landed_at_home(obs):
                     raise _End(
                         Status.CRASHED,
                         f"the vehicle disarmed in the air at {obs.pos_enu_m[2]:.1f} m "
