@@ -50,10 +50,8 @@ def evaluate(runner: Runner, scene: Scene | None) -> Evaluation:
     visited = tuple(building_at(k) for k in outcome.visited)
     matched = building_at(outcome.matched_poi) if outcome.matched_poi >= 0 else ""
     if mission.viewpoints is not None:  # the building it went on to photograph from above
-        ring = mission.viewpoints.footprint_en_m
-        x = sum(p[0] for p in ring) / len(ring) + offset[0]
-        y = sum(p[1] for p in ring) / len(ring) + offset[1]
-        matched = nearest_building(scene, (x, y))
+        ring = [(x + offset[0], y + offset[1]) for x, y in mission.viewpoints.footprint_en_m]
+        matched = building_under(scene, ring)
     iou = kept = None
     if mission.model is not None:
         iou = model_iou(mission.model.vertices_m, mission.model.faces, scene, offset)
@@ -131,6 +129,20 @@ def nearest_building(scene: Scene, point_en: tuple[float, float]) -> str:
 
     p = shapely.Point(point_en)
     return min(scene.buildings, key=lambda b: building_footprint(b).distance(p)).name
+
+
+def building_under(scene: Scene, ring_en: Sequence[tuple[float, float]]) -> str:
+    """The building whose footprint overlaps the polygon ``ring_en`` (scene ENU m) most; the
+    nearest one when none overlaps it. (A vertex average is no place to look: an L's or a
+    U's lies in its inner corner, maybe inside a neighbour, a courtyard's in its yard.)"""
+    import shapely  # noqa: PLC0415
+
+    area = shapely.Polygon(ring_en).buffer(0)  # a self-touching outline still has an area
+    overlaps = [(building_footprint(b).intersection(area).area, b.name) for b in scene.buildings]
+    best_m2, name = max(overlaps, default=(0.0, ""))
+    if best_m2 > 0.0:
+        return name
+    return nearest_building(scene, (area.centroid.x, area.centroid.y))
 
 
 def model_iou(
