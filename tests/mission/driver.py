@@ -77,7 +77,15 @@ class LinkOutage:
     failsafe_after_s: float = 5.0
 
 
-Inject = PilotMode | LinkOutage
+@dataclass(frozen=True, slots=True)
+class Stuck:
+    """From then on the vehicle holds where it is and takes GUIDED targets but never moves
+    toward them (RTL still works)."""
+
+    at: At
+
+
+Inject = PilotMode | LinkOutage | Stuck
 
 
 @dataclass(frozen=True, slots=True)
@@ -217,6 +225,8 @@ def run(
                 todo.remove(entry)
                 if isinstance(inj, PilotMode):
                     fake.set_mode(inj.mode)
+                elif isinstance(inj, Stuck):
+                    fake.stuck, fake.goal = True, fake.pos
                 else:
                     link.outage, link.outage_start_ms, link.reported = inj, fake.time_ms, False
         if not queue:

@@ -17,6 +17,7 @@ from tests.mission.driver import (
     Flown,
     LinkOutage,
     PilotMode,
+    Stuck,
     assert_home_safely,
     fly,
     target_rgb,
@@ -31,6 +32,7 @@ from uavtool.mission import (
     Mission,
     MissionInputError,
     MissionStateError,
+    ModelBuilt,
     Params,
     Photo,
     Plan,
@@ -140,6 +142,24 @@ def test_move_never_arriving_is_retried_then_aborts(paper: Scene) -> None:
     assert all(b - a >= slack_ms for a, b in itertools.pairwise(sent))
     assert sum("not reached in" in t for t in flight.texts()) == 4
     assert_home_safely(flown)  # RTL still flies home: only GUIDED targets are ignored
+
+
+def test_a_way_home_that_cannot_be_flown_is_no_success(paper: Scene) -> None:
+    """Model built, then the vehicle stops following GUIDED targets: the way home over the
+    roofs is tried (and retried) only, then the vehicle's RTL brings it down, and the outcome
+    is 'aborted' with that reason, not 'completed'."""
+    flown = fly(paper, script=(Stuck(At(after=ModelBuilt)),))
+    outcome = flown.outcome
+    assert outcome.status is Status.ABORTED and outcome.model_built
+    assert outcome.reason == (
+        f"the way home: home: across at {flown.mission.transit_m:.1f} m: position never "
+        "reached; landed by RTL, after 'completed: model built'"
+    )
+    texts = flown.flight.texts()
+    assert texts[-1] == f"mission ends: aborted: {outcome.reason}"
+    assert "landed and disarmed" in texts
+    assert flown.fake.landed and not flown.fake.armed
+    assert flown.flight.of_type(SetMode)[-1].mode == "RTL"
 
 
 def test_take_off_accepted_but_never_climbing_aborts(paper: Scene) -> None:

@@ -171,7 +171,9 @@ class Mission:
             yield from self._finish(end.status)
         except _End as exc:
             self.event(Level.ERROR, f"while finishing: {exc.reason}")
-            if exc.status is Status.CRASHED:  # whatever was achieved before, a crash is a crash
+            # A crash is a crash whatever was achieved before; a flight that did its work but
+            # could not come home and land is not 'completed' (nor 'partial', nor 'no-match').
+            if exc.status is Status.CRASHED or end.status in _FLIES_HOME:
                 end = _End(exc.status, f"{exc.reason}, after '{end.status.value}: {end.reason}'")
                 self.event(Level.ERROR, f"mission ends: {end.status.value}: {end.reason}")
         self.outcome = Outcome(
@@ -189,10 +191,13 @@ class Mission:
 
         Until then a disarm in the air, or anywhere but on the ground at home, is a crash
         (raised as CRASHED). A vehicle still on the ground lands where it is: RTL would climb.
+        A way home over the known roofs that cannot be flown leaves it to the vehicle's RTL,
+        and then ends ABORTED with its reason; so does a vehicle that never lands.
         """
         if status in (Status.LINK_LOST, Status.CRASHED) or self.last is None:
             return
         landed = self._landed_and_disarmed
+        way_home: _End | None = None
         if status is Status.TAKEOVER:
             self._airborne = False  # the pilot lands where they choose
             self._expected_modes = frozenset()
@@ -205,15 +210,26 @@ class Mission:
             if self.transit_m is not None and status in _FLIES_HOME:
                 # The vehicle's RTL flies straight home at its own altitude: go home over
                 # every known roof first.
-                yield from self.travel((0.0, 0.0, self.transit_m), None, self.transit_m, "home")
+                home = (0.0, 0.0, self.transit_m)
+                try:
+                    yield from self.travel(home, None, self.transit_m, "home")
+                except _End as exc:
+                    if exc.status is not Status.ABORTED:
+                        raise
+                    self.event(Level.ERROR, f"the way home failed: {exc.reason}")
+                    way_home = exc
             self.event(Level.INFO, "returning home (RTL)")
             self._landing = True
             yield from self.set_mode("RTL", also=("LAND",))
         ok = yield from self.wait_until(landed, self.params.mission.land_timeout_s)
-        if ok:
-            self.event(Level.INFO, "landed and disarmed")
-        else:
+        if not ok:
+            if status in _FLIES_HOME:  # its work done, it did not come back: not a success
+                raise _End(Status.ABORTED, "still flying when the mission stopped watching")
             self.event(Level.WARNING, "still flying when the mission stopped watching")
+            return
+        self.event(Level.INFO, "landed and disarmed")
+        if way_home is not None:
+            raise _End(Status.ABORTED, f"the way home: {way_home.reason}; landed by RTL")
 
     @staticmethod
     def _landed_and_disarmed(t: Telemetry) -> bool:
