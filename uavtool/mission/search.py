@@ -26,6 +26,7 @@ from uavtool.mission.outputs import Level, PointOfInterest, Recognition, Shapes,
 from uavtool.nav import ground_point, ground_polygon
 from uavtool.nav.heights import fit_altitude_m
 from uavtool.vision import Shape
+from uavtool.vision.vectorize import hue_distance_deg
 
 if TYPE_CHECKING:
     from uavtool.mission.mission import Mission, Wait
@@ -88,7 +89,9 @@ def search(
     best: Found | None = None
     best_score, best_poi = 0.0, -1
     ceiling_m = overview.pose.pos_enu_m[2]
-    for k in order:
+    todo = list(order)
+    while todo:
+        k = todo.pop(0)
         poi = pois[k]
         x, y = poi.pos_en_m
         alt = min(look_altitude_m(m, poi, overview.intrinsics), ceiling_m)
@@ -140,7 +143,7 @@ def search(
                 roof = yield from _measure_from_lower(m, k, poi, look, shape)  # mismatch
             best = Found(poi, look.photo, shape, j.score, poi.roof_m if roof is None else roof)
             if not p.visit_all:
-                break
+                todo = _rivals(m, pois, todo, k)
     if best is None:
         where = f" at point of interest {best_poi}" if best_poi >= 0 else ""
         raise m.end(
@@ -152,6 +155,26 @@ def search(
         f"roof {best.roof_m:.1f} m above home",
     )
     return best
+
+
+def _rivals(
+    m: Mission, pois: tuple[PointOfInterest, ...], todo: list[int], matched: int
+) -> list[int]:
+    """The points of interest still to visit that could be the target as well (its colour,
+    within the match's hue gate): a match is final only once none is left unseen, so a slab
+    in the target's colour never wins over the courtyard building further on."""
+    limit = m.params.mission.match_hue_tolerance_deg
+    target_rgb = m.target.colour_rgb
+    rivals = [
+        k for k in todo if limit <= 0 or hue_distance_deg(pois[k].colour_rgb, target_rgb) <= limit
+    ]
+    if rivals:
+        m.event(
+            Level.INFO,
+            f"point of interest {matched} matches; before deciding, looking at the others of the "
+            f"target's colour: {', '.join(map(str, rivals))}",
+        )
+    return rivals
 
 
 def _measure_from_lower(

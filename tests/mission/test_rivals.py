@@ -1,0 +1,57 @@
+"""A match is final only when no other building of the target's colour is left unseen: the
+best of them wins, not the first to clear the threshold."""
+
+from __future__ import annotations
+
+import math
+
+from tests.mission.driver import fly
+from uavtool.world import Scene, scene_from_dict
+
+RED = [210, 40, 40]
+
+
+def _tee(x0: float, y0: float, right_arm_m: float = 4.5) -> list[list[float]]:
+    """A T: a 3 m stem 8 m long under a 3 m bar with a 4.5 m left arm and ``right_arm_m``."""
+    bar_y, top_y = y0 + 8, y0 + 11
+    right = x0 + 7.5 + right_arm_m
+    return [
+        [x0, bar_y], [x0 + 4.5, bar_y], [x0 + 4.5, y0], [x0 + 7.5, y0], [x0 + 7.5, bar_y],
+        [right, bar_y], [right, top_y], [x0, top_y],
+    ]  # fmt: skip
+
+
+def _building(name: str, colour: list[int], footprint: list[list[float]]) -> dict[str, object]:
+    return {"name": name, "color": colour, "blocks": [{"footprint": footprint, "top_m": 6}]}
+
+
+def _scene() -> Scene:
+    """The target T, and nearer home a decoy T of the same colour with one arm 2.5 m short."""
+    blue = [[2, 8], [8, 8], [8, 13], [2, 13]]
+    buildings = [
+        _building("decoy", RED, _tee(-16, -6, 2.0)),
+        _building("target", RED, _tee(8, -14)),
+        _building("blue", [40, 90, 220], blue),
+    ]
+    return scene_from_dict({"name": "rival", "target": "target", "buildings": buildings})
+
+
+def test_the_best_of_the_targets_colour_wins_not_the_first_match() -> None:
+    flown = fly(_scene())
+    outcome = flown.outcome
+    pois = flown.mission.plan.pois  # type: ignore[union-attr]
+
+    def near(k: int) -> str:
+        x, y = pois[k].pos_en_m
+        return (
+            "target" if math.hypot(x - 12.6, y - 4.4) < math.hypot(x + 11.4, y - 12.4) else "decoy"
+        )
+
+    first = outcome.visited[0]
+    assert near(first) == "decoy"  # the nearest: visited first, and it clears the threshold
+    texts = flown.flight.texts()
+    assert f"point of interest {first}: MATCH" in " ".join(texts)
+    assert any("before deciding, looking at the others of the target's colour" in t for t in texts)
+    assert near(outcome.matched_poi) == "target"
+    assert outcome.match_score > 0.95
+    assert outcome.model_built
