@@ -6,7 +6,12 @@ recording's overhead against ``--no-record``.
 The baseline is the code of commit ``BASELINE`` (the last one before lockstep: the built-in
 SITL in its own thread at speed-up 30), extracted with ``git archive`` and run from the same
 virtualenv; the variants take turns in every round, so a machine whose speed drifts treats
-them alike. Run: ``python benchmarks/bench_fly.py [--runs N] [--baseline COMMIT]``.
+them alike.
+
+    python benchmarks/bench_fly.py [--quick] [--runs N] [--baseline COMMIT]
+
+``--quick``: one round (``--runs 1``), every variant and figure still printed. The baseline
+commit must be in the clone (``git fetch --unshallow`` in a shallow one).
 """
 
 from __future__ import annotations
@@ -31,10 +36,18 @@ _SUMMARY = re.compile(r"flight\s+([\d.]+) s sim.*?([\d.]+) s wall")
 
 
 def extract(commit: str, into: Path) -> Path:
-    """The ``uavtool`` package as it was at ``commit``, under ``into``."""
-    data = subprocess.run(
-        ["git", "-C", str(ROOT), "archive", commit, "uavtool"], check=True, capture_output=True
-    ).stdout
+    """The ``uavtool`` package as it was at ``commit``, under ``into`` (a plain copy, no
+    worktree: it goes with ``into``)."""
+    done = subprocess.run(
+        ["git", "-C", str(ROOT), "archive", commit, "uavtool"], check=False, capture_output=True
+    )
+    if done.returncode != 0:
+        why = done.stderr.decode(errors="replace").strip()
+        raise SystemExit(
+            f"the baseline commit {commit} cannot be read from {ROOT}: {why}\n"
+            "(a shallow clone lacks it: git fetch --unshallow)"
+        )
+    data = done.stdout
     with tarfile.open(fileobj=BytesIO(data)) as tar:
         tar.extractall(into, filter="data")
     return into
@@ -68,9 +81,14 @@ def _runs(times: list[float]) -> str:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--runs", type=int, default=5)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--quick", action="store_true", help="the smallest run: --runs 1")
+    parser.add_argument("--runs", type=int, default=5, help="rounds (default: %(default)s)")
     parser.add_argument("--baseline", default=BASELINE, help="commit of the threaded mode")
+    if parser.parse_known_args()[0].quick:
+        parser.set_defaults(runs=1)
     args = parser.parse_args()
     n = args.runs
     with tempfile.TemporaryDirectory() as tmp_text:

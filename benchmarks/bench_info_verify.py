@@ -1,12 +1,13 @@
 """What checking every chunk's CRC costs ``uavtool info`` on a ~100 MB recording.
 
-    python benchmarks/bench_info_verify.py [--size-mb 100] [--repeat 5]
+    python benchmarks/bench_info_verify.py [--quick] [--size-mb 100] [--repeat 5]
 
 Writes a recording shaped like a long flight (MAVLink telemetry both ways at 50 Hz, one
 ~20 KiB camera frame per second of log time, zstd chunks of one second) of about the given
 size, then times `summarize` with every chunk read and checked (``uavtool info``, the
 default) and from the summary alone (``uavtool info --no-verify``), and the whole command
-both ways in a fresh process. Prints medians and the ratios. On demand only, not in CI.
+both ways in a fresh process. Prints medians and the ratios. On demand, and in CI with
+``--quick`` (``--size-mb 5 --repeat 2``: the same rows on a small file).
 """
 
 from __future__ import annotations
@@ -86,9 +87,16 @@ def _cli(path: Path, *flags: str) -> None:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--size-mb", type=float, default=100.0)
-    parser.add_argument("--repeat", type=int, default=5)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument(
+        "--quick", action="store_true", help="the smallest run: --size-mb 5 --repeat 2"
+    )
+    parser.add_argument("--size-mb", type=float, default=100.0, help="default: %(default)s")
+    parser.add_argument("--repeat", type=int, default=5, help="default: %(default)s")
+    if parser.parse_known_args()[0].quick:
+        parser.set_defaults(size_mb=5.0, repeat=2)
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "big.mcap"

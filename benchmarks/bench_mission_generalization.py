@@ -3,8 +3,10 @@
 scaled and turned copy, a near-identical shape, spread past one overview, home beside a
 building), each flown on the built-in vehicle by today's mission and by the baseline's.
 
-    python benchmarks/bench_mission_generalization.py [--scenes 200] [--first-seed 1]
+    python benchmarks/bench_mission_generalization.py [--quick] [--scenes 200] [--first-seed 1]
         [--baseline 863e7d7] [--workers 2] [--variants new,baseline] [--random-home]
+
+``--quick``: two scenes (``--scenes 2``), both variants, every row of the table.
 
 The baseline is the code of commit ``BASELINE`` (the mission before roof heights, chosen
 altitudes, the mirror rule and collisions: fixed 45/20 m, a 5 m roof plane), extracted with
@@ -45,7 +47,13 @@ from bench_fly import extract  # run as a script: its folder is on sys.path
 
 from uavtool.recording import JsonDocument, RecordingReader
 from uavtool.recording.topics import OBSERVATIONS, OUTPUTS
-from uavtool.runner.evaluate import closest_clearance, model_iou, nearest_building, tunnel_kept
+from uavtool.runner.evaluate import (
+    building_under,
+    closest_clearance,
+    model_iou,
+    nearest_building,
+    tunnel_kept,
+)
 from uavtool.sitl import SitlConfig
 from uavtool.world import Scene, scene_to_dict
 from uavtool.world.hard import HardOptions, HardSceneInfo, generate_hard_scene_with_info
@@ -168,9 +176,9 @@ def judge(seed: int, scene: Scene, info: HardSceneInfo, row: dict[str, Any]) -> 
     matched = ""
     poi = int(outcome.get("matched_poi", -1))
     if views is not None:
-        ring = views["footprint_en_m"]
-        centre = (sum(x for x, _ in ring) / len(ring), sum(y for _, y in ring) / len(ring))
-        matched = nearest_building(scene, centre)
+        # As `uavtool fly` judges it: the building the measured footprint overlaps most (an
+        # L's or a U's vertex average may lie in a neighbour, a courtyard's in its yard).
+        matched = building_under(scene, [(x, y) for x, y in views["footprint_en_m"]])
     elif plan is not None and poi >= 0:
         matched = nearest_building(scene, tuple(plan["pois"][poi]["pos_en_m"]))
     iou = tunnel = None
@@ -312,7 +320,10 @@ def report(rows: list[dict[str, Any]]) -> None:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--quick", action="store_true", help="the smallest run: --scenes 2")
     parser.add_argument("--scenes", type=int, default=200)
     parser.add_argument("--first-seed", type=int, default=1)
     parser.add_argument("--baseline", default=BASELINE)
@@ -325,6 +336,8 @@ def main() -> None:
         action="store_true",
         help="each scene's home anywhere within 60° of the equator, the vehicle facing any way",
     )
+    if parser.parse_known_args()[0].quick:
+        parser.set_defaults(scenes=2)
     args = parser.parse_args()
     options = HardOptions(random_home=args.random_home)
     variants = args.variants.split(",")

@@ -21,9 +21,13 @@ spec's ``[[cases]]`` (condition × variant), crossed with its scenes; the flight
 when this script flew them one after another, so are the figures. A flight takes ~3–6 s of
 one core; the default run (30 conditions × 2) about 3 minutes on two busy cores.
 
-    python benchmarks/bench_mission_robustness.py [--scenes paper,dense] [--seeds 1,2]
-        [--wind 6] [--wind-dirs 0,90,180,270] [--headings 30,60] [--variants new,baseline]
+    python benchmarks/bench_mission_robustness.py [--quick]
+        [--scenes paper,blocked-front,dense] [--seeds 1,2] [--wind 6]
+        [--wind-dirs 0,90,180,270] [--headings 30,60] [--variants new,baseline]
         [--workers 2 | --scheduler ADDRESS] [--out FOLDER]
+
+``--quick``: one condition of each kind, both variants (``--scenes paper --seeds 1
+--wind-dirs 0 --headings 30``: 4 conditions, 8 flights).
 """
 
 from __future__ import annotations
@@ -136,7 +140,14 @@ def floats(text: str) -> list[float]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument(
+        "--quick",
+        action="store_true",
+        help="the smallest run: --scenes paper --seeds 1 --wind-dirs 0 --headings 30",
+    )
     parser.add_argument("--scenes", default="paper,blocked-front,dense")
     parser.add_argument("--seeds", default="1,2")
     parser.add_argument("--wind", type=float, default=6.0, help="wind speed, m/s")
@@ -146,6 +157,8 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=None, help="default: one per core")
     parser.add_argument("--scheduler", default=None, help="a running Dask scheduler")
     parser.add_argument("--out", type=Path, default=None, help="keep the sweep folder here")
+    if parser.parse_known_args()[0].quick:
+        parser.set_defaults(scenes="paper", seeds="1", wind_dirs="0", headings="30")
     args = parser.parse_args()
     known = valid_keys()
     baseline = {k: v for k, v in BASELINE.items() if k in known}

@@ -18,7 +18,10 @@ the other side of it: every other building of each hard scene photographed where
 it would be taken (and closer), every 30°: the photos the mission would take for the target
 (false matches) and their mean score.
 
-    python benchmarks/bench_recognition_heading.py [--scenes 60] [--baseline 73c3162]
+    python benchmarks/bench_recognition_heading.py [--quick] [--scenes 60] [--first-seed 1]
+        [--baseline 73c3162]
+
+``--quick``: one hard scene (``--scenes 1``); paper's photos and the baseline all the same.
 
 The baseline is the code of commit ``BASELINE`` (before the recognizer charged dropped corners
 by the area they change), extracted with ``git archive`` and run in a subprocess from the
@@ -151,10 +154,15 @@ def _row(scores: list[float]) -> dict[str, float]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scenes", type=int, default=60)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--quick", action="store_true", help="the smallest run: --scenes 1")
+    parser.add_argument("--scenes", type=int, default=60, help="hard scenes (default: 60)")
     parser.add_argument("--first-seed", type=int, default=1)
-    parser.add_argument("--baseline", default=BASELINE)
+    parser.add_argument("--baseline", default=BASELINE, help=f"commit (default: {BASELINE})")
+    if parser.parse_known_args()[0].quick:
+        parser.set_defaults(scenes=1)
     args = parser.parse_args()
     root = Path(__file__).resolve().parents[1]
     with tempfile.TemporaryDirectory() as tmp:

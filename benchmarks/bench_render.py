@@ -1,8 +1,8 @@
 """Renderer speed and correctness: ours vs a naive numpy z-buffer vs OpenCV painter's order.
 
-Run on demand (never in the test suite):
+Run on demand (never in the test suite; in CI with ``--quick``: one round, ``--rounds 1``):
 
-    python benchmarks/bench_render.py [--rounds 7]
+    python benchmarks/bench_render.py [--quick] [--rounds 7] [--scenes paper,dense]
 
 For each scene and image size, every method renders the same mission-like poses (overview
 from 45 m, nadir from 20 m over the target, front/right/oblique views of it); rounds are
@@ -92,9 +92,14 @@ def differing_share(
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--rounds", type=int, default=7)
-    parser.add_argument("--scenes", default="paper,dense")
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--quick", action="store_true", help="the smallest run: --rounds 1")
+    parser.add_argument("--rounds", type=int, default=7, help="default: %(default)s")
+    parser.add_argument("--scenes", default="paper,dense", help="default: %(default)s")
+    if parser.parse_known_args()[0].quick:
+        parser.set_defaults(rounds=1)
     args = parser.parse_args()
     cv2.setNumThreads(1)
     methods: dict[str, Renderer] = {

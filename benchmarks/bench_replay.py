@@ -2,7 +2,9 @@
 (goal: ≥ 50× faster and under 3 s wall) and vs simply reading every message of the file
 (the floor). Also the whole CLI in a fresh process (start-up included).
 
-Run: ``python benchmarks/bench_replay.py [RECORDING] [--runs N]``.
+    python benchmarks/bench_replay.py [RECORDING] [--quick] [--runs N]
+
+``--quick``: one run of each (``--runs 1``).
 """
 
 from __future__ import annotations
@@ -44,9 +46,16 @@ def timed(fn, runs: int) -> list[float]:  # type: ignore[no-untyped-def]
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser()
-    parser.add_argument("recording", nargs="?", type=Path, default=PAPER)
-    parser.add_argument("--runs", type=int, default=5)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument(
+        "recording", nargs="?", type=Path, default=PAPER, help="default: the golden paper.mcap"
+    )
+    parser.add_argument("--quick", action="store_true", help="the smallest run: --runs 1")
+    parser.add_argument("--runs", type=int, default=5, help="default: %(default)s")
+    if parser.parse_known_args()[0].quick:
+        parser.set_defaults(runs=1)
     a = parser.parse_args()
     flight = load_flight(a.recording)
     times = [o.time_boot_ms for o in flight.observations if isinstance(o, Telemetry)]

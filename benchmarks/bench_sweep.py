@@ -1,6 +1,6 @@
 """Throughput of ``uavtool sweep`` and ``uavtool replay DIR`` on Dask against plain loops.
 
-    python benchmarks/bench_sweep.py [--flights 24] [--replays 100] [--tasks 2000]
+    python benchmarks/bench_sweep.py [--quick] [--flights 24] [--replays 100] [--tasks 2000]
 
 - flights per minute with a 1-worker and a 2-worker LocalCluster (goal: ≥ 1.7× with 2 on a
   2-core machine), end to end (cluster start-up and shutdown included);
@@ -13,7 +13,8 @@
 
 Flights are of the ``paper`` scene with seeds 0..FLIGHTS-1 (one grid dimension), the same in
 every variant; the tables of the 1- and 2-worker sweeps are compared (apart from wall time
-and worker) to show the figures are of the same work.
+and worker) to show the figures are of the same work. ``--quick``: every row on a few flights
+(``--flights 2 --replays 4 --tasks 100``).
 """
 
 from __future__ import annotations
@@ -55,10 +56,19 @@ def timed_sweep(
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--flights", type=int, default=24)
-    parser.add_argument("--replays", type=int, default=100)
-    parser.add_argument("--tasks", type=int, default=2000)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument(
+        "--quick",
+        action="store_true",
+        help="the smallest run: --flights 2 --replays 4 --tasks 100",
+    )
+    parser.add_argument("--flights", type=int, default=24, help="default: %(default)s")
+    parser.add_argument("--replays", type=int, default=100, help="default: %(default)s")
+    parser.add_argument("--tasks", type=int, default=2000, help="default: %(default)s")
+    if parser.parse_known_args()[0].quick:
+        parser.set_defaults(flights=2, replays=4, tasks=100)
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp_text:
         tmp = Path(tmp_text)

@@ -1,11 +1,13 @@
 """Converting a recording for Rerun: `uavtool view REC --save out.rrd` (goal: paper < 5 s).
 
-    python benchmarks/bench_view.py [RECORDING] [--runs N]
+    python benchmarks/bench_view.py [RECORDING] [--quick] [--runs N]
 
 Prints, for the recording (default: the golden paper mission):
 - the whole command as a user runs it (a fresh process: imports, scene meshes, the file);
 - the conversion in-process (median of N), and the part of it spent reading the MCAP;
 - telemetry sent as columns (what the viewer does) against one `log` call per sample.
+
+``--quick``: one run of each (``--runs 1``).
 """
 
 from __future__ import annotations
@@ -82,11 +84,20 @@ def _log_columns(samples: list[dict[str, Any]], out: Path) -> None:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument(
-        "recording", nargs="?", type=Path, default=ROOT / "recordings/golden/paper.mcap"
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
-    parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument(
+        "recording",
+        nargs="?",
+        type=Path,
+        default=ROOT / "recordings/golden/paper.mcap",
+        help="default: the golden paper.mcap",
+    )
+    parser.add_argument("--quick", action="store_true", help="the smallest run: --runs 1")
+    parser.add_argument("--runs", type=int, default=3, help="default: %(default)s")
+    if parser.parse_known_args()[0].quick:
+        parser.set_defaults(runs=1)
     args = parser.parse_args()
     path: Path = args.recording
     with tempfile.TemporaryDirectory() as tmp:

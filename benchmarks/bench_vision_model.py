@@ -7,7 +7,9 @@ footprint's south and east sides at a distance that fits the building in the fra
 the mission's viewpoints. A through-hole is reproduced when the tunnel's centre is empty
 in the model.
 
-    python benchmarks/bench_vision_model.py [--buildings 60]
+    python benchmarks/bench_vision_model.py [--quick] [--buildings 60]
+
+``--quick``: four buildings (``--buildings 4``: one of each shape, two with a through-hole).
 """
 
 from __future__ import annotations
@@ -162,6 +164,11 @@ def run(count: int) -> None:
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--buildings", type=int, default=60)
+    ap = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    ap.add_argument("--quick", action="store_true", help="the smallest run: --buildings 4")
+    ap.add_argument("--buildings", type=int, default=60, help="default: %(default)s")
+    if ap.parse_known_args()[0].quick:
+        ap.set_defaults(buildings=4)
     run(ap.parse_args().buildings)

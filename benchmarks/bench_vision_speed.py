@@ -9,7 +9,9 @@ inflate much less.
 * match two shapes (the red target's outline against the red building's in the frame);
 * build the red target's model from its top / front / right photos.
 
-    python benchmarks/bench_vision_speed.py [--repeat 200]
+    python benchmarks/bench_vision_speed.py [--quick] [--repeat 200]
+
+``--quick``: medians of 5 rounds (``--repeat 5``).
 """
 
 from __future__ import annotations
@@ -154,6 +156,11 @@ def run(repeat: int) -> None:
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeat", type=int, default=200)
+    ap = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    ap.add_argument("--quick", action="store_true", help="the smallest run: --repeat 5")
+    ap.add_argument("--repeat", type=int, default=200, help="rounds (default: %(default)s)")
+    if ap.parse_known_args()[0].quick:
+        ap.set_defaults(repeat=5)
     run(ap.parse_args().repeat)
