@@ -236,9 +236,10 @@ class Mission:
         return t.landed and not t.armed
 
     def _landed_at_home(self, t: Telemetry) -> bool:
-        """A disarm that ends the landing the mission asked for: on the ground at home's
-        height, not on a roof nor falling."""
-        return self._landing and t.landed and abs(t.pos_enu_m[2]) <= _HOME_HEIGHT_TOLERANCE_M
+        """A disarm that ends the landing the mission asked for: at home's height, not on a
+        roof nor in the air. (Not by the landed flag: on a lossy link the vehicle's landed
+        state can be older than the heartbeat that says it disarmed.)"""
+        return self._landing and abs(t.pos_enu_m[2]) <= _HOME_HEIGHT_TOLERANCE_M
 
     # --- waiting: every observation passes through here ---------------------------------------
 
