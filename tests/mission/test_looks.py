@@ -156,26 +156,26 @@ def test_look_parameters_are_settable_and_checked() -> None:
         scenes.with_mission(max_looks=0)
 
 
-def test_a_roof_of_unknown_height_is_looked_at_again_from_closer() -> None:
+def test_a_roof_of_unknown_height_is_measured_before_the_look() -> None:
     """Hard scene 89: the target, a stepped T 40 m out, is cut by the border of the lower
-    overview photo, so its roof height is unknown and assumed the tallest expected (25 m):
-    its first look is taken from so high that, against a stricter threshold (0.82), it
-    scores below it (0.75). Two photos of it give its roof's height, and the next look, from
-    the altitude that fits it, matches (0.84)."""
+    overview photo, so the overviews cannot tell its roof height. Assumed the tallest
+    expected (25 m), its first look was taken from so high that, against a stricter threshold
+    (0.82), it scored below it (0.75) and needed a second, closer look. Now the mission
+    measures it first, from the overview's altitude over it, and its first look is taken
+    from the altitude that fits the roof and matches."""
     scene, info = generate_hard_scene_with_info(seed=89)
     params = Params()
     flown = fly(scene, replace(params, recognize=replace(params.recognize, threshold=0.82)))
     flight = flown.flight
     assert flight.outcome.status is Status.COMPLETED, flight.outcome.reason
+    assert "roof heights measured for 0 of 6 buildings (others assumed 25 m)" in flight.texts()
     (plan,) = flight.of_type(Plan)
     target = building_footprint(scene.building(info.target))
     poi = plan.pois[flight.outcome.matched_poi]
-    assert not poi.roof_measured
+    assert poi.roof_measured
     looks = _looks(flight, poi.index)
-    assert len(looks) >= 2 and not looks[0][1].matched and looks[-1][1].matched
-    alts = [photo.pose.pos_enu_m[2] for photo, _ in looks]
-    assert alts[-1] < min(alts[:-1]) - 5.0  # the matching look is the closer one
-    x, y, _ = looks[-1][0].pose.pos_enu_m  # the matching look is taken over the target
+    assert len(looks) == 1 and looks[0][1].matched
+    x, y, _ = looks[0][0].pose.pos_enu_m  # taken over the target
     assert target.distance(shapely.Point(x, y)) < 1.0
 
 

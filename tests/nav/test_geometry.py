@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from uavtool.nav import NavError
@@ -9,6 +11,7 @@ from uavtool.nav.geometry import (
     as_points,
     convex_hull,
     point_polygon_distance,
+    segment_polygon_distance,
     segments_intersect,
     triangle_hits_polygon,
 )
@@ -50,3 +53,16 @@ def test_triangle_hits_polygon() -> None:
 def test_as_points_rejects_bad_rows() -> None:
     with pytest.raises(NavError, match=r"obs\[1\] is not finite"):
         as_points([(0, 0), (float("inf"), 1)], what="obs")
+
+
+def test_segment_polygon_distance() -> None:
+    square = [(0.0, 0.0), (4.0, 0.0), (4.0, 4.0), (0.0, 4.0)]
+    assert segment_polygon_distance((-5.0, 2.0), (10.0, 2.0), square) == 0.0  # crosses it
+    assert segment_polygon_distance((1.0, 1.0), (2.0, 2.0), square) == 0.0  # inside it
+    assert segment_polygon_distance((-5.0, 7.0), (10.0, 7.0), square) == 3.0  # passes above
+    assert segment_polygon_distance((7.0, 2.0), (9.0, 2.0), square) == 3.0  # ends before it
+    # a corner nearest the middle of the segment, not its ends
+    assert segment_polygon_distance((-2.0, 8.0), (8.0, -2.0), square) == pytest.approx(0.0)
+    assert segment_polygon_distance((0.0, 10.0), (10.0, 0.0), square) == pytest.approx(
+        math.sqrt(2.0)
+    )

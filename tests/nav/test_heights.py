@@ -5,14 +5,21 @@ from __future__ import annotations
 import math
 
 import pytest
+import shapely
 
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.mission import Params
 from uavtool.mission.analysis import nadir_shapes
-from uavtool.nav.heights import fit_altitude_m, roof_from_photos, roof_height_m
+from uavtool.nav.heights import (
+    fit_altitude_m,
+    roof_from_cut_outline,
+    roof_from_photos,
+    roof_height_m,
+)
 from uavtool.world import load_scene, render
 
 K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
+Point = tuple[float, float]
 
 
 def test_hand_computed_roof() -> None:
@@ -130,3 +137,70 @@ def _roof_rgb(shapes, building):  # type: ignore[no-untyped-def]
         (s.colour_rgb for s in shapes),
         key=lambda c: sum(abs(a - b) for a, b in zip(c, building.color_rgb, strict=True)),
     )
+
+
+def _pixels(pose: CameraPose, corners_en: list[tuple[float, float]], h_m: float) -> list[Point]:
+    """Where a roof's corners at height ``h_m`` fall in a photo from ``pose``."""
+    right, down, forward = pose.axes()
+    out = []
+    for x, y in corners_en:
+        p = (x - pose.pos_enu_m[0], y - pose.pos_enu_m[1], h_m - pose.pos_enu_m[2])
+        z = sum(p[i] * forward[i] for i in range(3))
+        u = K.fx_px * sum(p[i] * right[i] for i in range(3)) / z + K.cx_px
+        v = K.fy_px * sum(p[i] * down[i] for i in range(3)) / z + K.cy_px
+        out.append((u, v))
+    return out
+
+
+@pytest.mark.parametrize(
+    ("h_m", "corners", "whole", "cut"),
+    [
+        # the lower overview (45 m) cuts a 6 m roof the higher one (117 m) sees whole
+        (6.0, [(-27, 4), (-19, 4), (-19, 10), (-27, 10)], (0, 0, 117.4, 0), (0, 0, 45, 0)),
+        # a 45 m tower beside a measuring photo from 117 m, cut by the overview from home
+        (45.0, [(30, -4), (38, -4), (38, 4), (30, 4)], (34, 0, 117.4, 90), (0, 0, 117.4, 90)),
+        # an L at 12 m, the photos turned 90°
+        (12.0, [(5, -5), (15, -5), (15, 0), (9, 0), (9, 5), (5, 5)], (0, 0, 90, 90),
+         (0, 0, 35, 90)),
+    ],
+)  # fmt: skip
+def test_a_roof_cut_by_one_photo_is_fitted_by_its_visible_edges(
+    h_m: float,
+    corners: list[tuple[float, float]],
+    whole: tuple[float, float, float, float],
+    cut: tuple[float, float, float, float],
+) -> None:
+    whole_pose = CameraPose((whole[0], whole[1], whole[2]), whole[3], -90.0)
+    cut_pose = CameraPose((cut[0], cut[1], cut[2]), cut[3], -90.0)
+    frame = shapely.box(0.0, 0.0, K.width_px - 1.0, K.height_px - 1.0)
+    seen = shapely.Polygon(_pixels(cut_pose, corners, h_m)).intersection(frame)
+    assert 0.0 < seen.area < shapely.Polygon(_pixels(cut_pose, corners, h_m)).area  # really cut
+    h = roof_from_cut_outline(
+        whole_ring_px=_pixels(whole_pose, corners, h_m),
+        whole_pose=whole_pose,
+        cut_ring_px=list(seen.exterior.coords)[:-1],
+        cut_pose=cut_pose,
+        intrinsics=K,
+        max_m=min(whole[2], cut[2]) - 1.0,
+    )
+    assert h == pytest.approx(h_m, abs=0.05)
+
+
+def test_a_cut_roof_that_fits_no_height_is_not_measured() -> None:
+    """The visible edges belong to another roof (or the outline is a different building's):
+    no height puts them within the tolerance, so no height is made up."""
+    whole_pose = CameraPose((0.0, 0.0, 117.4), 0.0, -90.0)
+    cut_pose = CameraPose((0.0, 0.0, 45.0), 0.0, -90.0)
+    square = [(-27.0, 4.0), (-19.0, 4.0), (-19.0, 10.0), (-27.0, 10.0)]
+    other = [(-29.0, 2.0), (-18.0, 6.0), (-22.0, 12.0)]  # a triangle where the square would be
+    frame = shapely.box(0.0, 0.0, K.width_px - 1.0, K.height_px - 1.0)
+    seen = shapely.Polygon(_pixels(cut_pose, other, 6.0)).intersection(frame)
+    h = roof_from_cut_outline(
+        whole_ring_px=_pixels(whole_pose, square, 6.0),
+        whole_pose=whole_pose,
+        cut_ring_px=list(seen.exterior.coords)[:-1],
+        cut_pose=cut_pose,
+        intrinsics=K,
+        max_m=44.0,
+    )
+    assert h is None

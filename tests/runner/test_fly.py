@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import socket
 import threading
 import time
@@ -216,6 +217,31 @@ def test_a_refused_take_off_ends_disarmed_on_the_ground(tmp_path: Path) -> None:
     assert "still on the ground: LAND to disarm" in result.output
     assert "returning home (RTL)" not in result.output
     assert "landed and disarmed" in result.output
+
+
+def test_a_tower_taller_than_expected_is_measured_before_it_is_flown_near(tmp_path: Path) -> None:
+    """A 45 m tower (taller than mission.assumed_roof_m, 25 m) out of the lower overview's
+    view: the mission measures it from above before descending anywhere, crosses over it
+    with the safety margin (4 m) and never comes closer (it passed within 0.42 m before)."""
+    data = {
+        "version": 1,
+        "name": "tower",
+        "target": "red",
+        "buildings": [
+            {"name": "tower", "color": [40, 90, 220],
+             "blocks": [{"footprint": _square(14, 12, 4), "top_m": 45}]},
+            {"name": "red", "color": [210, 40, 40],
+             "blocks": [{"footprint": [[24, 24], [34, 24], [34, 28], [28, 28], [28, 34],
+                                       [24, 34]], "top_m": 6}]},
+        ],
+    }  # fmt: skip
+    scene = tmp_path / "tower.json"
+    scene.write_text(json.dumps(data))
+    result = CliRunner().invoke(cli, ["fly", "--scene", str(scene), "--no-record"])
+    assert result.exit_code == 0, result.output
+    assert "taller than expected: 0 (45.0 m)" in result.output
+    clearance = re.search(r"clearance +(-?[\d.]+) m from building", result.output)
+    assert clearance is not None and float(clearance.group(1)) >= 4.0
 
 
 def test_an_arch_gets_a_diagonal_photo_and_its_model_keeps_the_tunnels(tmp_path: Path) -> None:

@@ -50,6 +50,7 @@ from uavtool.mission.outputs import (
     Viewpoints,
 )
 from uavtool.mission.params import MissionParams, Params
+from uavtool.nav.geometry import segment_polygon_distance
 
 T = TypeVar("T")
 Wait = Generator[None, Observation, T]
@@ -93,6 +94,10 @@ class Mission:
         self.model_built = False
         self.plan: Plan | None = None
         self.transit_m: float | None = None
+        self.ceiling_m: float | None = None
+        """The second overview's altitude: every roof it showed is below it."""
+        self.unknown_footprints: tuple[tuple[tuple[float, float], ...], ...] = ()
+        """Where buildings of unknown height may stand: a way near one crosses at the ceiling."""
         """The altitude that clears every known roof (once the survey has measured them)."""
         self.viewpoints: Viewpoints | None = None
         self.model: ModelBuilt | None = None
@@ -380,11 +385,30 @@ class Mission:
         x, y, z = pos_enu_m
         cruise = max(transit_m, z)
         here = self.last.pos_enu_m if self.last is not None else (x, y, cruise)
+        if (
+            self.ceiling_m is not None
+            and cruise < self.ceiling_m
+            and self._near_unknown(here, (x, y))
+        ):
+            cruise = self.ceiling_m
+            self.event(
+                Level.INFO,
+                f"{what}: a roof of unknown height near the way: across at {cruise:.1f} m",
+            )
         if math.hypot(here[0] - x, here[1] - y) > p.arrive_radius_m:
             if here[2] < cruise - p.arrive_radius_m:
                 yield from self.move((here[0], here[1], cruise), None, f"climb to {cruise:.1f} m")
             yield from self.move((x, y, cruise), None, f"{what}: across at {cruise:.1f} m")
         yield from self.move(pos_enu_m, heading_deg, what)
+
+    def _near_unknown(self, here: Vec3, there: tuple[float, float]) -> bool:
+        """Whether the ground track from ``here`` to ``there`` passes within the safety
+        margin of where a building of unknown height may stand."""
+        margin_m = self.params.viewpoints.safety_margin_m
+        a = (here[0], here[1])
+        return any(
+            segment_polygon_distance(a, there, fp) <= margin_m for fp in self.unknown_footprints
+        )
 
     def _arrived(self, t: Telemetry, pos_enu_m: Vec3, heading_deg: float | None) -> bool:
         p = self.params.mission

@@ -5,10 +5,11 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from uavtool.mission.measure import measure_from_above
 from uavtool.mission.modelling import photograph_and_model
 from uavtool.mission.outputs import Level, Plan, Status
 from uavtool.mission.search import search
-from uavtool.mission.survey import overview_heading_deg, survey
+from uavtool.mission.survey import Survey, overview_heading_deg, survey
 from uavtool.nav import route_length_m, visit_order
 
 if TYPE_CHECKING:
@@ -35,11 +36,12 @@ def fly(m: Mission) -> Wait[None]:
     yield from m.move((here[0], here[1], p.overview_alt_m), heading, "overview position")
 
     seen = yield from survey(m)
-    pois = seen.pois
-    if not pois:
+    if not seen.pois:
         raise m.end(Status.NO_MATCH, "the overview photos show no building")
     start = (m.last.pos_enu_m[0], m.last.pos_enu_m[1]) if m.last else (0.0, 0.0)
-    points = [poi.pos_en_m for poi in pois]
+    seen = yield from measure_from_above(m, seen, visit_order(start, _points(seen)))
+    pois = seen.pois
+    points = _points(seen)
     order = visit_order(start, points)
     m.plan = Plan(seen.photo.frame_index, pois, order, route_length_m(start, points, order))
     m.emit(m.plan)
@@ -59,3 +61,7 @@ def fly(m: Mission) -> Wait[None]:
     if not p.gimbal:
         raise m.end(Status.PARTIAL, NO_GIMBAL_REASON)
     yield from photograph_and_model(m, found, seen, transit_m)
+
+
+def _points(seen: Survey) -> list[tuple[float, float]]:
+    return [poi.pos_en_m for poi in seen.pois]

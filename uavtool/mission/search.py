@@ -94,7 +94,11 @@ def search(
         k = todo.pop(0)
         poi = pois[k]
         x, y = poi.pos_en_m
+        # a roof of unknown height is looked at from the ceiling: a closer look follows only
+        # once a look has measured it
         alt = min(look_altitude_m(m, poi, overview.intrinsics), ceiling_m)
+        if not poi.roof_measured:
+            alt = ceiling_m
         yield from m.travel((x, y, alt), None, transit_m, f"point of interest {k}")
         m.visited.append(k)
         looks = [(yield from _look(m, k, 1, alt, poi.colour_rgb))]

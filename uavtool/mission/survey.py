@@ -56,36 +56,51 @@ def survey(m: Mission) -> Wait[Survey]:
     high = yield from m.photo("overview-2", -90.0)
     shapes = photo_shapes(m, high)
     found = [_measure(m, shape, high, low, low_shapes) for shape in shapes]
-    known_m = sorted(h for h in found if h is not None)
-    # An unmeasured roof is assumed tall where that is the safe guess (altitudes), and as
-    # high as the measured ones are (their median) where the best guess is (positions).
-    typical_m = known_m[len(known_m) // 2] if known_m else 0.0
     measured = [h is not None for h in found]
     roofs = [p.assumed_roof_m if h is None else h for h in found]
-    planes = [typical_m if h is None else h for h in found]
     footprints = tuple(
-        _footprint(s, high, z) if h is not None else _anywhere(s, high, p.assumed_roof_m)
-        for s, z, h in zip(shapes, planes, found, strict=True)
+        footprint_at(s, high, h) if h is not None else _anywhere(s, high, p.assumed_roof_m)
+        for s, h in zip(shapes, found, strict=True)
     )
-    pois: list[PointOfInterest] = []
-    for i, shape in enumerate(shapes):
-        if shape.area_px < p.min_poi_area_px and not shape.cut_by_border:
-            continue  # too small for a building; one cut by the border may be any size
-        u, v = shape.centroid_px
-        pos = ground_point(u, v, high.pose, high.intrinsics, plane_z_m=planes[i])
-        extent = _extent_m(footprints[i])
-        pois.append(
-            PointOfInterest(
-                len(pois), i, pos, shape.colour_rgb, shape.area_px, roofs[i], measured[i], extent
-            )
-        )
+    pois = points_of_interest(m, shapes, high, roofs, measured, footprints)
     known = sum(measured)
     m.event(
         Level.INFO,
         f"roof heights measured for {known} of {len(shapes)} buildings"
         + (f" (others assumed {p.assumed_roof_m:g} m)" if known < len(shapes) else ""),
     )
-    return Survey(high, shapes, tuple(roofs), tuple(measured), footprints, tuple(pois))
+    return Survey(high, shapes, tuple(roofs), tuple(measured), footprints, pois)
+
+
+def points_of_interest(
+    m: Mission,
+    shapes: tuple[Shape, ...],
+    photo: Photo,
+    roofs_m: list[float],
+    measured: list[bool],
+    footprints: tuple[tuple[tuple[float, float], ...], ...],
+) -> tuple[PointOfInterest, ...]:
+    """A point of interest per shape of the overview ``photo`` large enough for a building.
+    An unmeasured roof is assumed tall where that is the safe guess (``roofs_m``, for
+    altitudes), and as high as the measured ones are (their median) where the best guess is
+    (its position)."""
+    p = m.params.mission
+    known_m = sorted(h for h, ok in zip(roofs_m, measured, strict=True) if ok)
+    typical_m = known_m[len(known_m) // 2] if known_m else 0.0
+    pois: list[PointOfInterest] = []
+    for i, shape in enumerate(shapes):
+        if shape.area_px < p.min_poi_area_px and not shape.cut_by_border:
+            continue  # too small for a building; one cut by the border may be any size
+        u, v = shape.centroid_px
+        plane_m = roofs_m[i] if measured[i] else typical_m
+        pos = ground_point(u, v, photo.pose, photo.intrinsics, plane_z_m=plane_m)
+        extent = _extent_m(footprints[i])
+        pois.append(
+            PointOfInterest(
+                len(pois), i, pos, shape.colour_rgb, shape.area_px, roofs_m[i], measured[i], extent
+            )
+        )
+    return tuple(pois)
 
 
 def overview_heading_deg(heading_deg: float) -> float:
@@ -140,7 +155,7 @@ def _measure(
     return roof_between(best[1], low, shape, high)
 
 
-def _footprint(shape: Shape, photo: Photo, roof_m: float) -> tuple[tuple[float, float], ...]:
+def footprint_at(shape: Shape, photo: Photo, roof_m: float) -> tuple[tuple[float, float], ...]:
     try:
         return ground_polygon(shape.polygon_px, photo.pose, photo.intrinsics, plane_z_m=roof_m)
     except NavError:  # a roof assumed above the camera: place it on the ground instead
@@ -222,7 +237,7 @@ def remeasured_obstacles(
         if not seen.measured[i] and not shape.cut_by_border:
             roof = _measure_against(m, shape, seen.photo, photo, shapes)
             if roof is not None and roof <= p.assumed_roof_m + p.min_above_roof_m:
-                footprint = _footprint(shape, seen.photo, roof)
+                footprint = footprint_at(shape, seen.photo, roof)
         out.append(footprint)
     return out
 
@@ -251,8 +266,8 @@ def _measure_against(
 def _anywhere(shape: Shape, photo: Photo, tallest_m: float) -> tuple[tuple[float, float], ...]:
     """Where a building of unknown height (up to ``tallest_m``) may stand: its roof's outline
     projected on the ground and on the tallest roof plane, and everything between."""
-    ground = _footprint(shape, photo, 0.0)
-    top = _footprint(shape, photo, tallest_m)
+    ground = footprint_at(shape, photo, 0.0)
+    top = footprint_at(shape, photo, tallest_m)
     return tuple(convex_hull([*ground, *top]))
 
 

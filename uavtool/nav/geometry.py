@@ -136,3 +136,13 @@ def triangle_hits_polygon(tri: Sequence[Point], poly: Sequence[Point]) -> bool:
     if _in_triangle(poly[0], tri):
         return True
     return len(poly) >= 3 and point_in_polygon(tri[0], poly)
+
+
+def segment_polygon_distance(a: Point, b: Point, poly: Sequence[Point]) -> float:
+    """Distance from the closed segment ``a``–``b`` to the polygon's area: 0 when they touch."""
+    if len(poly) >= 3 and (
+        point_in_polygon(a, poly) or any(segments_intersect(a, b, c, d) for c, d in _edges(poly))
+    ):
+        return 0.0
+    ends = (point_polygon_distance(a, poly), point_polygon_distance(b, poly))
+    return min(*ends, *(point_segment_distance(q, a, b) for q in poly))

@@ -18,8 +18,10 @@ home, as the altitudes.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 from uavtool.camera import CameraPose, Intrinsics
+from uavtool.nav.geometry import point_segment_distance
 
 SIZE_ERROR = 0.01
 """Relative error of a roof's linear size in pixels (its outline's area, square-rooted)."""
@@ -105,3 +107,132 @@ def _run_per_descent(
     if not d[2] < 0.0:
         return None
     return d[0] / -d[2], d[1] / -d[2]
+
+
+CUT_FIT_TOLERANCE_PX = 1.5
+"""How far (RMS, pixels) the visible edges of a roof cut by one photo's border may lie from
+where the other photo's whole outline puts them at the fitted height: about the outline's own
+error (half a pixel of tracing, one of simplification) with room for perspective on walls."""
+
+
+def roof_from_cut_outline(
+    *,
+    whole_ring_px: Sequence[tuple[float, float]],
+    whole_pose: CameraPose,
+    cut_ring_px: Sequence[tuple[float, float]],
+    cut_pose: CameraPose,
+    intrinsics: Intrinsics,
+    max_m: float,
+    border_px: float = 3.0,
+) -> float | None:
+    """The height of a roof seen whole in one photo and cut by the other's border: the height
+    at which the whole outline, placed on that plane and seen from the other camera, lies on
+    the edges the cut outline shows inside the frame (its own border edges say nothing).
+
+    Scans 0..``max_m`` (below both cameras) in metre steps, then refines to a centimetre. None
+    when fewer than three metres of edge show inside the frame, when no height puts the edges
+    within `CUT_FIT_TOLERANCE_PX`, or when the best height is not clearly the only one (a
+    roof straight below both cameras: no parallax).
+    """
+    k = intrinsics
+    samples = _inner_edge_points(cut_ring_px, k, border_px)
+    if len(samples) < 3:
+        return None
+    top_m = min(max_m, whole_pose.pos_enu_m[2] - 1.0, cut_pose.pos_enu_m[2] - 1.0)
+    if top_m <= 0.0:
+        return None
+
+    def cost(h_m: float) -> float:
+        ring = _reprojected(whole_ring_px, whole_pose, cut_pose, k, h_m)
+        if ring is None:
+            return math.inf
+        total = 0.0
+        for p in samples:
+            d = min(point_segment_distance(p, a, b) for a, b in _ring_edges(ring))
+            total += d * d
+        return math.sqrt(total / len(samples))
+
+    steps = int(top_m)
+    coarse = [(cost(float(i)), float(i)) for i in range(steps + 1)]
+    _, h0 = min(coarse)
+    lo, hi = max(h0 - 1.0, 0.0), min(h0 + 1.0, top_m)
+    for _ in range(40):  # golden-section search on the bracket around the best metre
+        a = hi - (hi - lo) * 0.6180339887498949
+        b = lo + (hi - lo) * 0.6180339887498949
+        if cost(a) <= cost(b):
+            hi = b
+        else:
+            lo = a
+        if hi - lo < 0.01:
+            break
+    h = (lo + hi) / 2.0
+    best = cost(h)
+    if not best <= CUT_FIT_TOLERANCE_PX:
+        return None
+    # identifiable: a height 10 % of the camera's distance away must fit clearly worse
+    away_m = 0.1 * (cut_pose.pos_enu_m[2] - h)
+    rivals = [cost(x) for x in (h - away_m, h + away_m) if 0.0 <= x <= top_m]
+    if rivals and min(rivals) < best + CUT_FIT_TOLERANCE_PX:
+        return None
+    return h
+
+
+def _inner_edge_points(
+    ring_px: Sequence[tuple[float, float]], k: Intrinsics, border_px: float
+) -> list[tuple[float, float]]:
+    """Points every two pixels along the ring's edges, those at least ``border_px`` inside
+    the frame (the frame's border is where the outline was cut, not an edge of the roof)."""
+    out = []
+    lo_u, hi_u = border_px, k.width_px - 1.0 - border_px
+    lo_v, hi_v = border_px, k.height_px - 1.0 - border_px
+    for a, b in _ring_edges(ring_px):
+        n = max(1, int(math.hypot(b[0] - a[0], b[1] - a[1]) / 2.0))
+        for i in range(n):
+            t = i / n
+            u, v = a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])
+            if lo_u <= u <= hi_u and lo_v <= v <= hi_v:
+                out.append((u, v))
+    return out
+
+
+def _ring_edges(
+    ring: Sequence[tuple[float, float]],
+) -> list[tuple[tuple[float, float], tuple[float, float]]]:
+    n = len(ring)
+    return [(ring[i], ring[(i + 1) % n]) for i in range(n)]
+
+
+def _reprojected(
+    ring_px: Sequence[tuple[float, float]],
+    pose: CameraPose,
+    other: CameraPose,
+    k: Intrinsics,
+    plane_z_m: float,
+) -> list[tuple[float, float]] | None:
+    """``ring_px`` of ``pose``'s photo placed on the plane z = ``plane_z_m`` and seen from
+    ``other``: its pixels there (None if a vertex falls behind that camera)."""
+    right, down, forward = pose.axes()
+    o_right, o_down, o_forward = other.axes()
+    cx, cy, cz = pose.pos_enu_m
+    ox, oy, oz = other.pos_enu_m
+    out = []
+    for u, v in ring_px:
+        x = (u - k.cx_px) / k.fx_px
+        y = (v - k.cy_px) / k.fy_px
+        d = [right[i] * x + down[i] * y + forward[i] for i in range(3)]
+        if not d[2] < 0.0:
+            return None
+        t = (cz - plane_z_m) / -d[2]
+        p = (cx + t * d[0] - ox, cy + t * d[1] - oy, plane_z_m - oz)
+        depth = p[0] * o_forward[0] + p[1] * o_forward[1] + p[2] * o_forward[2]
+        if not depth > 0.0:
+            return None
+        out.append(
+            (
+                k.fx_px * (p[0] * o_right[0] + p[1] * o_right[1] + p[2] * o_right[2]) / depth
+                + k.cx_px,
+                k.fy_px * (p[0] * o_down[0] + p[1] * o_down[1] + p[2] * o_down[2]) / depth
+                + k.cy_px,
+            )
+        )
+    return out

@@ -1,0 +1,145 @@
+"""Roofs measured before any is flown near.
+
+The two overviews measure only the roofs seen whole in both, and the lower one sees a smaller
+area: most roofs away from home stay unmeasured, and an unmeasured roof may be taller than
+``mission.assumed_roof_m`` (a tower). Before descending anywhere, the mission crosses at the
+second overview's altitude — space the overview showed free: every roof in it is below the
+camera — to above each point of interest whose roof is unknown, and photographs straight down.
+Each such photo and the overview see the roofs from two places, so every roof whole in both is
+triangulated, and one cut by a border is fitted by its visible edges
+(:func:`uavtool.nav.heights.roof_from_cut_outline`). A roof measured taller than expected is
+believed: as an obstacle, too tall is safe and too low is not.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+from uavtool.mission.analysis import roof_between
+from uavtool.mission.observations import Photo
+from uavtool.mission.outputs import Level
+from uavtool.mission.search import photo_shapes
+from uavtool.mission.survey import Survey, footprint_at, points_of_interest
+from uavtool.nav import NavError, ground_point
+from uavtool.nav.heights import roof_from_cut_outline
+from uavtool.vision import Shape
+
+if TYPE_CHECKING:
+    from uavtool.mission.mission import Mission, Wait
+
+_AGREE = 0.25
+"""How far apart the two photos may place one roof (at its height, as a share of the roof's
+size in the first photo) for their outlines to count as the same roof: a centroid moves
+with the roof's outline, a neighbour stands at least a safety margin away."""
+
+
+def measure_from_above(m: Mission, seen: Survey, order: tuple[int, ...]) -> Wait[Survey]:
+    """Photograph, from the overview's altitude, each point of interest (in ``order``) whose
+    roof is still unknown, measure every unknown roof against each photo, and return the
+    survey with those roofs, footprints and points of interest."""
+    ceiling_m = seen.photo.pose.pos_enu_m[2]
+    m.ceiling_m = ceiling_m
+    if all(seen.measured):
+        return seen
+    heading = seen.photo.pose.heading_deg
+    roofs, measured = list(seen.roofs_m), list(seen.measured)
+    before = sum(measured)
+    for k in order:
+        poi = seen.pois[k]
+        if measured[poi.shape_index]:
+            continue
+        x, y = poi.pos_en_m
+        yield from m.move((x, y, ceiling_m), heading, f"over point of interest {k}, measuring")
+        photo = yield from m.photo(f"measure-{k}", -90.0)
+        shapes = photo_shapes(m, photo)
+        for i, shape in enumerate(seen.shapes):
+            if measured[i]:
+                continue
+            roof = measure_roof(m, shape, seen.photo, photo, shapes, below_m=ceiling_m - 1.0)
+            if roof is not None:
+                roofs[i], measured[i] = roof, True
+    footprints = tuple(
+        footprint_at(s, seen.photo, roofs[i]) if measured[i] and not seen.measured[i] else fp
+        for i, (s, fp) in enumerate(zip(seen.shapes, seen.footprints, strict=True))
+    )
+    pois = points_of_interest(m, seen.shapes, seen.photo, roofs, measured, footprints)
+    taller = [
+        f"{poi.index} ({poi.roof_m:.1f} m)"
+        for poi in pois
+        if poi.roof_measured and poi.roof_m > m.params.mission.assumed_roof_m
+    ]
+    m.event(
+        Level.INFO,
+        f"roofs measured from above: {sum(measured) - before} more, {sum(measured)} of "
+        f"{len(measured)}" + (f"; taller than expected: {', '.join(taller)}" if taller else ""),
+    )
+    m.ceiling_m = ceiling_m
+    m.unknown_footprints = tuple(fp for fp, ok in zip(footprints, measured, strict=True) if not ok)
+    return replace(
+        seen, roofs_m=tuple(roofs), measured=tuple(measured), footprints=footprints, pois=pois
+    )
+
+
+def measure_roof(
+    m: Mission,
+    shape: Shape,
+    photo: Photo,
+    other: Photo,
+    others: tuple[Shape, ...],
+    *,
+    below_m: float,
+) -> float | None:
+    """The height of the roof ``shape`` (in nadir ``photo``) from the same roof in another
+    nadir photo (its ``others`` shapes): of its colour, and placed by both photos in one spot
+    at the height found. Whole in both: triangulated; whole in one: fitted by the edges the
+    other shows. None when no shape of the other photo agrees, or both are cut."""
+    tol = m.params.mission.roof_colour_tolerance_dn
+    k = photo.intrinsics
+    best: tuple[float, float] | None = None  # (disagreement px, height)
+    for cand in others:
+        if not all(
+            abs(a - b) <= tol for a, b in zip(cand.colour_rgb, shape.colour_rgb, strict=True)
+        ):
+            continue
+        if shape.cut_by_border and cand.cut_by_border:
+            continue
+        if not shape.cut_by_border and not cand.cut_by_border:
+            roof = roof_between(shape, photo, cand, other)
+        else:
+            whole, whole_photo, cut, cut_photo = (
+                (shape, photo, cand, other) if cand.cut_by_border else (cand, other, shape, photo)
+            )
+            roof = roof_from_cut_outline(
+                whole_ring_px=whole.polygon_px.tolist(),
+                whole_pose=whole_photo.pose,
+                cut_ring_px=cut.polygon_px.tolist(),
+                cut_pose=cut_photo.pose,
+                intrinsics=k,
+                max_m=below_m,
+            )
+        if roof is None or not 0.0 <= roof <= below_m:
+            continue
+        miss = _disagreement_px(shape, photo, cand, other, roof)
+        size_px = math.sqrt(shape.area_px)
+        limit_px = max(_AGREE * size_px, 2.0) * (1.0 + shape.cut_by_border)
+        if miss is not None and miss <= limit_px and (best is None or miss < best[0]):
+            best = (miss, roof)
+    return None if best is None else best[1]
+
+
+def _disagreement_px(
+    shape: Shape, photo: Photo, cand: Shape, other: Photo, roof_m: float
+) -> float | None:
+    """How far apart the two photos put the roof's centre on its own plane, in pixels of
+    ``photo`` there (for a cut outline, its centroid is only roughly the roof's: the caller
+    allows more)."""
+    k = photo.intrinsics
+    try:
+        a = ground_point(*shape.centroid_px, photo.pose, k, plane_z_m=roof_m)
+        b = ground_point(*cand.centroid_px, other.pose, other.intrinsics, plane_z_m=roof_m)
+    except NavError:
+        return None
+    metres_per_px = (photo.pose.pos_enu_m[2] - roof_m) / k.fx_px
+    return math.dist(a, b) / metres_per_px if metres_per_px > 0.0 else None
