@@ -219,6 +219,31 @@ def test_a_refused_take_off_ends_disarmed_on_the_ground(tmp_path: Path) -> None:
     assert "landed and disarmed" in result.output
 
 
+@pytest.mark.parametrize(
+    ("name", "colour"),
+    [("concrete", [165, 165, 170]), ("dark red", [120, 25, 25]), ("black", [30, 30, 30])],
+)
+def test_a_building_of_no_building_colour_is_an_obstacle(
+    tmp_path: Path, name: str, colour: list[int]
+) -> None:
+    """A 14 m block on the way home that the vectorizer leaves out (grey; a darker shade of
+    the target's red; black): the flight used to cross it at 11.6 m and crash. Everything
+    that is not ground is an obstacle: its roof is measured and the way home crosses over it
+    by the safety margin."""
+    data = scene_to_dict(load_scene("paper"))
+    block = {"footprint": _square(20, -18.3, 1.5), "top_m": 14}
+    data["buildings"].append({"name": "block", "color": colour, "blocks": [block]})
+    scene = tmp_path / "block.json"
+    scene.write_text(json.dumps(data))
+    result = CliRunner().invoke(cli, ["fly", "--scene", str(scene), "--no-record"])
+    assert result.exit_code == 0, result.output
+    found = re.search(r"1 obstacles of no building colour .*: roofs ([\d.]+) m", result.output)
+    assert found is not None and float(found.group(1)) == pytest.approx(14.0, abs=0.5), name
+    # the safety margin is 4 m; the roof measured up to half a metre low may take from it
+    clearance = re.search(r"clearance +(-?[\d.]+) m from building", result.output)
+    assert clearance is not None and float(clearance.group(1)) >= 3.5
+
+
 def test_a_tower_taller_than_expected_is_measured_before_it_is_flown_near(tmp_path: Path) -> None:
     """A 45 m tower (taller than mission.assumed_roof_m, 25 m) out of the lower overview's
     view: the mission measures it from above before descending anywhere, crosses over it

@@ -3,8 +3,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from uavtool.camera import CameraPose, Intrinsics
 from uavtool.vision import VectorizeParams, vectorize
 from uavtool.vision.errors import ImageError, VisionParamError
+from uavtool.vision.vectorize import non_ground
+from uavtool.world import render, scene_from_dict
 
 from .synth import draw, family_shape, place
 
@@ -117,3 +120,34 @@ def test_from_above_a_hole_showing_only_the_buildings_own_walls_is_no_hole() -> 
     (plain,) = vectorize(walled, VectorizeParams(roof_only=True))
     assert plain.holes_px == ()
     assert plain.area_px == pytest.approx(320 * 220, rel=0.02)
+
+
+def test_non_ground_finds_what_vectorize_leaves_out() -> None:
+    """Grey and black are no building colours to vectorize (nor, where it shares a region's
+    colour class, a darker shade); every one is a roof not on the ground for the obstacle map,
+    the ground none."""
+    scene = scene_from_dict(
+        {
+            "target": "red",
+            "buildings": [
+                {"name": "red", "color": [210, 40, 40],
+                 "blocks": [{"footprint": [[-12, -4], [-6, -4], [-6, 2], [-12, 2]], "top_m": 5}]},
+                {"name": "dark red", "color": [110, 20, 20],
+                 "blocks": [{"footprint": [[4, -4], [10, -4], [10, 2], [4, 2]], "top_m": 5}]},
+                {"name": "concrete", "color": [170, 170, 175],
+                 "blocks": [{"footprint": [[-12, 6], [-6, 6], [-6, 12], [-12, 12]], "top_m": 8}]},
+                {"name": "black", "color": [25, 25, 25],
+                 "blocks": [{"footprint": [[4, 6], [10, 6], [10, 12], [4, 12]], "top_m": 3}]},
+            ],
+        }
+    )  # fmt: skip
+    k = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
+    image = render(scene, CameraPose((0.0, 0.0, 45.0), 0.0, -90.0), k)
+    assert len(vectorize(image)) == 2  # the reds only: grey and black are no building colour
+    roofs = non_ground(image)
+    assert len(roofs) == 4
+    # each roof where its building is: pixels grow east (u) and south (v) of the centre
+    west_south = [s for s in roofs if s.centroid_px[0] < 320 and s.centroid_px[1] > 240]
+    assert len(west_south) == 1 and west_south[0].colour_rgb[0] > 150  # the red roof
+    assert all(not s.cut_by_border for s in roofs)
+    assert non_ground(np.full((480, 640, 3), 128, np.uint8)) == ()

@@ -15,16 +15,26 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
+
+import cv2
+import numpy as np
 
 from uavtool.mission.analysis import roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level
 from uavtool.mission.search import photo_shapes
-from uavtool.mission.survey import Survey, footprint_at, points_of_interest
+from uavtool.mission.survey import (
+    Obstacle,
+    Survey,
+    anywhere,
+    footprint_at,
+    points_of_interest,
+)
 from uavtool.nav import NavError, ground_point
 from uavtool.nav.heights import roof_from_cut_outline
 from uavtool.vision import Shape
+from uavtool.vision.vectorize import non_ground
 
 if TYPE_CHECKING:
     from uavtool.mission.mission import Mission, Wait
@@ -41,25 +51,62 @@ def measure_from_above(m: Mission, seen: Survey, order: tuple[int, ...]) -> Wait
     survey with those roofs, footprints and points of interest."""
     ceiling_m = seen.photo.pose.pos_enu_m[2]
     m.ceiling_m = ceiling_m
-    if all(seen.measured):
+    below_m = ceiling_m - 1.0
+    obstacles = _unclassified(m, seen)
+    if all(seen.measured) and not obstacles:
         return seen
+    if obstacles and seen.lower is not None:
+        lower = non_ground(seen.lower.image_rgb, m.params.vectorize)
+        for o in obstacles:
+            o[1] = measure_roof(m, o[0], seen.photo, seen.lower, lower, below_m=below_m)
     heading = seen.photo.pose.heading_deg
     roofs, measured = list(seen.roofs_m), list(seen.measured)
     before = sum(measured)
-    for k in order:
-        poi = seen.pois[k]
-        if measured[poi.shape_index]:
-            continue
-        x, y = poi.pos_en_m
-        yield from m.move((x, y, ceiling_m), heading, f"over point of interest {k}, measuring")
-        photo = yield from m.photo(f"measure-{k}", -90.0)
+    k_high = seen.photo.intrinsics
+    stops = [(f"point of interest {k}", f"measure-{k}", seen.pois[k].shape_index) for k in order]
+    stops += [(f"obstacle {j}", f"measure-obstacle-{j}", -1 - j) for j in range(len(obstacles))]
+    for what, tag, index in stops:
+        if index >= 0:
+            if measured[index]:
+                continue
+            x, y = next(poi.pos_en_m for poi in seen.pois if poi.shape_index == index)
+        else:
+            if obstacles[-1 - index][1] is not None:
+                continue
+            u, v = obstacles[-1 - index][0].centroid_px
+            x, y = ground_point(u, v, seen.photo.pose, k_high)
+        yield from m.move((x, y, ceiling_m), heading, f"over {what}, measuring")
+        photo = yield from m.photo(tag, -90.0)
         shapes = photo_shapes(m, photo)
         for i, shape in enumerate(seen.shapes):
             if measured[i]:
                 continue
-            roof = measure_roof(m, shape, seen.photo, photo, shapes, below_m=ceiling_m - 1.0)
+            roof = measure_roof(m, shape, seen.photo, photo, shapes, below_m=below_m)
             if roof is not None:
                 roofs[i], measured[i] = roof, True
+        if any(o[1] is None for o in obstacles):
+            others = non_ground(photo.image_rgb, m.params.vectorize)
+            for o in obstacles:
+                if o[1] is None:
+                    o[1] = measure_roof(m, o[0], seen.photo, photo, others, below_m=below_m)
+    assumed_m = m.params.mission.assumed_roof_m
+    found = tuple(
+        Obstacle(
+            shape,
+            assumed_m if roof is None else roof,
+            roof is not None,
+            anywhere(shape, seen.photo, assumed_m)
+            if roof is None
+            else footprint_at(shape, seen.photo, roof),
+        )
+        for shape, roof in obstacles
+    )
+    if found:
+        m.event(
+            Level.INFO,
+            f"{len(found)} obstacles of no building colour (grey, or a darker shade): roofs "
+            + ", ".join(f"{o.roof_m:.1f} m" if o.measured else "unknown" for o in found),
+        )
     footprints = tuple(
         footprint_at(s, seen.photo, roofs[i]) if measured[i] and not seen.measured[i] else fp
         for i, (s, fp) in enumerate(zip(seen.shapes, seen.footprints, strict=True))
@@ -75,11 +122,39 @@ def measure_from_above(m: Mission, seen: Survey, order: tuple[int, ...]) -> Wait
         f"roofs measured from above: {sum(measured) - before} more, {sum(measured)} of "
         f"{len(measured)}" + (f"; taller than expected: {', '.join(taller)}" if taller else ""),
     )
-    m.ceiling_m = ceiling_m
-    m.unknown_footprints = tuple(fp for fp, ok in zip(footprints, measured, strict=True) if not ok)
+    m.unknown_footprints = tuple(
+        fp for fp, ok in zip(footprints, measured, strict=True) if not ok
+    ) + tuple(o.footprint for o in found if not o.measured)
     return replace(
-        seen, roofs_m=tuple(roofs), measured=tuple(measured), footprints=footprints, pois=pois
+        seen,
+        roofs_m=tuple(roofs),
+        measured=tuple(measured),
+        footprints=footprints,
+        pois=pois,
+        obstacles=found,
     )
+
+
+def _unclassified(m: Mission, seen: Survey) -> list[list[Any]]:
+    """[shape, roof or None] for each region of the higher overview that is not ground and
+    shares no pixel with a building the vectorizer found (a coloured roof and its walls are
+    one region)."""
+    k = seen.photo.intrinsics
+    found = np.zeros((k.height_px, k.width_px), np.uint8)
+    cv2.fillPoly(found, [_pixels(s.polygon_px) for s in seen.shapes], 255)
+    out: list[list[Any]] = []
+    for region in non_ground(seen.photo.image_rgb, m.params.vectorize):
+        if region.area_px < m.params.vectorize.min_area_px:
+            continue
+        own = np.zeros_like(found)
+        cv2.fillPoly(own, [_pixels(region.polygon_px)], 255)
+        if cv2.countNonZero(cv2.bitwise_and(own, found)) == 0:
+            out.append([region, None])
+    return out
+
+
+def _pixels(polygon_px: Any) -> Any:
+    return np.round(np.asarray(polygon_px)).astype(np.int32).reshape(-1, 1, 2)
 
 
 def measure_roof(

@@ -38,10 +38,27 @@ class Survey:
     measured: tuple[bool, ...]
     footprints: tuple[tuple[tuple[float, float], ...], ...]
     pois: tuple[PointOfInterest, ...]
+    lower: Photo | None = None
+    """The lower overview photo."""
+    obstacles: tuple[Obstacle, ...] = ()
+    """What else is not ground in the higher photo: buildings of no colour the vectorizer
+    keeps (grey, white, black, a darker shade of another's colour)."""
 
     @property
     def highest_roof_m(self) -> float:
-        return max(self.roofs_m, default=0.0)
+        return max((*self.roofs_m, *(o.roof_m for o in self.obstacles)), default=0.0)
+
+
+@dataclass(frozen=True, slots=True)
+class Obstacle:
+    """A region of the higher overview that is not ground and no building of a colour: its
+    outline there, its roof's height (measured, or assumed ``mission.assumed_roof_m``) and
+    where it stands (for an unknown height, everywhere it may)."""
+
+    shape: Shape
+    roof_m: float
+    measured: bool
+    footprint: tuple[tuple[float, float], ...]
 
 
 def survey(m: Mission) -> Wait[Survey]:
@@ -59,7 +76,7 @@ def survey(m: Mission) -> Wait[Survey]:
     measured = [h is not None for h in found]
     roofs = [p.assumed_roof_m if h is None else h for h in found]
     footprints = tuple(
-        footprint_at(s, high, h) if h is not None else _anywhere(s, high, p.assumed_roof_m)
+        footprint_at(s, high, h) if h is not None else anywhere(s, high, p.assumed_roof_m)
         for s, h in zip(shapes, found, strict=True)
     )
     pois = points_of_interest(m, shapes, high, roofs, measured, footprints)
@@ -69,7 +86,7 @@ def survey(m: Mission) -> Wait[Survey]:
         f"roof heights measured for {known} of {len(shapes)} buildings"
         + (f" (others assumed {p.assumed_roof_m:g} m)" if known < len(shapes) else ""),
     )
-    return Survey(high, shapes, tuple(roofs), tuple(measured), footprints, pois)
+    return Survey(high, shapes, tuple(roofs), tuple(measured), footprints, pois, lower=low)
 
 
 def points_of_interest(
@@ -189,9 +206,12 @@ def same_building(m: Mission, seen: Survey, target: int) -> frozenset[int]:
 def obstacles_around(
     m: Mission, seen: Survey, target: int
 ) -> list[tuple[tuple[float, float], ...]]:
-    """The survey's footprints of every building but the target (and its other roofs)."""
+    """The survey's footprints of every building but the target (and its other roofs), and
+    of everything else that is not ground."""
     own = same_building(m, seen, target)
-    return [f for i, f in enumerate(seen.footprints) if i not in own]
+    return [f for i, f in enumerate(seen.footprints) if i not in own] + [
+        o.footprint for o in seen.obstacles
+    ]
 
 
 def beyond_the_frame(seen: Survey) -> list[tuple[tuple[float, float], ...]]:
@@ -229,7 +249,7 @@ def remeasured_obstacles(
     shows them whole."""
     p = m.params.mission
     own = same_building(m, seen, target)
-    out = []
+    out = [o.footprint for o in seen.obstacles]
     for i, shape in enumerate(seen.shapes):
         if i in own:
             continue
@@ -263,7 +283,7 @@ def _measure_against(
     return None if best is None else roof_between(shape, photo, best[1], other)
 
 
-def _anywhere(shape: Shape, photo: Photo, tallest_m: float) -> tuple[tuple[float, float], ...]:
+def anywhere(shape: Shape, photo: Photo, tallest_m: float) -> tuple[tuple[float, float], ...]:
     """Where a building of unknown height (up to ``tallest_m``) may stand: its roof's outline
     projected on the ground and on the tallest roof plane, and everything between."""
     ground = footprint_at(shape, photo, 0.0)

@@ -28,7 +28,7 @@ U8Array = npt.NDArray[np.uint8]
 CvArray = npt.NDArray[Any]
 
 # hue_of and hue_distance_deg live in uavtool.vision.colour; importable from here too.
-__all__ = ["CvArray", "U8Array", "hue_distance_deg", "hue_of", "vectorize"]
+__all__ = ["CvArray", "U8Array", "hue_distance_deg", "hue_of", "non_ground", "vectorize"]
 
 
 def vectorize(frame_rgb: U8Array, params: VectorizeParams | None = None) -> tuple[Shape, ...]:
@@ -90,6 +90,80 @@ def vectorize(frame_rgb: U8Array, params: VectorizeParams | None = None) -> tupl
         shapes.append((r.colour_class, -shape.area_px, order, _with_colour(shape, colour)))
     shapes.sort(key=lambda t: t[:3])
     return tuple(s for *_, s in shapes)
+
+
+def non_ground(
+    frame_rgb: U8Array, params: VectorizeParams | None = None, *, tolerance_dn: int = 15
+) -> tuple[Shape, ...]:
+    """The roofs of everything in an RGB frame that is not the ground, whatever its colour,
+    largest first. Not ground: pixels differing from the ground's colour (the frame's most
+    common colour, to 8 levels) by more than ``tolerance_dn`` in a channel; a roof: the part
+    of such a region in the region's own most common colour (its walls are shaded apart).
+    This is what the obstacle map is made of: grey, white or black roofs, and a darker shade
+    of a colour, which :func:`vectorize` leaves out, are here."""
+    p = params if params is not None else VectorizeParams()
+    frame = _check_frame(frame_rgb)
+    cv2.setNumThreads(1)
+    mask = cv2.bitwise_not(_near(frame, _mode_rgb(frame, None), tolerance_dn))
+    if p.denoise_px > 1:
+        mask = cv2.medianBlur(mask, p.denoise_px)
+    regions = _regions(mask, mask, (0, 0), frame.shape[:2], 1, p)
+    roofs: list[_Region] = []
+    for r in regions:
+        inside = np.zeros_like(mask)
+        cv2.drawContours(inside, [r.contour], 0, 255, cv2.FILLED)
+        roof = cv2.bitwise_and(_near(frame, _roof_rgb(frame, inside), 6), inside)
+        if p.denoise_px > 1:
+            roof = cv2.medianBlur(roof, p.denoise_px)
+        found = _regions(roof, roof, (0, 0), frame.shape[:2], 1, p)
+        if found:
+            roofs.append(max(found, key=lambda f: cv2.contourArea(f.contour)))
+    rings = simplify_rings([c for r in roofs for c in (r.outer, *r.holes)], p)
+    shapes: list[tuple[float, int, Shape]] = []
+    at = 0
+    for order, r in enumerate(roofs):
+        outer, holes = rings[at], rings[at + 1 : at + 1 + len(r.holes)]
+        at += 1 + len(r.holes)
+        if len(outer) < 3:
+            continue
+        shape = _offset_shape(outer, tuple(h for h in holes if len(h) >= 3), r.cut, p)
+        shapes.append((-shape.area_px, order, _with_colour(shape, _inside_colour(frame, r, shape))))
+    shapes.sort(key=lambda t: t[:2])
+    return tuple(s for *_, s in shapes)
+
+
+def _near(frame: U8Array, rgb: tuple[int, int, int], tolerance_dn: int) -> CvArray:
+    lo = np.array([max(c - tolerance_dn, 0) for c in rgb], np.uint8)
+    hi = np.array([min(c + tolerance_dn, 255) for c in rgb], np.uint8)
+    return cv2.inRange(frame, lo, hi)
+
+
+_ROOF_SHARE = 0.1
+"""The least share of a region's pixels a colour must hold to be its roof's."""
+
+
+def _roof_rgb(frame: U8Array, mask: CvArray) -> tuple[int, int, int]:
+    """The brightest colour (to 8 levels) holding at least `_ROOF_SHARE` of the pixels under
+    ``mask``: from above, in daylight, a roof is lit better than the walls around it."""
+    q = (frame >> 3).astype(np.int32)
+    codes = ((q[:, :, 0] << 10) | (q[:, :, 1] << 5) | q[:, :, 2])[mask != 0]
+    counts = np.bincount(codes, minlength=1 << 15)
+    common = np.flatnonzero(counts >= _ROOF_SHARE * len(codes))
+    if len(common) == 0:
+        common = np.array([int(np.argmax(counts))])
+    brightness = (common >> 10) + ((common >> 5) & 31) + (common & 31)
+    code = int(common[int(np.argmax(brightness))])
+    return ((code >> 10) * 8 + 4, ((code >> 5) & 31) * 8 + 4, (code & 31) * 8 + 4)
+
+
+def _mode_rgb(frame: U8Array, mask: CvArray | None) -> tuple[int, int, int]:
+    """The most common colour of the frame (or of its pixels under ``mask``), each channel
+    quantized to 8 levels (bin centres)."""
+    q = (frame >> 3).astype(np.int32)
+    codes = (q[:, :, 0] << 10) | (q[:, :, 1] << 5) | q[:, :, 2]
+    values = codes.ravel() if mask is None else codes[mask != 0]
+    code = int(np.argmax(np.bincount(values, minlength=1 << 15)))
+    return ((code >> 10) * 8 + 4, ((code >> 5) & 31) * 8 + 4, (code & 31) * 8 + 4)
 
 
 def _check_frame(frame_rgb: U8Array) -> U8Array:
