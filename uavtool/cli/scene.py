@@ -204,7 +204,8 @@ def show(scene_ref: str, size: str, output: Path) -> None:
     "--buildings",
     default=None,
     type=Number(Range(1), integer=True),
-    help="Number of buildings.  [default: 8; with --hard 5-8, drawn from the seed]",
+    help="Number of buildings.  [default: 8; with --hard 5-8, drawn from the seed; with "
+    "--town 6-9, 12-16 in a dense block]",
 )
 @click.option(
     "--margin",
@@ -228,6 +229,15 @@ def show(scene_ref: str, size: str, output: Path) -> None:
 )
 @click.option("--overhang", is_flag=True, help="With --hard: home under an arch 5-7 m up.")
 @click.option(
+    "--town",
+    is_flag=True,
+    help="With --hard: scenes of a town as well (HardOptions.town()): grey, white, black and "
+    "grey-blue roofs, darker shades of a building's hue, decoys in the target's colour that "
+    "differ by a courtyard or a wing, courtyard and 3-5 m targets, 30-60 m towers (one maybe "
+    "beside home), dense blocks of 12-16 buildings 2-3 m apart; each in about a fifth to a "
+    "third of the scenes. The file's description names them.",
+)
+@click.option(
     "--random-home",
     is_flag=True,
     help="With --hard: home anywhere within 60° of the equator, the vehicle facing any way "
@@ -247,6 +257,7 @@ def random_scene(
     hard: bool,
     spread: float | None,
     overhang: bool,
+    town: bool,
     random_home: bool,
     output: Path,
 ) -> None:
@@ -254,13 +265,17 @@ def random_scene(
 
     With --hard, the target has decoys (mirror image, scaled copy, near-identical shape),
     some buildings are stepped towers or arches, and they stand wider apart than one
-    photo from 45 m covers; the file's description names the decoys.
+    photo from 45 m covers; the file's description names the decoys. --town adds what a
+    town has and the search was not tuned on: grey roofs, darker shades, same-colour
+    decoys with a yard or a wing more or less, courtyards, small targets, tall towers,
+    home beside a tower, dense blocks.
 
     \b
     Examples:
       uavtool scene random --seed 7 --buildings 10 -o random7.yaml
       uavtool scene show random7.yaml -o random7.png
       uavtool scene random --hard --seed 7 -o hard7.yaml
+      uavtool scene random --hard --town --seed 7 -o town7.yaml
     """
     from uavtool.world.scene import dump_scene
 
@@ -268,13 +283,14 @@ def random_scene(
     if suffix not in (".yaml", ".yml", ".json"):
         raise InputError(f"{output}: output must end in .yaml, .yml or .json")
     if hard:
-        s, info = _hard_scene(seed, buildings, margin, spread, overhang, random_home)
+        s, info = _hard_scene(seed, buildings, margin, spread, overhang, town, random_home)
     else:
         from uavtool.world.generator import generate_scene
 
         for flag, given in (
             ("--spread", spread is not None),
             ("--overhang", overhang),
+            ("--town", town),
             ("--random-home", random_home),
         ):
             if given:
@@ -297,17 +313,21 @@ def _hard_scene(
     margin: float,
     spread: float | None,
     overhang: bool,
+    town: bool,
     random_home: bool,
 ) -> tuple[Scene, HardSceneInfo]:
+    from dataclasses import replace
+
     from uavtool.world.hard import MAX_HARD_BUILDINGS, HardOptions, generate_hard_scene_with_info
 
-    default = HardOptions()
+    default = HardOptions.town() if town else HardOptions()
     if buildings is not None and not 1 <= buildings <= MAX_HARD_BUILDINGS:
         raise InputError(
             f"--buildings must be in 1..{MAX_HARD_BUILDINGS} with --hard, got {buildings}"
         )
     # HardOptions checks the rest (SceneError, exit 2)
-    options = HardOptions(
+    options = replace(
+        default,
         min_buildings=default.min_buildings if buildings is None else buildings,
         max_buildings=default.max_buildings if buildings is None else buildings,
         margin_m=margin,

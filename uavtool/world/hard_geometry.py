@@ -117,3 +117,103 @@ def _hausdorff_m(a: Sequence[Point], b: Sequence[Point], stop_m: float) -> float
         if worst >= stop_m:
             return stop_m
     return worst
+
+
+def segment_distance_m(a: Point, b: Point, c: Point, d: Point) -> float:
+    """Distance between the segments ``a``–``b`` and ``c``–``d``, metres (0 if they cross)."""
+    d1, d2 = _cross3(c, d, a), _cross3(c, d, b)
+    d3, d4 = _cross3(a, b, c), _cross3(a, b, d)
+    if d1 * d2 < 0.0 and d3 * d4 < 0.0:
+        return 0.0
+    return min(
+        point_segment_m(a, c, d),
+        point_segment_m(b, c, d),
+        point_segment_m(c, a, b),
+        point_segment_m(d, a, b),
+    )
+
+
+def ring_distance_m(a: Sequence[Point], b: Sequence[Point]) -> float:
+    """Least distance between two polygons, metres: 0 if they overlap or one holds the other."""
+    if inside(a[0], b) or inside(b[0], a):
+        return 0.0
+    na, nb = len(a), len(b)
+    return min(
+        segment_distance_m(a[i], a[(i + 1) % na], b[j], b[(j + 1) % nb])
+        for i in range(na)
+        for j in range(nb)
+    )
+
+
+def rectilinear(ring: Sequence[Point]) -> bool:
+    """Whether every edge runs exactly east–west or north–south (a plan before it is turned)."""
+    n = len(ring)
+    return all(
+        ring[i][0] == ring[(i + 1) % n][0] or ring[i][1] == ring[(i + 1) % n][1] for i in range(n)
+    )
+
+
+def convex_corners(ring: Sequence[Point]) -> list[bool]:
+    """Per vertex of a counter-clockwise ring: whether it turns left (a convex corner)."""
+    n = len(ring)
+    return [_cross3(ring[k - 1], ring[k], ring[(k + 1) % n]) > 0.0 for k in range(n)]
+
+
+def inset_ring(ring: Sequence[Point], widths: Sequence[float]) -> Ring | None:
+    """The counter-clockwise ring with edge ``k`` moved inwards by ``widths[k]`` metres (vertex
+    ``k`` of the result answers vertex ``k``); None if two neighbouring edges are parallel or
+    an edge turns round (the ring is too narrow for those widths)."""
+    n = len(ring)
+    lines: list[tuple[Point, Point]] = []
+    for k in range(n):
+        (x0, y0), (x1, y1) = ring[k], ring[(k + 1) % n]
+        length = math.hypot(x1 - x0, y1 - y0)
+        dx, dy = (x1 - x0) / length, (y1 - y0) / length
+        lines.append(((x0 - widths[k] * dy, y0 + widths[k] * dx), (dx, dy)))  # left: inwards
+    out: list[Point] = []
+    for k in range(n):
+        (p, d), (q, e) = lines[k - 1], lines[k]
+        den = d[0] * e[1] - d[1] * e[0]
+        if abs(den) < 1e-9:
+            return None
+        t = ((q[0] - p[0]) * e[1] - (q[1] - p[1]) * e[0]) / den
+        out.append((p[0] + t * d[0], p[1] + t * d[1]))
+    for k in range(n):  # every edge keeps its direction (none flipped over)
+        (x0, y0), (x1, y1) = ring[k], ring[(k + 1) % n]
+        (u0, v0), (u1, v1) = out[k], out[(k + 1) % n]
+        if (x1 - x0) * (u1 - u0) + (y1 - y0) * (v1 - v0) <= 0.0:
+            return None
+    return tuple(out)
+
+
+def star_centre(ring: Sequence[Point], steps: int = 12) -> Point | None:
+    """A point inside the ring from which every vertex is seen (the ring is star-shaped about
+    it), the one farthest from the edges of a grid of ``steps`` × ``steps`` over its bounding
+    box; None if no grid point sees them all. No randomness: a function of the ring."""
+    n = len(ring)
+    xs, ys = [p[0] for p in ring], [p[1] for p in ring]
+    best: Point | None = None
+    best_m = 0.0
+    for i in range(1, steps):
+        for j in range(1, steps):
+            c = (
+                min(xs) + (max(xs) - min(xs)) * i / steps,
+                min(ys) + (max(ys) - min(ys)) * j / steps,
+            )
+            if not inside(c, ring):
+                continue
+            clear = min(point_segment_m(c, ring[k], ring[(k + 1) % n]) for k in range(n))
+            if clear > best_m and _sees_all(c, ring):
+                best, best_m = c, clear
+    return best
+
+
+def _sees_all(c: Point, ring: Sequence[Point]) -> bool:
+    n = len(ring)
+    for k in range(n):
+        for m in range(n):
+            if m in (k, (k - 1) % n):
+                continue  # the edges at ring[k] meet the sight line there
+            if segment_distance_m(c, ring[k], ring[m], ring[(m + 1) % n]) < 1e-6:
+                return False
+    return True

@@ -13,7 +13,18 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from uavtool.world.generator import _index
-from uavtool.world.hard_geometry import Point, Ring, well_formed
+from uavtool.world.hard_geometry import (
+    Point,
+    Ring,
+    convex_corners,
+    inset_ring,
+    inside,
+    point_segment_m,
+    rectilinear,
+    segment_distance_m,
+    star_centre,
+    well_formed,
+)
 from uavtool.world.polygon import normalise_ring, signed_area
 
 if TYPE_CHECKING:
@@ -37,6 +48,8 @@ class Plan:
     kind: str
     outline: Ring  # seen from above: every part's footprint lies inside it
     parts: tuple[Part, ...]
+    yard: Ring | None = None  # a courtyard's open yard (courtyard_plan's: vertex k answers
+    # the outline's k)
 
 
 def uniform(rng: random.Random, lo: float, hi: float) -> float:
@@ -209,7 +222,10 @@ def mapped(plan: Plan, f: Callable[[Point], Point]) -> Plan:
     parts = tuple(
         Part(normalise_ring([f(p) for p in q.ring]), q.base_m, q.top_m) for q in plan.parts
     )
-    return Plan(plan.shape, plan.kind, normalise_ring([f(p) for p in plan.outline]), parts)
+    outline = normalise_ring([f(p) for p in plan.outline])
+    if plan.yard is None:
+        return Plan(plan.shape, plan.kind, outline, parts)
+    return Plan(plan.shape, plan.kind, outline, parts, normalise_ring([f(p) for p in plan.yard]))
 
 
 def near_copy(rng: random.Random, plan: Plan) -> Plan | None:
@@ -229,3 +245,248 @@ def near_copy(rng: random.Random, plan: Plan) -> Plan | None:
             if len(out) == len(ring):
                 return Plan(plan.shape, "plain", out, (Part(out, 0.0, top),))
     return None
+
+
+# --------------------------------------------------------------------------- town classes
+# Courtyards, copies that differ by a yard or a wing, small targets: only drawn when one of
+# HardOptions' town knobs is on (see uavtool.world.hard).
+
+_YARD_DISC_M = 2.0  # a yard cut into a solid roof holds a disc this wide
+_WALL_M = 1.2  # and leaves walls at least this thick
+_ARM_LEFT_M = 1.5  # a shortened wing keeps at least this much of its length
+
+
+def yard_parts(outline: Ring, yard: Ring, base_m: float, top_m: float) -> tuple[Part, ...] | None:
+    """The walls between ``outline`` and ``yard`` (vertex ``k`` of one answering ``k`` of the
+    other) as two blocks, split along two spokes outline[k]–yard[k]: a footprint is a simple
+    polygon, so a ring of blocks makes a through-hole. Neighbouring blocks share whole edges
+    (no vertex of one lies inside an edge of the other), so rounding opens no gap and no
+    overlap. None if no pair of spokes gives two well-formed blocks."""
+    n = len(outline)
+    if len(yard) != n:
+        return None
+    for i in range(n):
+        j = (i + n // 2) % n
+        span_a, span_b = (j - i) % n, (i - j) % n
+        a = [outline[(i + k) % n] for k in range(span_a + 1)]
+        a += [yard[(j - k) % n] for k in range(span_a + 1)]
+        b = [outline[(j + k) % n] for k in range(span_b + 1)]
+        b += [yard[(i - k) % n] for k in range(span_b + 1)]
+        if all(
+            signed_area(p) > 0.0 and len(normalise_ring(p)) == len(p) and well_formed(p)
+            for p in (a, b)
+        ):
+            return Part(tuple(a), base_m, top_m), Part(tuple(b), base_m, top_m)
+    return None
+
+
+def courtyard_plan(rng: random.Random, o: HardOptions) -> Plan:
+    """A rectangle or an L of walls 2.2–3.6 m thick around an open yard at least 2.5 m wide
+    (2.6–9 m across), one height, as two blocks."""
+    for _try in range(20):
+        if _index(rng, 2) == 0:
+            t = [uniform(rng, 2.2, 3.6) for _ in range(4)]
+            w, h = t[3] + uniform(rng, 3.0, 9.0) + t[1], t[0] + uniform(rng, 3.0, 8.0) + t[2]
+            shape, ring = "rectangle", [(0.0, 0.0), (w, 0.0), (w, h), (0.0, h)]
+        else:  # edges: south, east end, top of the east arm, east of the north arm, north, west
+            t = [uniform(rng, 2.2, 3.2) for _ in range(6)]
+            a = t[5] + uniform(rng, 2.6, 5.0) + t[3]
+            b = t[0] + uniform(rng, 2.6, 5.0) + t[2]
+            w, h = a + uniform(rng, 4.0, 9.0), b + uniform(rng, 4.0, 9.0)
+            shape, ring = "L", [(0.0, 0.0), (w, 0.0), (w, b), (a, b), (a, h), (0.0, h)]
+        top = _height(rng, o)
+        outline, _ = _centred(ring, (0.0, 0.0))
+        yard = inset_ring(outline, t)
+        if yard is None or not well_formed(yard, edge_m=2.5, gap_m=2.5):
+            continue
+        parts = yard_parts(outline, yard, 0.0, top)
+        if parts is not None:
+            return Plan(shape, "courtyard", outline, parts, yard)
+    raise AssertionError("no courtyard in 20 tries")  # the ranges above always fit
+
+
+def filled_copy(plan: Plan) -> Plan:
+    """The plan's outline as one solid block as tall as the plan."""
+    top = max(p.top_m for p in plan.parts)
+    return Plan(plan.shape, "plain", plan.outline, (Part(plan.outline, 0.0, top),))
+
+
+def yard_copy(rng: random.Random, plan: Plan) -> Plan | None:
+    """The plan's outline, as tall as the plan, with a yard cut in that holds a 2 m disc and
+    leaves walls of 1.2 m or more: for a rectilinear outline a rectangle in its roomiest
+    part, else the outline shrunk to 30–60 % about a point it is star-shaped about; None if
+    the outline has no room for that."""
+    ring = plan.outline
+    top = max(p.top_m for p in plan.parts)
+    if rectilinear(ring):
+        box = _box_yard(rng, ring)
+        parts = None if box is None else _split_round(ring, box, top)
+        if box is None or parts is None:
+            return None
+        return Plan(plan.shape, "courtyard", ring, parts, box)
+    centre = star_centre(ring)
+    if centre is None:
+        return None
+    cx, cy = centre
+    n = len(ring)
+    clear = min(point_segment_m(centre, ring[k], ring[(k + 1) % n]) for k in range(n))
+    lo = max(0.3, 0.5 * _YARD_DISC_M / clear)
+    if lo >= 0.6:
+        return None
+    for _try in range(8):
+        f = uniform(rng, lo, 0.6)
+        yard = tuple((cx + f * (x - cx), cy + f * (y - cy)) for x, y in ring)
+        wall = min(
+            segment_distance_m(ring[i], ring[(i + 1) % n], yard[j], yard[(j + 1) % n])
+            for i in range(n)
+            for j in range(n)
+        )
+        if wall >= _WALL_M and well_formed(yard):
+            parts = yard_parts(ring, yard, 0.0, top)
+            if parts is not None:
+                return Plan(plan.shape, "courtyard", ring, parts, yard)
+    return None
+
+
+def _box_yard(rng: random.Random, ring: Ring, steps: int = 16) -> Ring | None:
+    """A rectangular yard (sides parallel to the rectilinear ring's) about the grid point
+    farthest from the edges in the chessboard metric: its sides 2 m or more, its walls
+    1.2 m or more; None if the ring has no room."""
+    n = len(ring)
+    xs, ys = [p[0] for p in ring], [p[1] for p in ring]
+    best, best_m = (0.0, 0.0), 0.0
+    for i in range(1, steps):
+        for j in range(1, steps):
+            c = (
+                min(xs) + (max(xs) - min(xs)) * i / steps,
+                min(ys) + (max(ys) - min(ys)) * j / steps,
+            )
+            if inside(c, ring):
+                clear = min(_chessboard_m(c, ring[k], ring[(k + 1) % n]) for k in range(n))
+                if clear > best_m:
+                    best, best_m = c, clear
+    room = best_m - _WALL_M
+    if room < 0.5 * _YARD_DISC_M:
+        return None
+    hx = uniform(rng, max(0.5 * _YARD_DISC_M, 0.6 * room), room)
+    hy = uniform(rng, max(0.5 * _YARD_DISC_M, 0.6 * room), room)
+    return _box(best[0] - hx, best[1] - hy, best[0] + hx, best[1] + hy)
+
+
+def _chessboard_m(c: Point, a: Point, b: Point) -> float:
+    """Chessboard (L∞) distance from ``c`` to an axis-aligned segment ``a``–``b``."""
+    qx = min(max(c[0], min(a[0], b[0])), max(a[0], b[0]))
+    qy = min(max(c[1], min(a[1], b[1])), max(a[1], b[1]))
+    return max(abs(c[0] - qx), abs(c[1] - qy))
+
+
+def _split_round(outline: Ring, yard: Ring, top_m: float) -> tuple[Part, ...] | None:
+    """The walls between ``outline`` and a ``yard`` inside it as two blocks, split along two
+    spokes from opposite corners of the yard to vertices of the outline (shortest first);
+    None if no such pair gives two well-formed blocks that tile the walls."""
+    n, m = len(outline), len(yard)
+    walls = signed_area(outline) - signed_area(yard)
+    for a in range(m // 2):
+        b = a + m // 2
+        near_a = sorted(range(n), key=lambda i: math.dist(outline[i], yard[a]))
+        near_b = sorted(range(n), key=lambda j: math.dist(outline[j], yard[b]))
+        for i in near_a:
+            for j in near_b:
+                if i == j:
+                    continue
+                span, back = (j - i) % n, (b - a) % m
+                one = [outline[(i + k) % n] for k in range(span + 1)]
+                one += [yard[(b - k) % m] for k in range(back + 1)]
+                two = [outline[(j + k) % n] for k in range(n - span + 1)]
+                two += [yard[(a - k) % m] for k in range(m - back + 1)]
+                pieces = (one, two)
+                if (
+                    all(signed_area(p) > 0.0 and well_formed(p) for p in pieces)
+                    and abs(signed_area(one) + signed_area(two) - walls) < 1e-6 * walls
+                    and all(len(normalise_ring(p)) == len(p) for p in pieces)
+                ):
+                    return Part(tuple(one), 0.0, top_m), Part(tuple(two), 0.0, top_m)
+    return None
+
+
+def wing_copy(rng: random.Random, plan: Plan) -> Plan | None:
+    """The plan with one wing (an edge with two convex corners, as an arm's end) moved in by
+    2–4 m, keeping at least 1.5 m of it, or (an arm that meets the body at a reflex corner,
+    about a third of the time) the arm taken off; as tall as the plan, one block, or a
+    courtyard's two blocks with the same walls (only shortened). None for a plan whose
+    outline is not rectilinear (the radial shapes) or with no wing that allows either."""
+    ring = plan.outline
+    n = len(ring)
+    if not rectilinear(ring):
+        return None
+    convex = convex_corners(ring)
+    wings: list[tuple[int, float, bool]] = []  # tip edge, its arm's length, can come off
+    for k in range(n):
+        k1 = (k + 1) % n
+        if not (convex[k] and convex[k1]):
+            continue
+        back, ahead = math.dist(ring[k - 1], ring[k]), math.dist(ring[k1], ring[(k + 2) % n])
+        # an arm comes off where its shorter side ends in a reflex corner (the body's)
+        if back < ahead:
+            off = not convex[k - 1]
+        elif ahead < back:
+            off = not convex[(k + 2) % n]
+        else:
+            off = not convex[k - 1] and not convex[(k + 2) % n]
+        off = off and plan.yard is None
+        arm = min(back, ahead)
+        if arm - 2.0 >= _ARM_LEFT_M or off:
+            wings.append((k, arm, off))
+    if not wings:
+        return None
+    first, f, g = _index(rng, len(wings)), rng.random(), rng.random()
+    top = max(p.top_m for p in plan.parts)
+    for step in range(len(wings)):
+        k, arm, off = wings[(first + step) % len(wings)]
+        shorten = arm - 2.0 >= _ARM_LEFT_M
+        remove = off and (not shorten or g < 0.35)
+        by_m = 2.0 + f * (min(4.0, arm - _ARM_LEFT_M) - 2.0)
+        out = normalise_ring(_moved_wing(ring, k, by_m, remove=remove))
+        if not well_formed(out) or signed_area(out) >= signed_area(ring) - 0.5:
+            continue
+        if plan.yard is None:
+            return Plan(plan.shape, "plain", out, (Part(out, 0.0, top),))
+        yard = normalise_ring(_moved_wing(plan.yard, k, by_m, remove=False))
+        if len(out) == n and len(yard) == n and well_formed(yard, edge_m=2.5, gap_m=2.5):
+            parts = yard_parts(out, yard, 0.0, top)
+            if parts is not None:
+                return Plan(plan.shape, "courtyard", out, parts, yard)
+    return None
+
+
+def _moved_wing(ring: Ring, k: int, by_m: float, *, remove: bool) -> list[Point]:
+    """``ring`` with edge k–k+1 moved ``by_m`` back along its neighbouring edges (both run
+    along one axis), or (``remove``) back to where the shorter of them ends: that coordinate
+    exactly, so the repeated and straight vertices left are dropped by normalise_ring."""
+    n = len(ring)
+    a, b, back, ahead = ring[k], ring[(k + 1) % n], ring[k - 1], ring[(k + 2) % n]
+    axis = 0 if abs(back[0] - a[0]) > abs(back[1] - a[1]) else 1
+    if remove:
+        value = (back if math.dist(back, a) <= math.dist(b, ahead) else ahead)[axis]
+    else:
+        value = a[axis] + (by_m if back[axis] > a[axis] else -by_m)
+    out = list(ring)
+    for i in (k, (k + 1) % n):
+        out[i] = (value, out[i][1]) if axis == 0 else (out[i][0], value)
+    return out
+
+
+def small_plan(rng: random.Random, o: HardOptions) -> Plan:
+    """One block of a :data:`SHAPES` footprint scaled to 3.05–4.95 m across (its farthest
+    two vertices), arms still 1.2 m or wider; a rectangle if 30 tries find none."""
+    for _try in range(30):
+        shape = SHAPES[_index(rng, len(SHAPES))]
+        ring, _ = _MAKERS[shape](rng)
+        across = uniform(rng, 3.05, 4.95)
+        size = max(math.dist(p, q) for p in ring for q in ring)
+        small = tuple((across / size * x, across / size * y) for x, y in ring)
+        if well_formed(small, gap_m=1.2):
+            return Plan(shape, "plain", small, (Part(small, 0.0, _height(rng, o)),))
+    w = uniform(rng, 2.0, 3.5)
+    ring = _box(-w / 2.0, -1.0, w / 2.0, 1.0)
+    return Plan("rectangle", "plain", ring, (Part(ring, 0.0, _height(rng, o)),))
