@@ -4,13 +4,23 @@ scaled and turned copy, a near-identical shape, spread past one overview, home b
 building), each flown on the built-in vehicle by today's mission and by the baseline's.
 
     python benchmarks/bench_mission_generalization.py [--quick] [--scenes 200] [--first-seed 1]
-        [--baseline 863e7d7] [--workers 2] [--variants new,baseline] [--random-home]
+        [--baseline COMMIT] [--workers 2] [--variants new,baseline] [--random-home] [--town]
 
 ``--quick``: two scenes (``--scenes 2``), both variants, every row of the table.
 
+``--town``: scenes the mission was not tuned on (``HardOptions.town()``, as `uavtool scene
+random --hard --town`): grey, white, black and grey-blue roofs, darker shades of a hue,
+decoys in the target's exact colour that differ by a courtyard or a wing, courtyard and
+3–5 m targets, 30–60 m towers, home beside a tower or under a deck, dense blocks. The
+report then gets one row per class (scenes holding it: correct / wrong / no match / crashed
+/ model built), and the baseline is ``TOWN_BASELINE`` unless ``--baseline`` is given.
+Combines with ``--random-home``.
+
 The baseline is the code of commit ``BASELINE`` (the mission before roof heights, chosen
-altitudes, the mirror rule and collisions: fixed 45/20 m, a 5 m roof plane), extracted with
-``git archive`` and run from the same virtualenv in worker processes beside today's. Every
+altitudes, the mirror rule and collisions: fixed 45/20 m, a 5 m roof plane), with ``--town``
+``TOWN_BASELINE`` (675267c, the mission the town issue measures today's against); any
+commit with ``--baseline``. It is extracted with ``git archive`` (only when the baseline
+variant is flown) and run from the same virtualenv in worker processes beside today's. Every
 flight writes its recording; both are judged from their recordings by today's code against
 the scene's ground truth, so the figures are comparable:
 
@@ -38,8 +48,9 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Mapping
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -56,10 +67,16 @@ from uavtool.runner.evaluate import (
 )
 from uavtool.sitl import SitlConfig
 from uavtool.world import Scene, scene_to_dict
-from uavtool.world.hard import HardOptions, HardSceneInfo, generate_hard_scene_with_info
+from uavtool.world.hard import (
+    TOWN_CLASSES,
+    HardOptions,
+    HardSceneInfo,
+    generate_hard_scene_with_info,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 BASELINE = "863e7d7"
+TOWN_BASELINE = "675267c"
 SAFETY_MARGIN_M = 4.0
 HOME_COLUMN_M = 1.5  # route points this close to home (horizontally) are take-off/landing
 
@@ -97,6 +114,27 @@ class Result:
     crashed: bool
     flight_s: float
     wall_s: float
+    classes: tuple[str, ...] = ()  # the town classes the scene holds
+    wrong_kind: str = ""  # what the building wrongly matched is (see _kind)
+
+
+def _kind(info: HardSceneInfo, name: str) -> str:
+    """What a building is to the scene: a decoy of some kind, a darker shade, grey, other."""
+    for kind, who in (
+        ("mirror decoy", info.mirror_decoy),
+        ("near decoy", info.near_decoy),
+        ("scaled decoy", info.scaled_decoy),
+        ("hole decoy", info.hole_decoy),
+        ("wing decoy", info.wing_decoy),
+    ):
+        if name == who:
+            return kind
+    for darker, brighter in info.darker:
+        if name == darker:
+            return "darker shade of the target" if brighter == info.target else "darker shade"
+    if name in info.grey:
+        return "grey"
+    return "other"
 
 
 def fly_batch(
@@ -142,15 +180,16 @@ def judge(seed: int, scene: Scene, info: HardSceneInfo, row: dict[str, Any]) -> 
         False,
         0.0,
         float(row["wall_s"]),
+        info.classes,
     )
     if status.startswith("error") or not path.exists():
         return empty
     route: list[tuple[float, float, float]] = []
     times: list[int] = []
-    plan: dict[str, Any] | None = None
-    outcome: dict[str, Any] = {}
-    model: dict[str, Any] | None = None
-    views: dict[str, Any] | None = None
+    plan: Mapping[str, Any] | None = None
+    outcome: Mapping[str, Any] = {}
+    model: Mapping[str, Any] | None = None
+    views: Mapping[str, Any] | None = None
     with RecordingReader(path) as reader:
         for entry in reader.entries([OBSERVATIONS, OUTPUTS]):
             value = entry.value
@@ -201,6 +240,8 @@ def judge(seed: int, scene: Scene, info: HardSceneInfo, row: dict[str, Any]) -> 
         crashed,
         flight_s,
         float(row["wall_s"]),
+        info.classes,
+        _kind(info, matched) if matched and matched != scene.target else "",
     )
 
 
@@ -240,6 +281,26 @@ def summarise(name: str, results: list[Result]) -> dict[str, Any]:
         "below_margin_seeds": [r.seed for r in results if r.clearance_m < SAFETY_MARGIN_M],
         "tunnel_lost_seeds": [r.seed for r in tunnels if not r.tunnel],
         "statuses": _count(r.status.split(":")[0] for r in results),
+        "wrong_kinds": _count(r.wrong_kind for r in wrong),
+        "classes": {c: _by_class([r for r in results if c in r.classes]) for c in TOWN_CLASSES},
+    }
+
+
+def _by_class(results: list[Result]) -> dict[str, Any]:
+    """The breakdown row of the scenes holding one town class."""
+    correct = [r for r in results if r.matched and r.matched == r.target]
+    return {
+        "n": len(results),
+        "correct": len(correct),
+        "wrong": sum(bool(r.matched) and r.matched != r.target for r in results),
+        "none": sum(not r.matched for r in results),
+        "crashes": sum(r.crashed for r in results),
+        "models": sum(r.model for r in correct),
+        "seeds": {
+            "wrong": [r.seed for r in results if r.matched and r.matched != r.target],
+            "no match": [r.seed for r in results if not r.matched],
+            "crashed": [r.seed for r in results if r.crashed],
+        },
     }
 
 
@@ -252,6 +313,28 @@ def _count(items: Any) -> dict[str, int]:
 
 def _pct(k: int, n: int) -> str:
     return f"{k:4d}/{n:<4d} {100.0 * k / n if n else 0.0:5.1f} %"
+
+
+def report_classes(rows: list[dict[str, Any]]) -> None:
+    """One row per town class: the scenes holding it, and per variant how they went."""
+    print(
+        "\n  by town class: scenes holding it; per variant correct / wrong / no match / "
+        "crashed / model built (of correct)"
+    )
+    print(f"  {'class':<30s}{'scenes':>7s}" + "".join(f"{r['name']:>22s}" for r in rows))
+    for c in TOWN_CLASSES:
+        cells = []
+        for r in rows:
+            k = r["classes"][c]
+            cells.append(f"{k['correct']}/{k['wrong']}/{k['none']}/{k['crashes']}/{k['models']}")
+        n = rows[0]["classes"][c]["n"]
+        print(f"  {c:<30s}{n:>7d}" + "".join(f"{cell:>22s}" for cell in cells))
+    for r in rows:
+        for c in TOWN_CLASSES:
+            bad = {k: v for k, v in r["classes"][c]["seeds"].items() if v}
+            if bad:
+                listed = "; ".join(f"{k} {v[:20]}" for k, v in bad.items())
+                print(f"    {r['name']}, {c}: {listed}")
 
 
 def report(rows: list[dict[str, Any]]) -> None:
@@ -278,6 +361,8 @@ def report(rows: list[dict[str, Any]]) -> None:
     line("wall time, all flights (s)", [f"{r['wall_s']:.0f}" for r in rows])
     for r in rows:
         print(f"\n  {r['name']}: outcomes {r['statuses']}")
+        if r["wrong_kinds"]:
+            print(f"    wrong matches by what was matched: {r['wrong_kinds']}")
         for key in (
             "wrong_seeds",
             "mirror_seeds",
@@ -326,7 +411,11 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="the smallest run: --scenes 2")
     parser.add_argument("--scenes", type=int, default=200)
     parser.add_argument("--first-seed", type=int, default=1)
-    parser.add_argument("--baseline", default=BASELINE)
+    parser.add_argument(
+        "--baseline",
+        default=None,
+        help=f"baseline commit [default: {BASELINE}; with --town {TOWN_BASELINE}]",
+    )
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--variants", default="new,baseline")
     parser.add_argument("--seeds", default=None, help="comma-separated seeds (instead of a range)")
@@ -336,10 +425,20 @@ def main() -> None:
         action="store_true",
         help="each scene's home anywhere within 60° of the equator, the vehicle facing any way",
     )
+    parser.add_argument(
+        "--town",
+        action="store_true",
+        help="town scenes (HardOptions.town()): a breakdown row per class; baseline "
+        f"{TOWN_BASELINE} unless --baseline says otherwise",
+    )
     if parser.parse_known_args()[0].quick:
         parser.set_defaults(scenes=2)
     args = parser.parse_args()
-    options = HardOptions(random_home=args.random_home)
+    options = HardOptions.town() if args.town else HardOptions()
+    if args.random_home:
+        options = replace(options, random_home=True)
+    if args.baseline is None:
+        args.baseline = TOWN_BASELINE if args.town else BASELINE
     variants = args.variants.split(",")
     seeds = (
         [int(x) for x in args.seeds.split(",")]
@@ -347,7 +446,12 @@ def main() -> None:
         else list(range(args.first_seed, args.first_seed + args.scenes))
     )
     homes = "; random homes" if args.random_home else ""
-    print(f"{len(seeds)} hard scenes, seeds {seeds[0]}..{seeds[-1]}{homes}; variants {variants}")
+    kind = "town" if args.town else "hard"
+    base = f" (baseline {args.baseline})" if "baseline" in variants else ""
+    print(
+        f"{len(seeds)} {kind} scenes, seeds {seeds[0]}..{seeds[-1]}{homes}; "
+        f"variants {variants}{base}"
+    )
     with tempfile.TemporaryDirectory() as tmp_text:
         tmp = args.keep or Path(tmp_text)
         tmp.mkdir(parents=True, exist_ok=True)
@@ -357,7 +461,9 @@ def main() -> None:
             path = tmp / f"hard-{seed}.json"
             path.write_text(json.dumps(scene_to_dict(scene)))
             scenes[seed] = (scene, info, path)
-        paths = {"new": None, "baseline": extract(args.baseline, tmp / "baseline")}
+        paths: dict[str, Path | None] = {"new": None}
+        if "baseline" in variants:
+            paths["baseline"] = extract(args.baseline, tmp / "baseline")
         jobs = []
         for variant in variants:
             pairs = [(str(scenes[s][2]), str(tmp / f"{variant}-{s}.mcap")) for s in seeds]
@@ -386,6 +492,8 @@ def main() -> None:
                 results.append(judge(seed, scene, info, row))
             summaries.append(summarise(variant, sorted(results, key=lambda r: r.seed)))
     report(summaries)
+    if args.town:
+        report_classes(summaries)
 
 
 if __name__ == "__main__":
