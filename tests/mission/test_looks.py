@@ -156,13 +156,14 @@ def test_look_parameters_are_settable_and_checked() -> None:
         scenes.with_mission(max_looks=0)
 
 
-def test_a_roof_of_unknown_height_is_measured_before_the_look() -> None:
+def test_a_roof_no_single_height_explains_is_looked_at_from_above() -> None:
     """Hard scene 89: the target, a stepped T 40 m out, is cut by the border of the lower
-    overview photo, so the overviews cannot tell its roof height. Assumed the tallest
-    expected (25 m), its first look was taken from so high that, against a stricter threshold
-    (0.82), it scored below it (0.75) and needed a second, closer look. Now the mission
-    measures it first, from the overview's altitude over it, and its first look is taken
-    from the altitude that fits the roof and matches."""
+    overview photo. Measured from above, its two tiers of one colour give outlines that no
+    single roof height explains (tiers, not one roof), so its height stays unknown: the
+    mission never descends toward it, looks at it from the overview's altitude, and it
+    matches there even against a stricter threshold (0.82). (Assumed 25 m tall and looked
+    at from 25 m + the look's fill, it once scored 0.75; the blended height the outlines gave
+    was lower than its top tier.)"""
     scene, info = generate_hard_scene_with_info(seed=89)
     params = Params()
     flown = fly(scene, replace(params, recognize=replace(params.recognize, threshold=0.82)))
@@ -172,11 +173,12 @@ def test_a_roof_of_unknown_height_is_measured_before_the_look() -> None:
     (plan,) = flight.of_type(Plan)
     target = building_footprint(scene.building(info.target))
     poi = plan.pois[flight.outcome.matched_poi]
-    assert poi.roof_measured
+    assert not poi.roof_measured
     looks = _looks(flight, poi.index)
-    assert len(looks) == 1 and looks[0][1].matched
-    x, y, _ = looks[0][0].pose.pos_enu_m  # taken over the target
+    assert looks[0][1].matched
+    x, y, alt = looks[0][0].pose.pos_enu_m  # taken over the target, from the ceiling
     assert target.distance(shapely.Point(x, y)) < 1.0
+    assert alt == pytest.approx(flown.mission.ceiling_m, abs=1.0)
 
 
 # --- the photo's heading and aim -------------------------------------------------------------

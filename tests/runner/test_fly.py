@@ -181,11 +181,12 @@ def _square(x: float, y: float, r: float) -> list[list[float]]:
 
 
 def test_a_crash_on_the_way_home_is_a_crash_whatever_came_before(tmp_path: Path) -> None:
-    """The search and the model done, a mast the mission cannot see stands on the way home:
+    """The search and the model done, a pole the mission cannot see (ground-coloured and
+    0.5 m thick: under three pixels of the 117 m overview) stands on the way home:
     the flight is 'crashed' (exit 5) in the summary and the recording's outcome, the mission
     sends nothing into the wreck afterwards, and the model built before is still counted."""
     scene = _paper_with(
-        tmp_path, "mast", [{"footprint": _square(20, -18.3, 0.4), "top_m": 14}], True
+        tmp_path, "mast", [{"footprint": _square(20, -18.3, 0.25), "top_m": 14}], True
     )
     rec = tmp_path / "home-crash.mcap"
     result = CliRunner().invoke(cli, ["fly", "-q", "--scene", str(scene), "--record", str(rec)])

@@ -177,6 +177,39 @@ def roof_from_cut_outline(
     return h
 
 
+def outline_residual_px(
+    *,
+    ring_px: Sequence[tuple[float, float]],
+    pose: CameraPose,
+    other_ring_px: Sequence[tuple[float, float]],
+    other_pose: CameraPose,
+    intrinsics: Intrinsics,
+    plane_z_m: float,
+    border_px: float = 3.0,
+) -> float:
+    """How well one roof outline, placed on the plane z = ``plane_z_m`` and seen from the
+    other camera, lies on the other photo's outline of it: the RMS distance (pixels of the
+    other photo) both ways, over the edges inside that frame. About a pixel for one flat roof
+    at that height; several where the outlines mix roofs of different heights (tiers of one
+    colour) or walls, which no single height explains. inf when nothing can be compared."""
+    k = intrinsics
+    ring = _reprojected(ring_px, pose, other_pose, k, plane_z_m)
+    if ring is None:
+        return math.inf
+    there = _inner_edge_points(other_ring_px, k, border_px)
+    here = _inner_edge_points(ring, k, border_px)
+    if len(there) < 3 or len(here) < 3:
+        return math.inf
+    worst = 0.0
+    for points, edges in ((there, _ring_edges(ring)), (here, _ring_edges(other_ring_px))):
+        total = 0.0
+        for p in points:
+            d = min(point_segment_distance(p, a, b) for a, b in edges)
+            total += d * d
+        worst = max(worst, math.sqrt(total / len(points)))
+    return worst
+
+
 def _inner_edge_points(
     ring_px: Sequence[tuple[float, float]], k: Intrinsics, border_px: float
 ) -> list[tuple[float, float]]:
