@@ -9,7 +9,7 @@ from uavtool.camera import Intrinsics
 from uavtool.mission.errors import MissionInputError
 from uavtool.mission.observations import Photo, U8Array
 from uavtool.mission.params import Params
-from uavtool.nav.heights import roof_from_photos
+from uavtool.nav.heights import outline_residual_px, roof_from_photos
 from uavtool.vision import Shape, best_match, mirror_score, vectorize
 from uavtool.vision.merge import merge_touching
 from uavtool.vision.model3d import central_shape
@@ -121,7 +121,31 @@ def roof_between(a: Shape, photo_a: Photo, b: Shape, photo_b: Photo) -> float | 
         pose2=photo_b.pose,
         intrinsics=photo_a.intrinsics,
     )
-    return None if roof is None else max(roof, 0.0)
+    if roof is None:
+        return None
+    roof = max(roof, 0.0)
+    # One flat roof at that height must explain both outlines: carried from the photo that
+    # shows it larger to the other, they agree within ONE_ROOF_PX of the coarser photo.
+    fine, coarse = (
+        ((a, photo_a), (b, photo_b)) if a.area_px >= b.area_px else ((b, photo_b), (a, photo_a))
+    )
+    residual = outline_residual_px(
+        ring_px=fine[0].polygon_px.tolist(),
+        pose=fine[1].pose,
+        other_ring_px=coarse[0].polygon_px.tolist(),
+        other_pose=coarse[1].pose,
+        intrinsics=coarse[1].intrinsics,
+        plane_z_m=roof,
+    )
+    return roof if residual <= ONE_ROOF_PX else None
+
+
+ONE_ROOF_PX = 1.0
+"""How far (RMS, pixels of the coarser photo) two outlines of one roof may lie apart once the
+finer is carried to the other photo at the measured height. One flat roof: up to 0.6 px
+(paper's stepped red, tiers 5 and 6.5 m: 0.9 px); two tiers of one colour far apart, or a
+dark roof with its walls, are pixels apart (tiers 7.3/12.2 m: 1.2 px; a black 23 m block
+with its walls: 10 px): their blend would be lower than the top, so no height is given."""
 
 
 _EDGE_PX = 1.0  # an outline this close to the frame's edge touches it

@@ -32,18 +32,13 @@ from uavtool.mission.survey import (
     points_of_interest,
 )
 from uavtool.nav import NavError, ground_point
-from uavtool.nav.heights import outline_residual_px, roof_from_cut_outline
+from uavtool.nav.heights import roof_from_cut_outline
 from uavtool.vision import Shape
 from uavtool.vision.vectorize import non_ground
 
 if TYPE_CHECKING:
     from uavtool.mission.mission import Mission, Wait
 
-ONE_ROOF_PX = 0.75
-"""How far (RMS, pixels) two outlines of one roof may lie apart once one is carried to the
-other photo at the measured height: a flat roof's outlines agree to a tenth of a pixel in a
-clean photo; two tiers of one colour, or a roof with its walls, are pixels apart (a stepped
-block, 1.2 px; a black tower with its walls, 10 px)."""
 _AGREE = 0.25
 """How far apart the two photos may place one roof (at its height, as a share of the roof's
 size in the first photo) for their outlines to count as the same roof: a centroid moves
@@ -186,9 +181,7 @@ def measure_roof(
         if shape.cut_by_border and cand.cut_by_border:
             continue
         if not shape.cut_by_border and not cand.cut_by_border:
-            roof = roof_between(shape, photo, cand, other)
-            if roof is not None and not _one_roof(shape, photo, cand, other, roof):
-                continue  # tiers of one colour, or walls: no single height explains both
+            roof = roof_between(shape, photo, cand, other)  # None: no one roof explains both
         else:
             whole, whole_photo, cut, cut_photo = (
                 (shape, photo, cand, other) if cand.cut_by_border else (cand, other, shape, photo)
@@ -209,19 +202,6 @@ def measure_roof(
         if miss is not None and miss <= limit_px and (best is None or miss < best[0]):
             best = (miss, roof)
     return None if best is None else best[1]
-
-
-def _one_roof(shape: Shape, photo: Photo, cand: Shape, other: Photo, roof_m: float) -> bool:
-    """Whether one flat roof at ``roof_m`` explains both outlines (`ONE_ROOF_PX`)."""
-    residual = outline_residual_px(
-        ring_px=shape.polygon_px.tolist(),
-        pose=photo.pose,
-        other_ring_px=cand.polygon_px.tolist(),
-        other_pose=other.pose,
-        intrinsics=photo.intrinsics,
-        plane_z_m=roof_m,
-    )
-    return residual <= ONE_ROOF_PX
 
 
 def _disagreement_px(
