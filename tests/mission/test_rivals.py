@@ -3,6 +3,7 @@ best of them wins, not the first to clear the threshold."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 from tests.mission.driver import fly
@@ -55,3 +56,18 @@ def test_the_best_of_the_targets_colour_wins_not_the_first_match() -> None:
     assert near(outcome.matched_poi) == "target"
     assert outcome.match_score > 0.95
     assert outcome.model_built
+
+
+def test_a_small_building_of_the_targets_colour_is_visited() -> None:
+    """Town scene 1038: the target is an L 4 m across, under `min_poi_area_px` in the 117 m
+    overview. Shapes that small are skipped as noise, but not one of the target's colour."""
+    from uavtool.world.hard import HardOptions, generate_hard_scene_with_info
+
+    options = dataclasses.replace(HardOptions.town(), random_home=True)
+    scene, info = generate_hard_scene_with_info(seed=1038, options=options)
+    assert info.small_target
+    flown = fly(scene)
+    pois = flown.mission.plan.pois  # type: ignore[union-attr]
+    matched = pois[flown.outcome.matched_poi]
+    assert matched.area_px < flown.mission.params.mission.min_poi_area_px
+    assert flown.outcome.model_built

@@ -85,7 +85,8 @@ class MissionParams:
     whatever its shape (0 = judge by shape alone)."""
     min_poi_area_px: float = 150.0
     """Overview shapes smaller than this (square pixels) are not visited, unless cut by the
-    photo's border (a building reaching out of the frame shows any part of itself)."""
+    photo's border (a building reaching out of the frame shows any part of itself) or of the
+    target's colour (within ``match_hue_tolerance_deg``: a small target)."""
     max_looks: int = 3
     """Photos taken at most at one point of interest. When a look is doubtful — the candidate
     has the target's hue but its outline is cut by the image border, or it scores between

@@ -21,6 +21,7 @@ from uavtool.mission.search import photo_shapes
 from uavtool.nav import NavError, ground_point, ground_polygon, min_area_rect
 from uavtool.nav.geometry import convex_hull, point_polygon_distance
 from uavtool.vision import Shape
+from uavtool.vision.vectorize import hue_distance_deg
 
 if TYPE_CHECKING:
     from uavtool.mission.mission import Mission, Wait
@@ -105,9 +106,12 @@ def points_of_interest(
     known_m = sorted(h for h, ok in zip(roofs_m, measured, strict=True) if ok)
     typical_m = known_m[len(known_m) // 2] if known_m else 0.0
     pois: list[PointOfInterest] = []
+    limit = p.match_hue_tolerance_deg
     for i, shape in enumerate(shapes):
-        if shape.area_px < p.min_poi_area_px and not shape.cut_by_border:
-            continue  # too small for a building; one cut by the border may be any size
+        like_target = limit <= 0 or hue_distance_deg(shape.colour_rgb, m.target.colour_rgb) <= limit
+        if shape.area_px < p.min_poi_area_px and not (shape.cut_by_border or like_target):
+            continue  # too small for a building; one cut by the border may be any size, and
+            # one of the target's colour may be a small target
         u, v = shape.centroid_px
         plane_m = roofs_m[i] if measured[i] else typical_m
         pos = ground_point(u, v, photo.pose, photo.intrinsics, plane_z_m=plane_m)
