@@ -54,6 +54,7 @@ def measure_from_above(m: Mission, seen: Survey, order: tuple[int, ...]) -> Wait
     below_m = ceiling_m - 1.0
     obstacles = _unclassified(m, seen)
     if all(seen.measured) and not obstacles:
+        m.roofs = tuple(zip(seen.footprints, seen.roofs_m, strict=True))
         return seen
     if obstacles and seen.lower is not None:
         lower = non_ground(seen.lower.image_rgb, m.params.vectorize)
@@ -122,6 +123,9 @@ def measure_from_above(m: Mission, seen: Survey, order: tuple[int, ...]) -> Wait
         f"roofs measured from above: {sum(measured) - before} more, {sum(measured)} of "
         f"{len(measured)}" + (f"; taller than expected: {', '.join(taller)}" if taller else ""),
     )
+    m.roofs = tuple(
+        (fp, roof) for fp, roof, ok in zip(footprints, roofs, measured, strict=True) if ok
+    ) + tuple((o.footprint, o.roof_m) for o in found if o.measured)
     m.unknown_footprints = tuple(
         fp for fp, ok in zip(footprints, measured, strict=True) if not ok
     ) + tuple(o.footprint for o in found if not o.measured)

@@ -50,7 +50,7 @@ from uavtool.mission.outputs import (
     Viewpoints,
 )
 from uavtool.mission.params import MissionParams, Params
-from uavtool.nav.geometry import segment_polygon_distance
+from uavtool.nav.geometry import point_polygon_distance, segment_polygon_distance
 
 T = TypeVar("T")
 Wait = Generator[None, Observation, T]
@@ -98,6 +98,8 @@ class Mission:
         """The second overview's altitude: every roof it showed is below it."""
         self.unknown_footprints: tuple[tuple[tuple[float, float], ...], ...] = ()
         """Where buildings of unknown height may stand: a way near one crosses at the ceiling."""
+        self.roofs: tuple[tuple[tuple[tuple[float, float], ...], float], ...] = ()
+        """Every measured roof: (footprint, height above home)."""
         """The altitude that clears every known roof (once the survey has measured them)."""
         self.viewpoints: Viewpoints | None = None
         self.model: ModelBuilt | None = None
@@ -400,6 +402,21 @@ class Mission:
                 yield from self.move((here[0], here[1], cruise), None, f"climb to {cruise:.1f} m")
             yield from self.move((x, y, cruise), None, f"{what}: across at {cruise:.1f} m")
         yield from self.move(pos_enu_m, heading_deg, what)
+
+    def floor_at(self, x: float, y: float) -> float:
+        """The lowest altitude over (x, y) that keeps the safety margin (and the arrival
+        radius) above every roof within the margin of it; the ceiling near a roof of unknown
+        height. (A look aimed at one tier of a stepped tower must not descend onto another.)"""
+        margin_m = self.params.viewpoints.safety_margin_m
+        need = 0.0
+        for footprint, roof_m in self.roofs:
+            if point_polygon_distance((x, y), footprint) <= margin_m:
+                need = max(need, roof_m + margin_m + self.params.mission.arrive_radius_m)
+        if self.ceiling_m is not None and any(
+            point_polygon_distance((x, y), fp) <= margin_m for fp in self.unknown_footprints
+        ):
+            need = max(need, self.ceiling_m)
+        return need
 
     def _near_unknown(self, here: Vec3, there: tuple[float, float]) -> bool:
         """Whether the ground track from ``here`` to ``there`` passes within the safety

@@ -99,6 +99,7 @@ def search(
         alt = min(look_altitude_m(m, poi, overview.intrinsics), ceiling_m)
         if not poi.roof_measured:
             alt = ceiling_m
+        alt = max(alt, m.floor_at(x, y))
         yield from m.travel((x, y, alt), None, transit_m, f"point of interest {k}")
         m.visited.append(k)
         looks = [(yield from _look(m, k, 1, alt, poi.colour_rgb))]
@@ -189,7 +190,7 @@ def _measure_from_lower(
     ``min_above_roof_m`` over the roof as assumed), compared with the look by size."""
     p = m.params.mission
     x, y, alt = look.photo.pose.pos_enu_m
-    lower = max(alt - p.overview_climb_m, poi.roof_m + p.min_above_roof_m)
+    lower = max(alt - p.overview_climb_m, poi.roof_m + p.min_above_roof_m, m.floor_at(x, y))
     if shape.cut_by_border or lower > alt - p.overview_climb_m / 2.0:
         return None
     yield from m.move((x, y, lower), None, f"point of interest {k}, measuring its roof")
@@ -263,7 +264,7 @@ def _closer_look(
         return None
     u, v = shape.centroid_px
     x, y = ground_point(u, v, photo.pose, k, plane_z_m=min(roof, look.alt_m - 1))
-    return (x, y, lower), roof
+    return (x, y, max(lower, m.floor_at(x, y))), roof
 
 
 def _farthest_pair(

@@ -1,0 +1,29 @@
+"""The lowest a look may descend to over a point: above every known roof near it by the
+safety margin, and no lower than the ceiling near a roof of unknown height."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from uavtool.mission import Mission, Params
+
+
+def _mission() -> Mission:
+    target = np.full((120, 160, 3), 128, np.uint8)
+    target[40:80, 50:110] = (210, 40, 40)
+    return Mission(Params(), target)
+
+
+def test_floor_over_tiers_and_unknown_roofs() -> None:
+    m = _mission()
+    square = ((0.0, 0.0), (6.0, 0.0), (6.0, 6.0), (0.0, 6.0))
+    inner = ((2.0, 2.0), (4.0, 2.0), (4.0, 4.0), (2.0, 4.0))
+    m.roofs = ((square, 20.0), (inner, 43.0))  # two tiers of one tower, measured apart
+    margin = m.params.viewpoints.safety_margin_m + m.params.mission.arrive_radius_m
+    assert m.floor_at(3.0, 3.0) == 43.0 + margin  # over the top tier
+    assert m.floor_at(0.5, 0.5) == 43.0 + margin  # over the lower tier, 1.5 m from the top
+    assert m.floor_at(-5.0, -5.0) == 0.0  # 7 m from either: nothing to clear
+    m.ceiling_m = 117.4
+    m.unknown_footprints = (((20.0, 0.0), (26.0, 0.0), (26.0, 6.0), (20.0, 6.0)),)
+    assert m.floor_at(18.0, 3.0) == 117.4  # within the margin of a roof of unknown height
+    assert m.floor_at(9.0, 3.0) == 20.0 + margin  # 3 m from the lower tier, 5 m from the top
