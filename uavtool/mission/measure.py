@@ -126,9 +126,10 @@ def measure_from_above(m: Mission, seen: Survey, order: tuple[int, ...]) -> Wait
     m.roofs = tuple(
         (fp, roof) for fp, roof, ok in zip(footprints, roofs, measured, strict=True) if ok
     ) + tuple((o.footprint, o.roof_m) for o in found if o.measured)
-    m.unknown_footprints = tuple(
-        fp for fp, ok in zip(footprints, measured, strict=True) if not ok
-    ) + tuple(o.footprint for o in found if not o.measured)
+    m.unknown = {
+        i: fp for i, (fp, ok) in enumerate(zip(footprints, measured, strict=True)) if not ok
+    }
+    m.unknown.update({-1 - j: o.footprint for j, o in enumerate(found) if not o.measured})
     return replace(
         seen,
         roofs_m=tuple(roofs),

@@ -96,8 +96,9 @@ class Mission:
         self.transit_m: float | None = None
         self.ceiling_m: float | None = None
         """The second overview's altitude: every roof it showed is below it."""
-        self.unknown_footprints: tuple[tuple[tuple[float, float], ...], ...] = ()
-        """Where buildings of unknown height may stand: a way near one crosses at the ceiling."""
+        self.unknown: dict[int, tuple[tuple[float, float], ...]] = {}
+        """Where buildings of unknown height may stand (by the overview shape's index; an
+        obstacle's is negative): a way near one crosses at the ceiling."""
         self.roofs: tuple[tuple[tuple[tuple[float, float], ...], float], ...] = ()
         """Every measured roof: (footprint, height above home)."""
         """The altitude that clears every known roof (once the survey has measured them)."""
@@ -413,10 +414,17 @@ class Mission:
             if point_polygon_distance((x, y), footprint) <= margin_m:
                 need = max(need, roof_m + margin_m + self.params.mission.arrive_radius_m)
         if self.ceiling_m is not None and any(
-            point_polygon_distance((x, y), fp) <= margin_m for fp in self.unknown_footprints
+            point_polygon_distance((x, y), fp) <= margin_m for fp in self.unknown.values()
         ):
             need = max(need, self.ceiling_m)
         return need
+
+    def learn_roof(
+        self, index: int, footprint: tuple[tuple[float, float], ...], roof_m: float
+    ) -> None:
+        """A roof of unknown height (overview shape ``index``) measured at last."""
+        self.unknown.pop(index, None)
+        self.roofs = (*self.roofs, (footprint, roof_m))
 
     def _near_unknown(self, here: Vec3, there: tuple[float, float]) -> bool:
         """Whether the ground track from ``here`` to ``there`` passes within the safety
@@ -424,7 +432,7 @@ class Mission:
         margin_m = self.params.viewpoints.safety_margin_m
         a = (here[0], here[1])
         return any(
-            segment_polygon_distance(a, there, fp) <= margin_m for fp in self.unknown_footprints
+            segment_polygon_distance(a, there, fp) <= margin_m for fp in self.unknown.values()
         )
 
     def _arrived(self, t: Telemetry, pos_enu_m: Vec3, heading_deg: float | None) -> bool:

@@ -112,7 +112,7 @@ def search(
                     for look in looks[:-1]
                     if look.judgement.candidate >= 0
                 ]
-                closer = _closer_look(m, looks[-1], before)
+                closer = _closer_look(m, looks[-1], before, poi.shape_index)
             if closer is not None:
                 pos, roof_m = closer
                 m.event(
@@ -230,7 +230,7 @@ def _look(m: Mission, k: int, n: int, alt_m: float, aimed_rgb: tuple[int, int, i
 
 
 def _closer_look(
-    m: Mission, look: _Look, before: list[tuple[Shape, Photo]]
+    m: Mission, look: _Look, before: list[tuple[Shape, Photo]], index: int
 ) -> tuple[Vec3, float] | None:
     """Where to look again from, lower, and the roof height measured, when the look was
     taken high over a roof of unknown height (assumed the tallest expected) and its
@@ -257,6 +257,7 @@ def _closer_look(
         return None
     k = photo.intrinsics
     ring = ground_polygon(shape.polygon_px, photo.pose, k, plane_z_m=min(roof, look.alt_m - 1))
+    m.learn_roof(index, ring, roof)  # measured: a look may now descend near it
     extent = math.dist(*_farthest_pair(ring))
     fit = fit_altitude_m(roof_m=roof, extent_m=extent, intrinsics=k, fill=p.look_fill)
     lower = max(fit, roof + p.min_above_roof_m)
