@@ -142,6 +142,10 @@ def photograph_and_model(m: Mission, found: Found, seen: Survey, transit_m: floa
     )
     m.emit(m.model)
     m.model_built = True
+    # The model measures the target's height: the way home crosses over it by the margin.
+    clear_m = model.height_m + m.params.viewpoints.safety_margin_m + p.arrive_radius_m
+    m.transit_m = max(m.transit_m or 0.0, clear_m)
+    m.roofs = (*m.roofs, (tuple(footprint), model.height_m))
     m.event(
         Level.INFO,
         f"model built: height {model.height_m:.2f} m, volume {float(mesh.volume):.1f} m³",
