@@ -146,11 +146,7 @@ def roof_from_cut_outline(
         ring = _reprojected(whole_ring_px, whole_pose, cut_pose, k, h_m)
         if ring is None:
             return math.inf
-        total = 0.0
-        for p in samples:
-            d = min(point_segment_distance(p, a, b) for a, b in _ring_edges(ring))
-            total += d * d
-        return math.sqrt(total / len(samples))
+        return _rms_to_edges(samples, _ring_edges(ring))
 
     steps = int(top_m)
     coarse = [(cost(float(i)), float(i)) for i in range(steps + 1)]
@@ -200,14 +196,21 @@ def outline_residual_px(
     here = _inner_edge_points(ring, k, border_px)
     if len(there) < 3 or len(here) < 3:
         return math.inf
-    worst = 0.0
-    for points, edges in ((there, _ring_edges(ring)), (here, _ring_edges(other_ring_px))):
-        total = 0.0
-        for p in points:
-            d = min(point_segment_distance(p, a, b) for a, b in edges)
-            total += d * d
-        worst = max(worst, math.sqrt(total / len(points)))
-    return worst
+    return max(
+        _rms_to_edges(there, _ring_edges(ring)), _rms_to_edges(here, _ring_edges(other_ring_px))
+    )
+
+
+def _rms_to_edges(
+    points: Sequence[tuple[float, float]],
+    edges: Sequence[tuple[tuple[float, float], tuple[float, float]]],
+) -> float:
+    """RMS of each point's distance to the nearest of ``edges``."""
+    total = 0.0
+    for p in points:
+        d = min(point_segment_distance(p, a, b) for a, b in edges)
+        total += d * d
+    return math.sqrt(total / len(points))
 
 
 def _inner_edge_points(

@@ -77,8 +77,21 @@ def vectorize(frame_rgb: U8Array, params: VectorizeParams | None = None) -> tupl
         if p.roof_only:
             mask = brightest_shade(val[sub], mask, p)
         regions.extend(_regions(mask, every, (x0 + bx, y0 + by), frame.shape[:2], k, p))
+    shapes = [
+        (r.colour_class, -shape.area_px, order, shape)
+        for order, r, shape in _traced(frame, regions, p)
+    ]
+    shapes.sort(key=lambda t: t[:3])
+    return tuple(s for *_, s in shapes)
+
+
+def _traced(
+    frame: U8Array, regions: list[_Region], p: VectorizeParams
+) -> list[tuple[int, _Region, Shape]]:
+    """(order, region, shape with its inside colour) for each region whose outline keeps
+    three corners once the outlines are simplified together."""
     rings = simplify_rings([c for r in regions for c in (r.outer, *r.holes)], p)
-    shapes: list[tuple[int, float, int, Shape]] = []
+    out: list[tuple[int, _Region, Shape]] = []
     at = 0
     for order, r in enumerate(regions):
         outer, holes = rings[at], rings[at + 1 : at + 1 + len(r.holes)]
@@ -86,10 +99,8 @@ def vectorize(frame_rgb: U8Array, params: VectorizeParams | None = None) -> tupl
         if len(outer) < 3:
             continue
         shape = _offset_shape(outer, tuple(h for h in holes if len(h) >= 3), r.cut, p)
-        colour = _inside_colour(frame, r, shape)
-        shapes.append((r.colour_class, -shape.area_px, order, _with_colour(shape, colour)))
-    shapes.sort(key=lambda t: t[:3])
-    return tuple(s for *_, s in shapes)
+        out.append((order, r, _with_colour(shape, _inside_colour(frame, r, shape))))
+    return out
 
 
 def non_ground(
@@ -118,16 +129,7 @@ def non_ground(
         found = _regions(roof, roof, (0, 0), frame.shape[:2], 1, p)
         if found:
             roofs.append(max(found, key=lambda f: cv2.contourArea(f.contour)))
-    rings = simplify_rings([c for r in roofs for c in (r.outer, *r.holes)], p)
-    shapes: list[tuple[float, int, Shape]] = []
-    at = 0
-    for order, r in enumerate(roofs):
-        outer, holes = rings[at], rings[at + 1 : at + 1 + len(r.holes)]
-        at += 1 + len(r.holes)
-        if len(outer) < 3:
-            continue
-        shape = _offset_shape(outer, tuple(h for h in holes if len(h) >= 3), r.cut, p)
-        shapes.append((-shape.area_px, order, _with_colour(shape, _inside_colour(frame, r, shape))))
+    shapes = [(-shape.area_px, order, shape) for order, _r, shape in _traced(frame, roofs, p)]
     shapes.sort(key=lambda t: t[:2])
     return tuple(s for *_, s in shapes)
 
