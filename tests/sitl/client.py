@@ -65,6 +65,10 @@ class Client:
                 data = self.sock.recv(65536)
             except (TimeoutError, BlockingIOError):
                 data = None
+            except ConnectionResetError:
+                # The vehicle dropped the link while our last frames were still unread on its
+                # side: TCP resets instead of closing. Either way the link is gone.
+                return new
             if data:
                 for frame in self.parser.feed(data):
                     self.frames.append(frame)

@@ -154,7 +154,11 @@ def test_2000_ghost_udp_peers_expire_and_a_flight_is_unaffected() -> None:
 
 
 def test_a_fault_refuses_one_request_and_repeated_faults_drop_only_that_link(
-    vehicle: Sitl, client: Client, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+    vehicle: Sitl,
+    client: Client,
+    monkeypatch: pytest.MonkeyPatch,
+    caplog: pytest.LogCaptureFixture,
+    request: pytest.FixtureRequest,
 ) -> None:
     from uavtool.sitl import commands
 
@@ -163,6 +167,7 @@ def test_a_fault_refuses_one_request_and_repeated_faults_drop_only_that_link(
 
     monkeypatch.setitem(commands.HANDLERS, M.MAV_CMD_DO_SET_ROI, broken)
     other = Client.tcp(vehicle.ports[0])
+    request.addfinalizer(other.close)  # closed even when an assertion fails
     other.wait_for("HEARTBEAT")
     with caplog.at_level(logging.ERROR, logger="uavtool.sitl.server"):
         ack = client.command(M.MAV_CMD_DO_SET_ROI)
@@ -178,7 +183,6 @@ def test_a_fault_refuses_one_request_and_repeated_faults_drop_only_that_link(
     # The vehicle and its other client go on.
     assert other.command(ARM, 1).result == M.MAV_RESULT_ACCEPTED
     assert len(vehicle.sessions) == 1
-    other.close()
 
 
 def test_a_message_that_does_not_fit_is_not_sent_and_the_link_goes_on(
