@@ -22,7 +22,7 @@ import numpy as np
 
 from uavtool.mission.analysis import roof_between
 from uavtool.mission.observations import Photo
-from uavtool.mission.outputs import Level
+from uavtool.mission.outputs import Level, PointOfInterest
 from uavtool.mission.search import photo_shapes
 from uavtool.mission.survey import (
     Obstacle,
@@ -30,6 +30,7 @@ from uavtool.mission.survey import (
     anywhere,
     footprint_at,
     points_of_interest,
+    same_colour,
 )
 from uavtool.nav import NavError, ground_point
 from uavtool.nav.heights import roof_from_cut_outline
@@ -46,67 +47,68 @@ with the roof's outline, a neighbour stands at least a safety margin away."""
 
 
 def measure_from_above(m: Mission, seen: Survey, order: tuple[int, ...]) -> Wait[Survey]:
-    """Photograph, from the overview's altitude, each point of interest (in ``order``) whose
-    roof is still unknown, measure every unknown roof against each photo, and return the
-    survey with those roofs, footprints and points of interest."""
+    """Photograph, from the overview's altitude, each point of interest (in ``order``) and
+    then each obstacle whose roof is still unknown, measure every unknown roof against each
+    photo, and return the survey with those roofs, footprints, points of interest and
+    obstacles."""
     ceiling_m = seen.photo.pose.pos_enu_m[2]
     m.ceiling_m = ceiling_m
     below_m = ceiling_m - 1.0
-    obstacles = _unclassified(m, seen)
-    if all(seen.measured) and not obstacles:
+    others = _unclassified(m, seen)  # obstacles of no building colour
+    if all(seen.measured) and not others:
         m.roofs = tuple(zip(seen.footprints, seen.roofs_m, strict=True))
         return seen
-    if obstacles and seen.lower is not None:
+    others_m: list[float | None] = [None] * len(others)
+    if others and seen.lower is not None:
         lower = non_ground(seen.lower.image_rgb, m.params.vectorize)
-        for o in obstacles:
-            o[1] = measure_roof(m, o[0], seen.photo, seen.lower, lower, below_m=below_m)
-    heading = seen.photo.pose.heading_deg
+        others_m = [
+            measure_roof(m, o, seen.photo, seen.lower, lower, below_m=below_m) for o in others
+        ]
     roofs, measured = list(seen.roofs_m), list(seen.measured)
     before = sum(measured)
-    k_high = seen.photo.intrinsics
-    stops = [(f"point of interest {k}", f"measure-{k}", seen.pois[k].shape_index) for k in order]
-    stops += [(f"obstacle {j}", f"measure-obstacle-{j}", -1 - j) for j in range(len(obstacles))]
-    for what, tag, index in stops:
-        if index >= 0:
-            if measured[index]:
+    # Where to photograph from: over each point of interest, then each obstacle; a stop
+    # whose roof an earlier photo measured is skipped.
+    stops: list[tuple[str, str, PointOfInterest | None, int]] = [
+        (f"point of interest {k}", f"measure-{k}", seen.pois[k], -1) for k in order
+    ]
+    stops += [(f"obstacle {j}", f"measure-obstacle-{j}", None, j) for j in range(len(others))]
+    for what, tag, poi, j in stops:
+        if poi is not None:
+            if measured[poi.shape_index]:
                 continue
-            x, y = next(poi.pos_en_m for poi in seen.pois if poi.shape_index == index)
+            x, y = poi.pos_en_m
         else:
-            if obstacles[-1 - index][1] is not None:
+            if others_m[j] is not None:
                 continue
-            u, v = obstacles[-1 - index][0].centroid_px
-            x, y = ground_point(u, v, seen.photo.pose, k_high)
-        yield from m.move((x, y, ceiling_m), heading, f"over {what}, measuring")
+            x, y = ground_point(*others[j].centroid_px, seen.photo.pose, seen.photo.intrinsics)
+        yield from m.move((x, y, ceiling_m), seen.photo.pose.heading_deg, f"over {what}, measuring")
         photo = yield from m.photo(tag, -90.0)
         shapes = photo_shapes(m, photo)
         for i, shape in enumerate(seen.shapes):
-            if measured[i]:
-                continue
-            roof = measure_roof(m, shape, seen.photo, photo, shapes, below_m=below_m)
-            if roof is not None:
-                roofs[i], measured[i] = roof, True
-        if any(o[1] is None for o in obstacles):
-            others = non_ground(photo.image_rgb, m.params.vectorize)
-            for o in obstacles:
-                if o[1] is None:
-                    o[1] = measure_roof(m, o[0], seen.photo, photo, others, below_m=below_m)
+            if not measured[i]:
+                roof = measure_roof(m, shape, seen.photo, photo, shapes, below_m=below_m)
+                if roof is not None:
+                    roofs[i], measured[i] = roof, True
+        if None in others_m:
+            found_here = non_ground(photo.image_rgb, m.params.vectorize)
+            others_m = [
+                h
+                if h is not None
+                else measure_roof(m, o, seen.photo, photo, found_here, below_m=below_m)
+                for o, h in zip(others, others_m, strict=True)
+            ]
     assumed_m = m.params.mission.assumed_roof_m
-    found = tuple(
-        Obstacle(
-            shape,
-            assumed_m if roof is None else roof,
-            roof is not None,
-            anywhere(shape, seen.photo, assumed_m)
-            if roof is None
-            else footprint_at(shape, seen.photo, roof),
-        )
-        for shape, roof in obstacles
+    obstacles = tuple(
+        Obstacle(o, assumed_m, False, anywhere(o, seen.photo, assumed_m))
+        if h is None
+        else Obstacle(o, h, True, footprint_at(o, seen.photo, h))
+        for o, h in zip(others, others_m, strict=True)
     )
-    if found:
+    if obstacles:
         m.event(
             Level.INFO,
-            f"{len(found)} obstacles of no building colour (grey, or a darker shade): roofs "
-            + ", ".join(f"{o.roof_m:.1f} m" if o.measured else "unknown" for o in found),
+            f"{len(obstacles)} obstacles of no building colour (grey, or a darker shade): roofs "
+            + ", ".join(f"{o.roof_m:.1f} m" if o.measured else "unknown" for o in obstacles),
         )
     footprints = tuple(
         footprint_at(s, seen.photo, roofs[i]) if measured[i] and not seen.measured[i] else fp
@@ -116,7 +118,7 @@ def measure_from_above(m: Mission, seen: Survey, order: tuple[int, ...]) -> Wait
     taller = [
         f"{poi.index} ({poi.roof_m:.1f} m)"
         for poi in pois
-        if poi.roof_measured and poi.roof_m > m.params.mission.assumed_roof_m
+        if poi.roof_measured and poi.roof_m > assumed_m
     ]
     m.event(
         Level.INFO,
@@ -125,36 +127,35 @@ def measure_from_above(m: Mission, seen: Survey, order: tuple[int, ...]) -> Wait
     )
     m.roofs = tuple(
         (fp, roof) for fp, roof, ok in zip(footprints, roofs, measured, strict=True) if ok
-    ) + tuple((o.footprint, o.roof_m) for o in found if o.measured)
+    ) + tuple((o.footprint, o.roof_m) for o in obstacles if o.measured)
     m.unknown = {
         i: fp for i, (fp, ok) in enumerate(zip(footprints, measured, strict=True)) if not ok
     }
-    m.unknown.update({-1 - j: o.footprint for j, o in enumerate(found) if not o.measured})
+    m.unknown.update({-1 - j: o.footprint for j, o in enumerate(obstacles) if not o.measured})
     return replace(
         seen,
         roofs_m=tuple(roofs),
         measured=tuple(measured),
         footprints=footprints,
         pois=pois,
-        obstacles=found,
+        obstacles=obstacles,
     )
 
 
-def _unclassified(m: Mission, seen: Survey) -> list[list[Any]]:
-    """[shape, roof or None] for each region of the higher overview that is not ground and
-    shares no pixel with a building the vectorizer found (a coloured roof and its walls are
-    one region)."""
+def _unclassified(m: Mission, seen: Survey) -> list[Shape]:
+    """The regions of the higher overview that are not ground and share no pixel with a
+    building the vectorizer found (a coloured roof and its walls are one region)."""
     k = seen.photo.intrinsics
     found = np.zeros((k.height_px, k.width_px), np.uint8)
     cv2.fillPoly(found, [_pixels(s.polygon_px) for s in seen.shapes], 255)
-    out: list[list[Any]] = []
+    out: list[Shape] = []
     for region in non_ground(seen.photo.image_rgb, m.params.vectorize):
         if region.area_px < m.params.vectorize.min_area_px:
             continue
         own = np.zeros_like(found)
         cv2.fillPoly(own, [_pixels(region.polygon_px)], 255)
         if cv2.countNonZero(cv2.bitwise_and(own, found)) == 0:
-            out.append([region, None])
+            out.append(region)
     return out
 
 
@@ -175,13 +176,10 @@ def measure_roof(
     nadir photo (its ``others`` shapes): of its colour, and placed by both photos in one spot
     at the height found. Whole in both: triangulated; whole in one: fitted by the edges the
     other shows. None when no shape of the other photo agrees, or both are cut."""
-    tol = m.params.mission.roof_colour_tolerance_dn
     k = photo.intrinsics
     best: tuple[float, float] | None = None  # (disagreement px, height)
     for cand in others:
-        if not all(
-            abs(a - b) <= tol for a, b in zip(cand.colour_rgb, shape.colour_rgb, strict=True)
-        ):
+        if not same_colour(m, cand.colour_rgb, shape.colour_rgb):
             continue
         if shape.cut_by_border and cand.cut_by_border:
             continue

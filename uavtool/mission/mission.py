@@ -94,6 +94,7 @@ class Mission:
         self.model_built = False
         self.plan: Plan | None = None
         self.transit_m: float | None = None
+        """The altitude that clears every known roof (once the survey has measured them)."""
         self.ceiling_m: float | None = None
         """The second overview's altitude: every roof it showed is below it."""
         self.unknown: dict[int, tuple[tuple[float, float], ...]] = {}
@@ -101,7 +102,6 @@ class Mission:
         obstacle's is negative): a way near one crosses at the ceiling."""
         self.roofs: tuple[tuple[tuple[tuple[float, float], ...], float], ...] = ()
         """Every measured roof: (footprint, height above home)."""
-        """The altitude that clears every known roof (once the survey has measured them)."""
         self.viewpoints: Viewpoints | None = None
         self.model: ModelBuilt | None = None
         self._out: list[Output] = []

@@ -156,12 +156,9 @@ def _measure(
         return None
     p = m.params.mission
     k = high.intrinsics
-    tol = p.roof_colour_tolerance_dn
     best: tuple[float, Shape] | None = None
     for other in low_shapes:
-        if other.cut_by_border or not all(
-            abs(a - b) <= tol for a, b in zip(other.colour_rgb, shape.colour_rgb, strict=True)
-        ):
+        if other.cut_by_border or not same_colour(m, other.colour_rgb, shape.colour_rgb):
             continue
         # Climbing straight up, a roof's offset from the image centre shrinks as its size
         # does: where the lower photo should show this roof, given its size there.
@@ -176,6 +173,13 @@ def _measure(
     return roof_between(best[1], low, shape, high)
 
 
+def same_colour(m: Mission, a_rgb: tuple[int, int, int], b_rgb: tuple[int, int, int]) -> bool:
+    """Whether two outlines' colours can be one roof's (``mission.roof_colour_tolerance_dn``
+    in every channel)."""
+    tol = m.params.mission.roof_colour_tolerance_dn
+    return all(abs(a - b) <= tol for a, b in zip(a_rgb, b_rgb, strict=True))
+
+
 def footprint_at(shape: Shape, photo: Photo, roof_m: float) -> tuple[tuple[float, float], ...]:
     try:
         return ground_polygon(shape.polygon_px, photo.pose, photo.intrinsics, plane_z_m=roof_m)
@@ -187,15 +191,12 @@ def same_building(m: Mission, seen: Survey, target: int) -> frozenset[int]:
     """``target`` and the survey's other shapes of its colour that touch it, within the
     safety margin: the roofs of one stepped building, split in the overview by the walls
     between its tiers, are not obstacles to photographing it."""
-    tol = m.params.mission.roof_colour_tolerance_dn
     margin_m = m.params.viewpoints.safety_margin_m
     own = seen.footprints[target]
     colour = seen.shapes[target].colour_rgb
     parts = {target}
     for i, shape in enumerate(seen.shapes):
-        if i == target or not all(
-            abs(a - b) <= tol for a, b in zip(shape.colour_rgb, colour, strict=True)
-        ):
+        if i == target or not same_colour(m, shape.colour_rgb, colour):
             continue
         other = seen.footprints[i]
         gap = min(
@@ -271,14 +272,11 @@ def _measure_against(
 ) -> float | None:
     """The roof height of ``shape`` (in ``photo``) triangulated with the same roof in another
     nadir photo: its colour, whole, nearest where it falls on the ground."""
-    tol = m.params.mission.roof_colour_tolerance_dn
     k = photo.intrinsics
     here = ground_point(*shape.centroid_px, photo.pose, k)
     best: tuple[float, Shape] | None = None
     for cand in others:
-        if cand.cut_by_border or not all(
-            abs(a - b) <= tol for a, b in zip(cand.colour_rgb, shape.colour_rgb, strict=True)
-        ):
+        if cand.cut_by_border or not same_colour(m, cand.colour_rgb, shape.colour_rgb):
             continue
         there = ground_point(*cand.centroid_px, other.pose, other.intrinsics)
         miss = math.dist(here, there)

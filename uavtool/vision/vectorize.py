@@ -109,13 +109,14 @@ def non_ground(
     """The roofs of everything in an RGB frame that is not the ground, whatever its colour,
     largest first. Not ground: pixels differing from the ground's colour (the frame's most
     common colour, to 8 levels) by more than ``tolerance_dn`` in a channel; a roof: the part
-    of such a region in the region's own most common colour (its walls are shaded apart).
+    of such a region in its brightest colour that covers a tenth of it (walls are shaded
+    darker from above in daylight).
     This is what the obstacle map is made of: grey, white or black roofs, and a darker shade
     of a colour, which :func:`vectorize` leaves out, are here."""
     p = params if params is not None else VectorizeParams()
     frame = _check_frame(frame_rgb)
     cv2.setNumThreads(1)
-    mask = cv2.bitwise_not(_near(frame, _mode_rgb(frame, None), tolerance_dn))
+    mask = cv2.bitwise_not(_near(frame, _mode_rgb(frame), tolerance_dn))
     if p.denoise_px > 1:
         mask = cv2.medianBlur(mask, p.denoise_px)
     regions = _regions(mask, mask, (0, 0), frame.shape[:2], 1, p)
@@ -123,7 +124,7 @@ def non_ground(
     for r in regions:
         inside = np.zeros_like(mask)
         cv2.drawContours(inside, [r.contour], 0, 255, cv2.FILLED)
-        roof = cv2.bitwise_and(_near(frame, _roof_rgb(frame, inside), 6), inside)
+        roof = cv2.bitwise_and(_near(frame, _roof_rgb(frame, inside), _ROOF_TOLERANCE_DN), inside)
         if p.denoise_px > 1:
             roof = cv2.medianBlur(roof, p.denoise_px)
         found = _regions(roof, roof, (0, 0), frame.shape[:2], 1, p)
@@ -142,29 +143,36 @@ def _near(frame: U8Array, rgb: tuple[int, int, int], tolerance_dn: int) -> CvArr
 
 _ROOF_SHARE = 0.1
 """The least share of a region's pixels a colour must hold to be its roof's."""
+_ROOF_TOLERANCE_DN = 6
+"""How far (per channel) a roof's pixels may be from its colour: flat shading and noise."""
 
 
 def _roof_rgb(frame: U8Array, mask: CvArray) -> tuple[int, int, int]:
     """The brightest colour (to 8 levels) holding at least `_ROOF_SHARE` of the pixels under
     ``mask``: from above, in daylight, a roof is lit better than the walls around it."""
-    q = (frame >> 3).astype(np.int32)
-    codes = ((q[:, :, 0] << 10) | (q[:, :, 1] << 5) | q[:, :, 2])[mask != 0]
+    codes = _colour_codes(frame)[mask != 0]
     counts = np.bincount(codes, minlength=1 << 15)
     common = np.flatnonzero(counts >= _ROOF_SHARE * len(codes))
     if len(common) == 0:
         common = np.array([int(np.argmax(counts))])
     brightness = (common >> 10) + ((common >> 5) & 31) + (common & 31)
-    code = int(common[int(np.argmax(brightness))])
-    return ((code >> 10) * 8 + 4, ((code >> 5) & 31) * 8 + 4, (code & 31) * 8 + 4)
+    return _code_rgb(int(common[int(np.argmax(brightness))]))
 
 
-def _mode_rgb(frame: U8Array, mask: CvArray | None) -> tuple[int, int, int]:
-    """The most common colour of the frame (or of its pixels under ``mask``), each channel
-    quantized to 8 levels (bin centres)."""
+def _mode_rgb(frame: U8Array) -> tuple[int, int, int]:
+    """The frame's most common colour, to 8 levels."""
+    return _code_rgb(int(np.argmax(np.bincount(_colour_codes(frame).ravel(), minlength=1 << 15))))
+
+
+def _colour_codes(frame: U8Array) -> npt.NDArray[np.int32]:
+    """Each pixel's colour, every channel quantized to 8 levels, as one 15-bit code."""
     q = (frame >> 3).astype(np.int32)
-    codes = (q[:, :, 0] << 10) | (q[:, :, 1] << 5) | q[:, :, 2]
-    values = codes.ravel() if mask is None else codes[mask != 0]
-    code = int(np.argmax(np.bincount(values, minlength=1 << 15)))
+    codes: npt.NDArray[np.int32] = (q[:, :, 0] << 10) | (q[:, :, 1] << 5) | q[:, :, 2]
+    return codes
+
+
+def _code_rgb(code: int) -> tuple[int, int, int]:
+    """The colour at the centre of a code's bin."""
     return ((code >> 10) * 8 + 4, ((code >> 5) & 31) * 8 + 4, (code & 31) * 8 + 4)
 
 
