@@ -38,9 +38,13 @@ HOME = "50.0647,19.945,219,0"  # the paper scene's home (the scene follows the v
 
 
 def _copter_defaults() -> Path:
-    """ArduPilot's copter.parm beside the binary's tree (build/sitl/bin/arducopter)."""
-    tree = Path(ARDUCOPTER).resolve().parents[3]
-    return tree / "Tools" / "autotest" / "default_params" / "copter.parm"
+    """ArduPilot's copter.parm: beside the binary (a prebuilt SITL, as ../shared/peers lays
+    it out), else in the source tree the binary was built in (build/sitl/bin/arducopter)."""
+    binary = Path(ARDUCOPTER).resolve()
+    beside = binary.parent / "copter.parm"
+    if beside.is_file():
+        return beside
+    return binary.parents[3] / "Tools" / "autotest" / "default_params" / "copter.parm"
 
 
 @contextmanager
