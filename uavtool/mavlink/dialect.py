@@ -1,8 +1,13 @@
-"""The one MAVLink dialect uavtool speaks: MAVLink 2, ArduPilot's ``ardupilotmega``."""
+"""The one MAVLink dialect uavtool speaks: MAVLink 2, ArduPilot's ``ardupilotmega`` (with
+common.xml's events messages, :mod:`uavtool.mavlink.events`)."""
 
 from __future__ import annotations
 
 from pymavlink.dialects.v20 import ardupilotmega as mavlink
+
+from uavtool.mavlink.events import register
+
+register(mavlink)  # common.xml's EVENT messages, which pymavlink's bundled XML lacks
 
 DIALECT = "ardupilotmega"
 

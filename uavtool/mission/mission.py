@@ -293,7 +293,10 @@ class Mission:
             self._deferred.append(obs)  # e.g. a command result that arrived before the cut
 
     def _check_mode(self, t: Telemetry) -> None:
-        if not self._expected_modes or t.mode in self._expected_modes:
+        # Down from the landing the mission asked for, the autopilot picks its own mode on the
+        # ground (PX4 switches to Hold): nobody took over.
+        touched_down = self._landing and t.landed
+        if not self._expected_modes or t.mode in self._expected_modes or touched_down:
             self._link_was_lost = False  # the link came back and the vehicle kept its mode
             return
         who = "the vehicle's failsafe" if self._link_was_lost else "the pilot or a failsafe"

@@ -18,6 +18,7 @@ from contextlib import ExitStack
 from dataclasses import dataclass, field
 
 from uavtool import __version__
+from uavtool.autopilot import for_vehicle
 from uavtool.camera import Intrinsics
 from uavtool.errors import InputError, LinkError
 from uavtool.geo import GeoPoint, enu_from_geo
@@ -219,7 +220,8 @@ class _Loop:
             return False
         # Poses stay in one frame for the whole file, whatever the vehicle's home does.
         state.home = self.origin
-        t = telemetry(self.link, (self.config.gimbal_pitch_deg, 0.0))
+        autopilot = self.watch.autopilot or for_vehicle(self.link.state.heartbeat)
+        t = telemetry(self.link, (self.config.gimbal_pitch_deg, 0.0), autopilot)
         state.home = self._vehicle_home
         if t is None:
             return False

@@ -15,7 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from uavtool.mavlink.dialect import COPTER_MODE_NAMES
+from uavtool.autopilot import Autopilot, for_vehicle
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mavlink.framing import FrameParser
 from uavtool.recording import LogLevel
@@ -67,6 +67,8 @@ class VehicleWatch:
         self.other_gcs: dict[int, float] = {}  # sysid -> when last heard
         self._parser = FrameParser()
         self._mode: tuple[int, bool] | None = None
+        self.autopilot: Autopilot | None = None
+        """The vehicle's autopilot, known from its first HEARTBEAT."""
         self._mission_seq: int | None = None
         self._last_trigger_s: float | None = None
         self.airborne_seen = False
@@ -141,13 +143,15 @@ class VehicleWatch:
         mode = (int(msg.custom_mode), bool(msg.base_mode & M.MAV_MODE_FLAG_SAFETY_ARMED))
         if mode == self._mode:
             return
-        name = COPTER_MODE_NAMES.get(mode[0], f"MODE{mode[0]}")
+        if self.autopilot is None:
+            self.autopilot = for_vehicle(msg)
+        name = self.autopilot.mode_name(mode[0])
         if self._mode is None:
             state = "armed" if mode[1] else "disarmed"
             self.events.append(Event(LogLevel.INFO, f"mode {name}, {state}"))
         else:
             if mode[0] != self._mode[0]:
-                old = COPTER_MODE_NAMES.get(self._mode[0], f"MODE{self._mode[0]}")
+                old = self.autopilot.mode_name(self._mode[0])
                 self.events.append(Event(LogLevel.INFO, f"mode {old} → {name}"))
             if mode[1] != self._mode[1]:
                 self.events.append(Event(LogLevel.INFO, "armed" if mode[1] else "disarmed"))

@@ -22,12 +22,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from uavtool import __version__
+from uavtool.autopilot import Autopilot, for_vehicle
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.errors import InputError, LinkError
 from uavtool.images import png_decode, png_encode
 from uavtool.link import Clock, Transport, VehicleLink, open_transport
-from uavtool.mavlink.dialect import COPTER_MODES
-from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mission import Level, Mission, Outcome, Params
 from uavtool.mission.params import to_dict
 from uavtool.mission.survey import overview_ceiling_m
@@ -212,8 +211,9 @@ def fly(
         link.wait_vehicle(config.connect_timeout_s)
         home = link.state.home
         assert home is not None
+        autopilot = for_vehicle(link.state.heartbeat)
         say(
-            f"vehicle {link.target_system} on {link.name}, "
+            f"vehicle {link.target_system} ({autopilot.name}) on {link.name}, "
             f"home {home.lat_deg:.6f},{home.lon_deg:.6f}"
         )
         if live is not None:
@@ -221,16 +221,19 @@ def fly(
         if recorder is not None:
             recorder.home = home
             recorder.note(Level.INFO, f"connected to sysid {link.target_system} on {link.name}")
+        learnt = autopilot.prepare(link)
+        if learnt:
+            say(learnt)
         if config.vehicle_params:
             set_vehicle_params(link, config.vehicle_params)
         check_home(link)
         if config.camera != "sim":
             check_camera(camera)
         if not config.no_gimbal:
-            check_gimbal(link)
+            check_gimbal(link, autopilot)
         search = config.params.mission
         corner_m = search.search_radius_m * math.sqrt(2.0)  # the search square's corners
-        check_fence(link, overview_ceiling_m(search, camera.intrinsics), corner_m)
+        check_fence(link, autopilot, overview_ceiling_m(search, camera.intrinsics), corner_m)
         origin = scene.home
         if config.camera == "sim" and config.connect is not None:
             origin = place_scene(scene, home, config.scene_origin, say)
@@ -245,6 +248,7 @@ def fly(
             progress=progress,
             vehicle_says=vehicle_says,
             fixed_camera=config.no_gimbal,
+            autopilot=autopilot,
             # A real link may lose a command, its ACK or a position target: send them again
             # each second (lockstep loses nothing, and its recordings stay byte for byte).
             config=RunnerConfig(command_resend_s=1.0, target_resend_s=1.0)
@@ -256,7 +260,7 @@ def fly(
         try:
             outcome = runner.run()
         except KeyboardInterrupt:
-            _abort(link, recorder, "interrupted by the user: RTL sent")
+            _abort(link, autopilot, recorder, "interrupted by the user: RTL sent")
             raise
         except Exception as exc:
             _failed(recorder, exc)
@@ -408,11 +412,11 @@ def _origin_name(config: FlyConfig) -> str:
     return "vehicle-home" if config.scene_origin == "vehicle" else "scene"
 
 
-def _abort(link: VehicleLink, recorder: MissionRecorder | None, why: str) -> None:
+def _abort(
+    link: VehicleLink, autopilot: Autopilot, recorder: MissionRecorder | None, why: str
+) -> None:
     with contextlib.suppress(LinkError):  # best effort: the link may be what failed
-        link.command_long(
-            M.MAV_CMD_DO_SET_MODE, M.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, COPTER_MODES["RTL"]
-        )
+        autopilot.return_home(link)
     if recorder is not None:
         recorder.note(Level.WARNING, why)
         recorder.outcome({"status": "interrupted", "reason": why})

@@ -1,9 +1,10 @@
 """Checks on the ground, before arming: what the mission needs of the vehicle and the camera.
 
-The vehicle is asked what it has (GIMBAL_MANAGER_INFORMATION, and ArduPilot's ``MNT1_TYPE``)
-so that a missing mount stops the run before take-off with the fix, not at 45 m with a
-refused DO_MOUNT_CONTROL; and ArduPilot's fence, so that a fence below the second overview
-or inside the search square stops it too, not at the fence with an RTL. Every wait is on
+The vehicle is asked what it has (GIMBAL_MANAGER_INFORMATION, and the autopilot's mount
+parameters) so that a missing mount stops the run before take-off with the fix in its own
+parameter names, not at 45 m with a refused gimbal command; and its geofence, so that a fence
+below the second overview or inside the search square stops it too, not at the fence with an
+RTL. Every wait is on
 the link's clock (vehicle time in lockstep).
 """
 
@@ -13,6 +14,7 @@ import math
 from collections.abc import Callable
 from typing import Any
 
+from uavtool.autopilot import Autopilot, ParamReader
 from uavtool.camera import CameraPose
 from uavtool.errors import InputError
 from uavtool.link import VehicleLink
@@ -23,14 +25,6 @@ ANSWER_S = 3.0
 """How long the vehicle has to answer each question."""
 RETRY_S = 0.5
 """How often an unanswered question is asked again."""
-SERVO_MOUNT_FIX = (
-    "set MNT1_TYPE=1 (servo) with SERVO9_FUNCTION=7 (mount pitch) and SERVO10_FUNCTION=6 "
-    "(mount yaw), e.g. in a defaults file, and reboot the autopilot (ArduPilot reads "
-    "MNT1_TYPE only at boot)"
-)
-
-_FENCE_ALT_MAX, _FENCE_CIRCLE = 1, 2
-"""FENCE_TYPE bits (ArduPilot's AC_FENCE_TYPE_ALT_MAX and AC_FENCE_TYPE_CIRCLE)."""
 
 
 class PreflightError(InputError):
@@ -52,6 +46,7 @@ def check_camera(camera: CameraSource) -> None:
 
 def check_gimbal(
     link: VehicleLink,
+    autopilot: Autopilot,
     *,
     need_pitch_deg: tuple[float, float] = (-90.0, 0.0),
     on_wait: Callable[[], None] | None = None,
@@ -68,58 +63,55 @@ def check_gimbal(
     )
     if info is None:
         raise PreflightError(
-            f"the vehicle has no gimbal: {_mount_fix(link, on_wait)}; or fly with --no-gimbal"
+            f"the vehicle has no gimbal: {autopilot.gimbal_fix(_reader(link, on_wait))}; "
+            "or fly with --no-gimbal"
         )
     low, high = math.degrees(info.pitch_min), math.degrees(info.pitch_max)
     missing = [p for p in need_pitch_deg if not low - 0.5 <= p <= high + 0.5]
     if missing:
         raise PreflightError(
             f"the gimbal pitches {low:g}..{high:g}° but the mission needs "
-            f"{', '.join(f'{p:g}°' for p in missing)}: set MNT1_PITCH_MIN=-90 and MNT1_PITCH_MAX=0"
+            f"{', '.join(f'{p:g}°' for p in missing)}: {autopilot.pitch_fix()}"
         )
     return info
 
 
 def check_fence(
     link: VehicleLink,
+    autopilot: Autopilot,
     climb_to_m: float,
     reach_m: float,
     *,
     on_wait: Callable[[], None] | None = None,
 ) -> None:
-    """PreflightError when ArduPilot's fence is on and keeps the vehicle from where the
-    mission must fly: an altitude fence below ``climb_to_m`` (the second overview, above
-    home), or a circle fence closer than ``reach_m`` (the search square's corners). The
-    vehicle would refuse the move or breach the fence and return home mid-mission. Other
-    autopilots, or parameters that do not answer, pass."""
-    if not _ardupilot(link):
+    """PreflightError when the vehicle's geofence is on and keeps it from where the mission
+    must fly: an altitude limit below ``climb_to_m`` (the second overview, above home), or a
+    horizontal one closer than ``reach_m`` (the search square's corners). The vehicle would
+    refuse the move or breach the fence and return home mid-mission. A vehicle whose
+    parameters do not answer passes."""
+    fence = autopilot.fence(_reader(link, on_wait))
+    if fence is None:
         return
-    names = ("FENCE_ENABLE", "FENCE_TYPE", "FENCE_ALT_MAX", "FENCE_RADIUS")
-    values = [_param(link, name, on_wait) for name in names]
-    if None in values:
-        return
-    enabled, types, alt_max, radius = (float(v) for v in values if v is not None)
-    if not enabled:
-        return
-    if int(types) & _FENCE_ALT_MAX and alt_max < climb_to_m:
+    if fence.alt_max_m is not None and fence.alt_max_m < climb_to_m:
+        name = fence.alt_param
         raise PreflightError(
-            f"the altitude fence is on at FENCE_ALT_MAX={alt_max:g} m but the mission climbs "
-            f"to {climb_to_m:.1f} m above home for its second overview: set FENCE_ALT_MAX="
+            f"the altitude fence is on at {name}={fence.alt_max_m:g} m but the mission climbs "
+            f"to {climb_to_m:.1f} m above home for its second overview: set {name}="
             f"{math.ceil(climb_to_m) + 5}, or lower mission.search_radius_m or "
             "mission.assumed_roof_m"
         )
-    if int(types) & _FENCE_CIRCLE and radius < reach_m:
+    if fence.radius_m is not None and fence.radius_m < reach_m:
+        name = fence.radius_param
         raise PreflightError(
-            f"the circle fence is on at FENCE_RADIUS={radius:g} m but the search square's "
-            f"corners are {reach_m:.1f} m from home: set FENCE_RADIUS above "
+            f"the fence is on at {name}={fence.radius_m:g} m from home but the search "
+            f"square's corners are {reach_m:.1f} m from home: set {name} above "
             f"{math.ceil(reach_m)} (more for side photos of a building at the edge), or lower "
             "mission.search_radius_m"
         )
 
 
-def _ardupilot(link: VehicleLink) -> bool:
-    heartbeat = link.state.heartbeat
-    return heartbeat is not None and heartbeat.autopilot == M.MAV_AUTOPILOT_ARDUPILOTMEGA
+def _reader(link: VehicleLink, on_wait: Callable[[], None] | None) -> ParamReader:
+    return lambda name: _param(link, name, on_wait)
 
 
 def _param(link: VehicleLink, name: str, on_wait: Callable[[], None] | None) -> float | None:
@@ -136,19 +128,6 @@ def _param(link: VehicleLink, name: str, on_wait: Callable[[], None] | None) -> 
         lambda msg: _param_name(msg) == name,
     )
     return None if value is None else float(value.param_value)
-
-
-def _mount_fix(link: VehicleLink, on_wait: Callable[[], None] | None) -> str:
-    """What to do, from ArduPilot's MNT1_TYPE when it answers."""
-    if not _ardupilot(link):
-        return "configure a gimbal on the autopilot (gimbal protocol v2)"
-    value = _param(link, "MNT1_TYPE", on_wait)
-    if value is not None and value != 0:
-        return (
-            f"MNT1_TYPE is {value:g} but no mount started: reboot the autopilot "
-            "(ArduPilot reads MNT1_TYPE only at boot)"
-        )
-    return f"MNT1_TYPE=0; {SERVO_MOUNT_FIX}"
 
 
 def _param_name(msg: Any) -> str:

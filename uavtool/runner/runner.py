@@ -14,6 +14,7 @@ from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from uavtool.autopilot import COMMAND_NAMES, RESULT_NAMES, Autopilot, for_vehicle
 from uavtool.camera import CameraPose
 from uavtool.geo import GeoPoint, enu_from_geo
 from uavtool.images import png_encode
@@ -39,13 +40,7 @@ from uavtool.mission import (
 from uavtool.runner.camera import CameraSource
 from uavtool.runner.live import LiveView
 from uavtool.runner.record import MissionRecorder
-from uavtool.runner.vehicle import (
-    COMMAND_NAMES,
-    RESULT_NAMES,
-    photo_pose,
-    send_command,
-    telemetry,
-)
+from uavtool.runner.vehicle import photo_pose, telemetry
 
 Progress = Callable[[str, Telemetry | None], None]
 """Told each mission event, with the latest telemetry."""
@@ -94,8 +89,10 @@ class Runner:
         progress: Progress | None = None,
         vehicle_says: VehicleSays | None = None,
         fixed_camera: bool = False,
+        autopilot: Autopilot | None = None,
     ) -> None:
         self.link = link
+        self.autopilot = autopilot or for_vehicle(link.state.heartbeat)
         self.vehicle_says = vehicle_says or (lambda _text: None)
         self.fixed_camera = fixed_camera
         self.last_refusal = ""
@@ -159,7 +156,7 @@ class Runner:
                 self._heartbeat(now)
             if self._resend_due(now):
                 assert self._target is not None
-                send_command(self.link, self._target, home)
+                self.autopilot.send(self.link, self._target, home)
         assert self.mission.outcome is not None
         return self.mission.outcome
 
@@ -211,7 +208,7 @@ class Runner:
     def _on_message(self, msg: object) -> None:
         kind = msg.get_type()  # type: ignore[attr-defined]
         if kind == "GLOBAL_POSITION_INT":
-            t = telemetry(self.link, self._gimbal)
+            t = telemetry(self.link, self._gimbal, self.autopilot)
             if t is not None:
                 self._last = t
                 if self._queue and isinstance(self._queue[-1], Telemetry):
@@ -230,8 +227,8 @@ class Runner:
             # Pace our heartbeat by the vehicle's: at any speed-up the vehicle hears us as
             # often as it speaks, so its ground-station failsafe never fires by accident.
             self._heartbeat(self.link.clock())
-        elif kind == "STATUSTEXT":
-            text, severity = msg.text, msg.severity  # type: ignore[attr-defined]
+        elif (said := self.autopilot.vehicle_text(msg)) is not None:
+            severity, text = said
             if self.recorder is not None:
                 self.recorder.note(Level.INFO, f"vehicle: {text}", name="vehicle")
             if severity <= M.MAV_SEVERITY_WARNING:
@@ -252,7 +249,7 @@ class Runner:
         detail = "" if accepted else f"refused ({RESULT_NAMES.get(result, result)})"
         if not accepted:
             # The vehicle's reason is the warning it sent since the command (ArduPilot sends
-            # it just before the ACK); DO_MOUNT_CONTROL without a mount has none.
+            # it just before the ACK, PX4 around it); DO_MOUNT_CONTROL without a mount has none.
             said = self._warnings[-1] if len(self._warnings) > pending[2] else ""
             name = COMMAND_NAMES.get(command, str(command))
             self.last_refusal = f"{name} {detail}" + (f": {said}" if said else "")
@@ -271,7 +268,7 @@ class Runner:
             elif resend is not None and command in self._unacked:
                 cmd, last_ms = self._unacked[command]
                 if now_ms - last_ms > resend * 1000.0:
-                    send_command(self.link, cmd, self.home)
+                    self.autopilot.send(self.link, cmd, self.home)
                     self._unacked[command] = (cmd, now_ms)
 
     def _check_silence(self, now: float, last_rx: float) -> None:
@@ -299,7 +296,7 @@ class Runner:
             self._target, self._target_sent, self._target_left = cmd, self.link.clock(), math.inf
         else:  # a mode change, arming, a take-off: the target is no longer what is flown
             self._target = None
-        sent = send_command(self.link, cmd, self.home)
+        sent = self.autopilot.send(self.link, cmd, self.home)
         if sent.mav_cmd == 0:
             self._queue.append(CommandResult(cmd.id, True, "sent"))
         else:

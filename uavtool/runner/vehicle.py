@@ -1,36 +1,26 @@
-"""The MAVLink boundary of the runner: vehicle messages → :class:`Telemetry` observations,
-mission commands → ArduPilot MAVLink (GUIDED position targets, COMMAND_LONG), and which
-command each COMMAND_ACK answers."""
+"""The MAVLink boundary of the runner, inbound: vehicle messages → :class:`Telemetry`
+observations and camera poses. (Outbound, mission commands go on the wire through the
+vehicle's :class:`~uavtool.autopilot.Autopilot`.)"""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
+from uavtool.autopilot import Autopilot
 from uavtool.camera import CameraPose, Quaternion, camera_from_attitude
-from uavtool.geo import GeoPoint, enu_from_geo, geo_from_enu
+from uavtool.geo import GeoPoint, enu_from_geo
 from uavtool.link import VehicleLink
 from uavtool.link.client import gimbal_camera_pose
-from uavtool.mavlink.dialect import COPTER_MODE_NAMES, COPTER_MODES
 from uavtool.mavlink.dialect import mavlink as M
-from uavtool.mission import Arm, Command, GoTo, SetGimbal, SetMode, Takeoff, Telemetry
-
-# SET_POSITION_TARGET: use the position (and yaw when given), ignore velocity, acceleration
-# and yaw rate.
-_POS_ONLY = (
-    M.POSITION_TARGET_TYPEMASK_VX_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_VY_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_VZ_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_AX_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_AY_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_AZ_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_YAW_RATE_IGNORE
-)
+from uavtool.mission import Telemetry
 
 
-def telemetry(link: VehicleLink, commanded_gimbal: tuple[float, float]) -> Telemetry | None:
-    """The vehicle's state now, in ENU around its home; None until home and position are
-    known. A vehicle that reports no gimbal attitude is assumed to hold ``commanded_gimbal``."""
+def telemetry(
+    link: VehicleLink, commanded_gimbal: tuple[float, float], autopilot: Autopilot
+) -> Telemetry | None:
+    """The vehicle's state now, in ENU around its home, its mode in the mission's vocabulary;
+    None until home and position are known. A vehicle that reports no gimbal attitude is
+    assumed to hold ``commanded_gimbal``."""
     s = link.state
     pos, home = s.position, s.home
     if pos is None or home is None or s.heartbeat is None:
@@ -54,7 +44,7 @@ def telemetry(link: VehicleLink, commanded_gimbal: tuple[float, float]) -> Telem
         pos_enu_m=(east, north, up),
         vel_enu_m_s=(pos.vy / 100.0, pos.vx / 100.0, -pos.vz / 100.0),
         heading_deg=heading % 360.0,
-        mode=COPTER_MODE_NAMES.get(hb.custom_mode, f"MODE{hb.custom_mode}"),
+        mode=autopilot.mission_mode(hb),
         armed=armed,
         landed=landed,
         gimbal_pitch_deg=float(pitch),
@@ -106,75 +96,3 @@ def photo_pose(link: VehicleLink, t: Telemetry, *, fixed_down: bool = False) -> 
         if pose is not None:
             return pose
     return camera_pose(t)
-
-
-@dataclass(frozen=True, slots=True)
-class Sent:
-    """A command on the wire: the MAVLink command number its ACK will carry (0: none)."""
-
-    mav_cmd: int
-
-
-def send_command(link: VehicleLink, cmd: Command, home: GeoPoint) -> Sent:
-    """Send a mission command the way ArduCopter takes it."""
-    if isinstance(cmd, SetMode):
-        number = COPTER_MODES.get(cmd.mode)
-        if number is None:
-            raise ValueError(f"unknown ArduCopter mode {cmd.mode!r}")
-        link.command_long(M.MAV_CMD_DO_SET_MODE, M.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, number)
-        return Sent(M.MAV_CMD_DO_SET_MODE)
-    if isinstance(cmd, Arm):
-        link.command_long(M.MAV_CMD_COMPONENT_ARM_DISARM, 1.0)
-        return Sent(M.MAV_CMD_COMPONENT_ARM_DISARM)
-    if isinstance(cmd, Takeoff):
-        link.command_long(M.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, math.nan, 0, 0, cmd.alt_m)
-        return Sent(M.MAV_CMD_NAV_TAKEOFF)
-    if isinstance(cmd, SetGimbal):
-        link.command_long(
-            M.MAV_CMD_DO_MOUNT_CONTROL,
-            cmd.pitch_deg,
-            0.0,
-            cmd.yaw_deg,
-            0,
-            0,
-            0,
-            M.MAV_MOUNT_MODE_MAVLINK_TARGETING,
-        )
-        return Sent(M.MAV_CMD_DO_MOUNT_CONTROL)
-    if isinstance(cmd, GoTo):
-        x, y, z = cmd.pos_enu_m
-        target = geo_from_enu(home, x, y, 0.0)
-        mask = _POS_ONLY | (M.POSITION_TARGET_TYPEMASK_YAW_IGNORE if cmd.heading_deg is None else 0)
-        yaw = 0.0 if cmd.heading_deg is None else math.radians(cmd.heading_deg)
-        link.send(
-            M.MAVLink_set_position_target_global_int_message(
-                0,
-                link.target_system,
-                link.target_component,
-                M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
-                mask,
-                target.lat_e7,
-                target.lon_e7,
-                z,
-                0,
-                0,
-                0,
-                0,
-                0,
-                0,
-                yaw,
-                0,
-            )
-        )
-        return Sent(0)  # position targets have no ACK
-    raise TypeError(f"not a vehicle command: {cmd!r}")
-
-
-RESULT_NAMES = {
-    v: k for k, v in vars(M).items() if k.startswith("MAV_RESULT_") and isinstance(v, int)
-}
-COMMAND_NAMES = {
-    v: k.removeprefix("MAV_CMD_")
-    for k, v in vars(M).items()
-    if k.startswith("MAV_CMD_") and isinstance(v, int)
-}
