@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import lzma
 import struct
+from collections.abc import Callable
 from typing import Any
 
 from uavtool.link import VehicleLink
@@ -115,10 +116,11 @@ def xz(data: bytes) -> bytes:
     return lzma.compress(data, format=lzma.FORMAT_XZ)
 
 
-def link_to(fake: FakePX4) -> VehicleLink:
-    """A link that has heard the fake vehicle (its heartbeat and position)."""
+def link_to(fake: FakePX4, clock: Callable[[], float] | None = None) -> VehicleLink:
+    """A link that has heard the fake vehicle (its heartbeat and position); its clock moves
+    10 ms each time it is read, unless ``clock`` is given."""
     ticks = iter(range(10**9))
-    link = VehicleLink(fake, clock=lambda: next(ticks) * 0.01, announce=False)
+    link = VehicleLink(fake, clock=clock or (lambda: next(ticks) * 0.01), announce=False)
     link.poll(0.0)
     assert link.target_system == 1
     return link

@@ -143,3 +143,28 @@ def test_preflight_stops_at_px4s_geofence_with_its_parameter_named() -> None:
         check_fence(link_to(fake), PX4(), 65.3, 57.0)
     fake = FakePX4({}, params={"GF_ACTION": 2, "GF_MAX_VER_DIST": 120, "GF_MAX_HOR_DIST": 200})
     check_fence(link_to(fake), PX4(), 65.3, 57.0)  # room enough: passes
+
+
+def test_offboard_streams_setpoints_then_asks_for_offboard() -> None:
+    """MAVSDK's way: setpoints first (PX4 refuses OFFBOARD without them), at least 2 Hz, and
+    OFFBOARD asked for again until shown; a mode change stops the stream."""
+    now = [0.0]
+    px4, fake = PX4(movement="offboard"), FakePX4({})
+    link = link_to(fake, clock=lambda: now[0])
+    sent = px4.send(link, GoTo(1, (10.0, 0.0, 20.0), None), HOME)
+    assert sent.mav_cmd == 0  # no ACK for setpoints
+    for tenth in range(1, 31):  # three seconds, the runner's loop every 0.1 s
+        now[0] = tenth * 0.1
+        px4.tick(link, now[0], HOME)
+    setpoints = _sent(fake, "SET_POSITION_TARGET_GLOBAL_INT")
+    assert 2 * 3 <= len(setpoints) <= 14  # every 0.25 s: above PX4's 2 Hz, not every turn
+    assert setpoints[-1].coordinate_frame == M.MAV_FRAME_GLOBAL_INT
+    assert setpoints[-1].alt == pytest.approx(500.7 + 20.0, abs=1e-3)
+    asks = [m for m in _sent(fake, "COMMAND_LONG") if m.command == M.MAV_CMD_DO_SET_MODE]
+    assert len(asks) == 3  # after 0.5 s of setpoints, then each second it is not shown
+    assert (asks[0].param2, asks[0].param3) == (6, 0)  # OFFBOARD
+    px4.send(link, SetMode(2, "RTL"), HOME)
+    before = len(_sent(fake, "SET_POSITION_TARGET_GLOBAL_INT"))
+    now[0] = 10.0
+    px4.tick(link, now[0], HOME)
+    assert len(_sent(fake, "SET_POSITION_TARGET_GLOBAL_INT")) == before

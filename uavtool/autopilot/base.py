@@ -78,6 +78,10 @@ class Autopilot:
         """Put a mission command on the wire, the way this autopilot takes it."""
         raise NotImplementedError
 
+    def tick(self, link: VehicleLink, now_s: float, home: GeoPoint) -> None:
+        """Called on every turn of the runner's loop (``now_s`` on the link's clock): for what
+        the autopilot needs sent continuously (PX4's offboard setpoints). Nothing by default."""
+
     def return_home(self, link: VehicleLink) -> None:
         """Best effort, when the run stops early: the vehicle's own return-to-launch."""
         raise NotImplementedError

@@ -1,10 +1,12 @@
 """PX4: main and sub modes in the custom mode, take-off to an altitude above sea level,
-movement by DO_REPOSITION in Hold (as QGroundControl's "go to location"), the gimbal through
-the gimbal manager (protocol v2), and PX4's own parameter names in every hint.
+movement by DO_REPOSITION in Hold (as QGroundControl's "go to location"; or, with
+``movement="offboard"``, a stream of position setpoints in OFFBOARD, as MAVSDK's offboard
+plugin), the gimbal through the gimbal manager (protocol v2), and PX4's own parameter names
+in every hint.
 
 PX4 has no GUIDED mode. The adapter emulates one: after the mission asks for GUIDED, the
 modes the adapter drives the vehicle through — Hold (AUTO.LOITER, where DO_REPOSITION moves
-it) and AUTO.TAKEOFF — read as GUIDED; any other mode the vehicle shows ends that (whoever
+it), AUTO.TAKEOFF and OFFBOARD — read as GUIDED; any other mode the vehicle shows ends that (whoever
 switched: the mission to RTL, a pilot, a failsafe), so a later Hold reads as AUTO.LOITER.
 """
 
@@ -36,7 +38,21 @@ RTL = (_AUTO, 5)
 LAND = (_AUTO, 6)
 _OURS = {"GUIDED": HOLD, "RTL": RTL, "LAND": LAND}
 """The mission's modes, as PX4 (main, sub) modes."""
-_GUIDED_SHOWN_AS = {"AUTO.LOITER", "AUTO.TAKEOFF"}
+OFFBOARD = (6, 0)
+_GUIDED_SHOWN_AS = {"AUTO.LOITER", "AUTO.TAKEOFF", "OFFBOARD"}
+SETPOINT_S = 0.25
+"""How often offboard setpoints go out (PX4 wants at least 2 Hz, and fails over without)."""
+OFFBOARD_AFTER_S = 0.5
+"""Setpoints streamed this long before OFFBOARD is asked for (PX4 refuses it without)."""
+_SETPOINT_MASK = (
+    M.POSITION_TARGET_TYPEMASK_VX_IGNORE
+    | M.POSITION_TARGET_TYPEMASK_VY_IGNORE
+    | M.POSITION_TARGET_TYPEMASK_VZ_IGNORE
+    | M.POSITION_TARGET_TYPEMASK_AX_IGNORE
+    | M.POSITION_TARGET_TYPEMASK_AY_IGNORE
+    | M.POSITION_TARGET_TYPEMASK_AZ_IGNORE
+    | M.POSITION_TARGET_TYPEMASK_YAW_RATE_IGNORE
+)
 _NAMED_FOR_MISSION = {"AUTO.RTL": "RTL", "AUTO.LAND": "LAND"}
 
 _OFF, _ASKED, _ON = 0, 1, 2
@@ -77,11 +93,18 @@ def _amsl(link: VehicleLink, home: GeoPoint, up_m: float) -> float:
 class PX4(Autopilot):
     name = "PX4"
 
-    def __init__(self, events: EventDecoder | None = None) -> None:
+    def __init__(self, events: EventDecoder | None = None, *, movement: str = "reposition") -> None:
+        if movement not in ("reposition", "offboard"):
+            raise ValueError(f"PX4 movement is 'reposition' or 'offboard', not {movement!r}")
+        self.movement = movement
         self._guided = _OFF
         self._gimbal_control = False
         self.events = events
         """Texts for PX4's EVENT messages (None: they read as their numbers)."""
+        self._setpoint: GoTo | None = None  # offboard: the target streamed, and since when
+        self._streaming_since = 0.0
+        self._setpoint_sent = -math.inf
+        self._offboard_asked = -math.inf
 
     def prepare(self, link: VehicleLink, on_wait: Callable[[], None] | None = None) -> str:
         if self.events is None:
@@ -113,6 +136,8 @@ class PX4(Autopilot):
         return _NAMED_FOR_MISSION.get(name, name)
 
     def send(self, link: VehicleLink, cmd: Command, home: GeoPoint) -> Sent:
+        if not isinstance(cmd, GoTo | SetGimbal):
+            self._setpoint = None  # a mode change or a take-off: the stream stops
         if isinstance(cmd, SetMode):
             mode = _OURS.get(cmd.mode) or _BY_NAME.get(cmd.mode)
             if mode is None:
@@ -145,6 +170,12 @@ class PX4(Autopilot):
                 0,  # flags: yaw relative to the vehicle ("follow")
             )
             return Sent(M.MAV_CMD_DO_GIMBAL_MANAGER_PITCHYAW)
+        if isinstance(cmd, GoTo) and self.movement == "offboard":
+            if self._setpoint is None:
+                self._streaming_since = link.clock()
+            self._setpoint = cmd
+            self._send_setpoint(link, cmd, home)
+            return Sent(0)  # setpoints have no ACK; OFFBOARD is asked for by tick()
         if isinstance(cmd, GoTo):
             x, y, z = cmd.pos_enu_m
             target = geo_from_enu(home, x, y, 0.0)
@@ -171,7 +202,46 @@ class PX4(Autopilot):
             return Sent(M.MAV_CMD_DO_REPOSITION)
         raise TypeError(f"not a vehicle command: {cmd!r}")
 
+    def tick(self, link: VehicleLink, now_s: float, home: GeoPoint) -> None:
+        """Offboard: the setpoint again every :data:`SETPOINT_S`, and OFFBOARD asked for (again
+        each second until the vehicle shows it) once the stream has run long enough."""
+        if self._setpoint is None:
+            return
+        if now_s - self._setpoint_sent >= SETPOINT_S:
+            self._send_setpoint(link, self._setpoint, home)
+        shown = link.state.heartbeat
+        in_offboard = shown is not None and px4_mode(int(shown.custom_mode)) == OFFBOARD
+        if (
+            not in_offboard
+            and now_s - self._streaming_since >= OFFBOARD_AFTER_S
+            and now_s - self._offboard_asked >= 1.0
+        ):
+            set_mode_long(link, *OFFBOARD)
+            self._offboard_asked = now_s
+
+    def _send_setpoint(self, link: VehicleLink, cmd: GoTo, home: GeoPoint) -> None:
+        x, y, z = cmd.pos_enu_m
+        target = geo_from_enu(home, x, y, 0.0)
+        no_yaw = cmd.heading_deg is None
+        link.send(
+            M.MAVLink_set_position_target_global_int_message(
+                0,
+                link.target_system,
+                link.target_component,
+                M.MAV_FRAME_GLOBAL_INT,
+                _SETPOINT_MASK | (M.POSITION_TARGET_TYPEMASK_YAW_IGNORE if no_yaw else 0),
+                target.lat_e7,
+                target.lon_e7,
+                _amsl(link, home, z),
+                0, 0, 0, 0, 0, 0,
+                0.0 if no_yaw else math.radians(cmd.heading_deg or 0.0),
+                0,
+            )
+        )  # fmt: skip
+        self._setpoint_sent = link.clock()
+
     def return_home(self, link: VehicleLink) -> None:
+        self._setpoint = None
         set_mode_long(link, *RTL)
 
     def gimbal_fix(self, read: ParamReader) -> str:

@@ -133,11 +133,13 @@ def fly(
     progress: Progress | None = None,
     status: Callable[[str], None] | None = None,
     vehicle_says: Callable[[str], None] | None = None,
+    autopilot_for: Callable[[object], Autopilot] = for_vehicle,
 ) -> FlightSummary:
     """Fly one mission; raises InputError on bad input or a failed pre-flight check
     (:class:`PreflightError`, before arming), LinkError when the vehicle cannot be reached.
     ``progress`` hears each mission event, ``status`` the set-up steps, ``vehicle_says`` the
-    vehicle's warnings and refusals as they arrive."""
+    vehicle's warnings and refusals as they arrive. ``autopilot_for`` picks the adapter from
+    the vehicle's HEARTBEAT (e.g. ``lambda _: PX4(movement="offboard")``)."""
     say = status or (lambda _text: None)
     wall0 = time.monotonic()
     if config.scene_origin not in SCENE_ORIGINS:
@@ -211,7 +213,7 @@ def fly(
         link.wait_vehicle(config.connect_timeout_s)
         home = link.state.home
         assert home is not None
-        autopilot = for_vehicle(link.state.heartbeat)
+        autopilot = autopilot_for(link.state.heartbeat)
         say(
             f"vehicle {link.target_system} ({autopilot.name}) on {link.name}, "
             f"home {home.lat_deg:.6f},{home.lon_deg:.6f}"

@@ -157,6 +157,7 @@ class Runner:
             if self._resend_due(now):
                 assert self._target is not None
                 self.autopilot.send(self.link, self._target, home)
+            self.autopilot.tick(self.link, now, home)
         assert self.mission.outcome is not None
         return self.mission.outcome
 
