@@ -14,7 +14,7 @@ from uavtool.autopilot.px4 import px4_mode_name
 from uavtool.geo import GeoPoint, enu_from_geo
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mission import Arm, GoTo, SetGimbal, SetMode, Takeoff
-from uavtool.runner.preflight import PreflightError, check_fence
+from uavtool.runner.preflight import PreflightError, check_fence, check_gimbal
 
 HOME = GeoPoint(47.397743, 8.545597, 499.4)  # HOME_POSITION's altitude; the vehicle says 500.7
 
@@ -168,3 +168,20 @@ def test_offboard_streams_setpoints_then_asks_for_offboard() -> None:
     now[0] = 10.0
     px4.tick(link, now[0], HOME)
     assert len(_sent(fake, "SET_POSITION_TARGET_GLOBAL_INT")) == before
+
+
+def test_a_gimbal_v1_mount_is_pointed_with_do_mount_control() -> None:
+    """PX4 with MNT_MODE_IN=3 takes DO_MOUNT_CONTROL and has no gimbal manager (it denies
+    GIMBAL_MANAGER_INFORMATION): the pitch range comes from its parameters."""
+    params: dict[str, float] = {"MNT_MODE_IN": 3, "MNT_MIN_PITCH": -90, "MNT_MAX_PITCH": 0}
+    px4, fake = PX4(), FakePX4({}, params=params)
+    link = link_to(fake)
+    assert check_gimbal(link, px4) == (-90.0, 0.0)
+    sent = px4.send(link, SetGimbal(1, -45.0), HOME)
+    assert sent.mav_cmd == _sent(fake, "COMMAND_LONG")[-1].command == M.MAV_CMD_DO_MOUNT_CONTROL
+    fake = FakePX4({}, params={**params, "MNT_MAX_PITCH": -20})
+    with pytest.raises(PreflightError, match="MNT_MIN_PITCH=-90 and MNT_MAX_PITCH=0"):
+        check_gimbal(link_to(fake), PX4())
+    fake = FakePX4({}, params={**params, "MNT_MODE_IN": -1})
+    with pytest.raises(PreflightError, match="no gimbal: set MNT_MODE_IN=4"):
+        check_gimbal(link_to(fake), PX4())

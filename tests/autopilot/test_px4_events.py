@@ -94,3 +94,21 @@ def test_a_vehicle_without_the_file_is_a_link_error_and_events_read_as_numbers()
     said = px4.vehicle_text(_event(1, 1234, b"", level=3))
     assert said == (3, f"event {(1 << 24) | 1234}")
     assert px4.vehicle_text(_event(1, 1234, b"", level=8)) is None  # protocol level: not news
+
+
+def test_px4_saying_a_thing_twice_is_said_once_and_standing_reports_are_not_warnings() -> None:
+    metadata = json.loads(json.dumps(METADATA))
+    group = metadata["components"]["1"]["event_groups"]
+    group["health"] = {"events": {"55": {"name": "no_rc", "message": "No manual control input"}}}
+    px4 = PX4(EventDecoder(metadata))
+    low = M.MAVLink_statustext_message(M.MAV_SEVERITY_WARNING, b"Arming denied: X\t")
+    denied = _event(1, 77, struct.pack("<IB", 0, 2), level=4)
+    assert px4.vehicle_text(low) == (4, "Arming denied: X")
+    assert px4.vehicle_text(_event(1, 77, b"", level=4)) is not None  # another text
+    assert px4.vehicle_text(low) == (4, "Arming denied: X")
+    again = M.MAVLink_statustext_message(M.MAV_SEVERITY_WARNING, b"Arming denied: Return in X")
+    assert px4.vehicle_text(denied) == (4, "Arming denied: Return in X")
+    assert px4.vehicle_text(again) is None  # the same words, the other way, right after
+    assert px4.vehicle_text(again) == (4, "Arming denied: Return in X")  # said again: news
+    severity, text = px4.vehicle_text(_event(1, 55, b"", level=3)) or (0, "")
+    assert (severity, text) == (M.MAV_SEVERITY_INFO, "No manual control input")

@@ -5,6 +5,7 @@ PX4's modes, take-off, DO_REPOSITION, gimbal manager and parameter names."""
 
 from __future__ import annotations
 
+import itertools
 import subprocess
 import sys
 import time
@@ -89,3 +90,19 @@ def test_record_records_a_px4_flight_flown_by_someone_else(tmp_path: Path) -> No
     assert any("→ AUTO.TAKEOFF" in e for e in events), events
     assert any("→ AUTO.RTL" in e for e in events), events
     assert max(heights) > 40.0 and abs(heights[-1]) < 1.0
+
+
+def test_a_failsafe_is_a_takeover_in_px4s_own_words(tmp_path: Path) -> None:
+    """A battery that runs flat seconds after take-off (SIH's simulated battery): PX4's
+    failsafe switches to RTL; the mission says so and stops commanding (pilot-takeover, exit
+    1), and PX4's events — which pymavlink cannot decode — are printed in words, once each."""
+    drains = {**PX4_GIMBAL, "SIM_BAT_MIN_PCT": "5", "SIM_BAT_DRAIN": "1"}
+    with px4(tmp_path, params=drains) as port:
+        result = fly(f"udpin:0.0.0.0:{port}", tmp_path)
+    said = result.stdout + result.stderr
+    assert result.returncode == 1, said
+    assert "outcome        pilot-takeover: mode changed to RTL" in result.stdout
+    assert "PX4's events metadata:" in said
+    assert "vehicle: Critical battery level: switching to RTL" in said
+    lines = [line for line in said.splitlines() if line.startswith("uavtool fly: vehicle:")]
+    assert all(a != b for a, b in itertools.pairwise(lines)), lines  # said once, not twice

@@ -92,6 +92,12 @@ class Autopilot:
         """What to set when the vehicle reports no gimbal manager (its parameters, by name)."""
         return "configure a gimbal on the autopilot (MAVLink gimbal protocol v2)"
 
+    def mount_v1(self, read: ParamReader) -> tuple[float, float] | None:  # noqa: ARG002
+        """The pitch range of a mount this vehicle drives with gimbal protocol v1 only (no
+        gimbal manager), from its parameters; None if it has none. From then on the adapter
+        points it with DO_MOUNT_CONTROL."""
+        return None
+
     def pitch_fix(self) -> str:
         """What to set when the gimbal cannot pitch from straight down to the horizon."""
         return "give the gimbal a pitch range of -90..0°"

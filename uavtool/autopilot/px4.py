@@ -56,6 +56,7 @@ _SETPOINT_MASK = (
 _NAMED_FOR_MISSION = {"AUTO.RTL": "RTL", "AUTO.LAND": "LAND"}
 
 _OFF, _ASKED, _ON = 0, 1, 2
+_STANDING_REPORTS = {"health", "arming_check"}
 
 
 def px4_mode(custom_mode: int) -> tuple[int, int]:
@@ -99,8 +100,10 @@ class PX4(Autopilot):
         self.movement = movement
         self._guided = _OFF
         self._gimbal_control = False
+        self._gimbal_v1 = False  # a mount driven by DO_MOUNT_CONTROL (MNT_MODE_IN=3)
         self.events = events
         """Texts for PX4's EVENT messages (None: they read as their numbers)."""
+        self._last_said = ("", "")  # (message type, text) of the last thing the vehicle said
         self._setpoint: GoTo | None = None  # offboard: the target streamed, and since when
         self._streaming_since = 0.0
         self._setpoint_sent = -math.inf
@@ -115,13 +118,31 @@ class PX4(Autopilot):
         return f"PX4's events metadata: {len(self.events)} events"
 
     def vehicle_text(self, msg: Any) -> tuple[int, str] | None:
-        if msg.get_type() == "EVENT":
-            if int(msg.log_levels) & 0x0F > M.MAV_SEVERITY_DEBUG:
-                return None  # libevents' protocol-level events (summaries for the GCS)
-            if self.events is None:
-                return int(msg.log_levels) & 0x0F, f"event {int(msg.id)}"
-            return self.events.describe(msg)
-        return super().vehicle_text(msg)
+        said = self._vehicle_text(msg)
+        if said is None:
+            return None
+        # PX4 says much twice in a row, as a STATUSTEXT and as an event: once is enough (a
+        # repeat of the same kind is news again, e.g. the reason for a second refusal).
+        text, kind = said[1].strip(), msg.get_type()
+        last, self._last_said = self._last_said, (kind, text)
+        if last[1] == text and last[0] != kind:
+            self._last_said = ("", "")
+            return None
+        return said[0], text
+
+    def _vehicle_text(self, msg: Any) -> tuple[int, str] | None:
+        if msg.get_type() != "EVENT":
+            return super().vehicle_text(msg)
+        if int(msg.log_levels) & 0x0F > M.MAV_SEVERITY_DEBUG:
+            return None  # libevents' protocol-level events (summaries for the GCS)
+        if self.events is None:
+            return int(msg.log_levels) & 0x0F, f"event {int(msg.id)}"
+        severity, text = self.events.describe(msg)
+        if self.events.group(msg) in _STANDING_REPORTS:
+            # What some mode lacks ("No offboard signal", "No manual control input"): kept in
+            # the recording, not said as a warning (QGroundControl lists them apart too).
+            severity = max(severity, M.MAV_SEVERITY_INFO)
+        return severity, text
 
     def mode_name(self, custom_mode: int) -> str:
         return px4_mode_name(*px4_mode(custom_mode))
@@ -155,6 +176,12 @@ class PX4(Autopilot):
             amsl = _amsl(link, home, cmd.alt_m)
             link.command_long(M.MAV_CMD_NAV_TAKEOFF, nan, 0, 0, nan, nan, nan, amsl)
             return Sent(M.MAV_CMD_NAV_TAKEOFF)
+        if isinstance(cmd, SetGimbal) and self._gimbal_v1:
+            link.command_long(
+                M.MAV_CMD_DO_MOUNT_CONTROL, cmd.pitch_deg, 0.0, cmd.yaw_deg, 0, 0, 0,
+                M.MAV_MOUNT_MODE_MAVLINK_TARGETING,
+            )  # fmt: skip
+            return Sent(M.MAV_CMD_DO_MOUNT_CONTROL)
         if isinstance(cmd, SetGimbal):
             if not self._gimbal_control:  # PX4 denies PITCHYAW from a GCS without control
                 link.command_long(
@@ -256,6 +283,15 @@ class PX4(Autopilot):
             "set MNT_MODE_IN=4 (MAVLink gimbal protocol v2) and MNT_MODE_OUT=0 (AUX outputs; "
             "2 for a MAVLink gimbal), then reboot PX4"
         )
+
+    def mount_v1(self, read: ParamReader) -> tuple[float, float] | None:
+        if read("MNT_MODE_IN") != 3:  # MAVLINK_DO_MOUNT: gimbal protocol v1 in
+            return None
+        low, high = read("MNT_MIN_PITCH"), read("MNT_MAX_PITCH")
+        if low is None or high is None:
+            return None
+        self._gimbal_v1 = True
+        return low, high
 
     def pitch_fix(self) -> str:
         return "set MNT_MIN_PITCH=-90 and MNT_MAX_PITCH=0"

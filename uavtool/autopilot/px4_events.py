@@ -35,18 +35,19 @@ class EventDecoder:
     """Texts for EVENT messages from libevents metadata (the parsed ``all_events.json``)."""
 
     def __init__(self, metadata: dict[str, Any]) -> None:
-        self._events: dict[int, tuple[str, list[str], str]] = {}
+        self._events: dict[int, tuple[str, list[str], str, str]] = {}
         self._enums: dict[str, dict[str, Any]] = {}  # "namespace::name" -> enum
         components = metadata.get("components", {})
         for component_id, component in components.items():
             namespace = str(component.get("namespace", ""))
             for name, enum in component.get("enums", {}).items():
                 self._enums[f"{namespace}::{name}"] = enum
-            for group in component.get("event_groups", {}).values():
+            for group_name, group in component.get("event_groups", {}).items():
                 for sub_id, event in group.get("events", {}).items():
                     event_id = (int(component_id) << 24) | int(sub_id)
                     types = [str(a.get("type", "")) for a in event.get("arguments", [])]
-                    self._events[event_id] = (str(event.get("message", "")), types, namespace)
+                    message = str(event.get("message", ""))
+                    self._events[event_id] = (message, types, namespace, str(group_name))
 
     def __len__(self) -> int:
         return len(self._events)
@@ -57,9 +58,15 @@ class EventDecoder:
         known = self._events.get(int(msg.id))
         if known is None:
             return severity, f"event {int(msg.id) >> 24}:{int(msg.id) & 0xFFFFFF}"
-        template, types, namespace = known
+        template, types, namespace, _ = known
         values = self._arguments(bytes(msg.arguments), types, namespace)
         return severity, self._text(template, values, types, namespace)
+
+    def group(self, msg: Any) -> str:
+        """The event's group in the metadata ("" if unknown): ``health`` and ``arming_check``
+        events are PX4's standing reports of what each mode lacks, not news."""
+        known = self._events.get(int(msg.id))
+        return known[3] if known is not None else ""
 
     def _enum(self, ftype: str, namespace: str) -> dict[str, Any] | None:
         name = ftype if "::" in ftype else f"{namespace}::{ftype}"

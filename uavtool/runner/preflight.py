@@ -50,9 +50,11 @@ def check_gimbal(
     *,
     need_pitch_deg: tuple[float, float] = (-90.0, 0.0),
     on_wait: Callable[[], None] | None = None,
-) -> Any:
-    """The vehicle's GIMBAL_MANAGER_INFORMATION if its gimbal can point at each of
-    ``need_pitch_deg``; PreflightError naming the fix otherwise."""
+) -> tuple[float, float]:
+    """The gimbal's pitch range (degrees) if it can point at each of ``need_pitch_deg``:
+    a gimbal manager's (GIMBAL_MANAGER_INFORMATION, protocol v2), else the range of a mount
+    the autopilot drives with gimbal protocol v1 only; PreflightError naming the fix
+    otherwise."""
     info = _ask(
         link,
         lambda: link.command_long(
@@ -61,19 +63,22 @@ def check_gimbal(
         "GIMBAL_MANAGER_INFORMATION",
         on_wait,
     )
-    if info is None:
+    if info is not None:
+        low, high = math.degrees(info.pitch_min), math.degrees(info.pitch_max)
+    elif (v1 := autopilot.mount_v1(_reader(link, on_wait))) is not None:
+        low, high = v1
+    else:
         raise PreflightError(
             f"the vehicle has no gimbal: {autopilot.gimbal_fix(_reader(link, on_wait))}; "
             "or fly with --no-gimbal"
         )
-    low, high = math.degrees(info.pitch_min), math.degrees(info.pitch_max)
     missing = [p for p in need_pitch_deg if not low - 0.5 <= p <= high + 0.5]
     if missing:
         raise PreflightError(
             f"the gimbal pitches {low:g}..{high:g}° but the mission needs "
             f"{', '.join(f'{p:g}°' for p in missing)}: {autopilot.pitch_fix()}"
         )
-    return info
+    return low, high
 
 
 def check_fence(
