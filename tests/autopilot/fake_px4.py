@@ -14,6 +14,8 @@ from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mavlink.framing import FrameParser, new_encoder
 
 _HEADER = struct.Struct("<HBBBBBxI")
+INT_PARAMS = {"GF_ACTION", "MNT_MODE_IN", "MNT_MODE_OUT", "COM_ARM_WO_GPS"}
+"""Parameters the fake keeps as INT32, as PX4 does; the others are REAL32."""
 
 
 class FakePX4:
@@ -77,14 +79,25 @@ class FakePX4:
             if int(msg.param1) == M.MAVLINK_MSG_ID_COMPONENT_METADATA:
                 uri = b"mftp://etc/extras/component_general.json.xz"
                 self._reply(M.MAVLink_component_metadata_message(1000, 1, uri))
-        elif kind == "PARAM_REQUEST_READ":
+        elif kind in ("PARAM_REQUEST_READ", "PARAM_SET"):
             name = msg.param_id if isinstance(msg.param_id, str) else msg.param_id.decode()
-            if name in self.params:
-                self._reply(
-                    M.MAVLink_param_value_message(
-                        name.encode(), self.params[name], M.MAV_PARAM_TYPE_REAL32, 1, 0
-                    )
-                )
+            if name not in self.params:
+                return
+            is_int = name in INT_PARAMS
+            if kind == "PARAM_SET":
+                if msg.param_type != (
+                    M.MAV_PARAM_TYPE_INT32 if is_int else M.MAV_PARAM_TYPE_REAL32
+                ):
+                    return  # PX4 ignores a PARAM_SET of the wrong type
+                raw = struct.pack("<f", msg.param_value)
+                self.params[name] = struct.unpack("<i", raw)[0] if is_int else msg.param_value
+            value = self.params[name]
+            if is_int:  # PX4's bytewise encoding: the int32's bytes in the float's place
+                wire = struct.unpack("<f", struct.pack("<i", int(value)))[0]
+                ptype = M.MAV_PARAM_TYPE_INT32
+            else:
+                wire, ptype = float(value), M.MAV_PARAM_TYPE_REAL32
+            self._reply(M.MAVLink_param_value_message(name.encode(), wire, ptype, 1, 0))
         elif kind == "FILE_TRANSFER_PROTOCOL":
             self._ftp(bytes(msg.payload))
 

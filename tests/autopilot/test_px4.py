@@ -11,10 +11,12 @@ import pytest
 from tests.autopilot.fake_px4 import FakePX4, link_to
 from uavtool.autopilot import PX4, ArduPilot, GenericMAVLink, for_vehicle
 from uavtool.autopilot.px4 import px4_mode_name
+from uavtool.errors import ParamError
 from uavtool.geo import GeoPoint, enu_from_geo
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mission import Arm, GoTo, SetGimbal, SetMode, Takeoff
-from uavtool.runner.preflight import PreflightError, check_fence, check_gimbal
+from uavtool.runner.params import set_vehicle_params
+from uavtool.runner.preflight import PreflightError, check_fence, check_gimbal, param_reader
 
 HOME = GeoPoint(47.397743, 8.545597, 499.4)  # HOME_POSITION's altitude; the vehicle says 500.7
 
@@ -185,3 +187,16 @@ def test_a_gimbal_v1_mount_is_pointed_with_do_mount_control() -> None:
     fake = FakePX4({}, params={**params, "MNT_MODE_IN": -1})
     with pytest.raises(PreflightError, match="no gimbal: set MNT_MODE_IN=4"):
         check_gimbal(link_to(fake), PX4())
+
+
+def test_integer_parameters_are_read_and_set_bytewise_as_px4_encodes_them() -> None:
+    """PX4 puts an INT32 parameter's bytes where the float goes: GF_ACTION=2 is 2.8e-45 read
+    as a float, and MNT_MODE_IN=-1 is a NaN."""
+    fake = FakePX4({}, params={"GF_ACTION": 2, "MPC_XY_CRUISE": 5.0, "MNT_MODE_IN": -1})
+    link = link_to(fake)
+    reader = param_reader(link, PX4(), None)
+    assert (reader("GF_ACTION"), reader("MNT_MODE_IN"), reader("MPC_XY_CRUISE")) == (2, -1, 5)
+    set_vehicle_params(link, (("GF_ACTION", 3.0), ("MPC_XY_CRUISE", 8.0)), PX4())
+    assert fake.params == {"GF_ACTION": 3, "MPC_XY_CRUISE": 8.0, "MNT_MODE_IN": -1}
+    with pytest.raises(ParamError, match="no such parameter"):
+        set_vehicle_params(link, (("NOPE", 1.0),), PX4())

@@ -74,6 +74,18 @@ class Autopilot:
             return int(msg.severity), str(msg.text)
         return None
 
+    def param_value(self, msg: Any) -> float:
+        """A PARAM_VALUE's value. ArduPilot casts integers to the float it sends."""
+        return float(msg.param_value)
+
+    param_types_matter = False
+    """Whether PARAM_SET must carry the parameter's own type (read first); ArduPilot takes
+    every value as REAL32."""
+
+    def param_encoded(self, value: float, param_type: int) -> float:  # noqa: ARG002
+        """What PARAM_SET carries for ``value`` of a parameter of ``param_type``."""
+        return float(value)
+
     def send(self, link: VehicleLink, cmd: Command, home: GeoPoint) -> Sent:
         """Put a mission command on the wire, the way this autopilot takes it."""
         raise NotImplementedError

@@ -13,6 +13,7 @@ switched: the mission to RTL, a pilot, a failsafe), so a later Hold reads as AUT
 from __future__ import annotations
 
 import math
+import struct
 from collections.abc import Callable
 from typing import Any
 
@@ -56,6 +57,11 @@ _SETPOINT_MASK = (
 _NAMED_FOR_MISSION = {"AUTO.RTL": "RTL", "AUTO.LAND": "LAND"}
 
 _OFF, _ASKED, _ON = 0, 1, 2
+_INT_CODES = {
+    M.MAV_PARAM_TYPE_UINT8: "<B", M.MAV_PARAM_TYPE_INT8: "<b",
+    M.MAV_PARAM_TYPE_UINT16: "<H", M.MAV_PARAM_TYPE_INT16: "<h",
+    M.MAV_PARAM_TYPE_UINT32: "<I", M.MAV_PARAM_TYPE_INT32: "<i",
+}  # fmt: skip
 _STANDING_REPORTS = {"health", "arming_check"}
 
 
@@ -295,6 +301,25 @@ class PX4(Autopilot):
 
     def pitch_fix(self) -> str:
         return "set MNT_MIN_PITCH=-90 and MNT_MAX_PITCH=0"
+
+    # PX4 encodes integer parameters bytewise: the int32's four bytes in the float's place
+    # (MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_BYTEWISE), where ArduPilot casts.
+
+    def param_value(self, msg: Any) -> float:
+        code = _INT_CODES.get(int(msg.param_type))
+        if code is None:
+            return float(msg.param_value)
+        raw = struct.pack("<f", float(msg.param_value))
+        return float(struct.unpack_from(code, raw)[0])
+
+    param_types_matter = True
+
+    def param_encoded(self, value: float, param_type: int) -> float:
+        code = _INT_CODES.get(param_type)
+        if code is None:
+            return float(value)
+        raw = struct.pack(code, int(value)).ljust(4, b"\0")
+        return float(struct.unpack("<f", raw)[0])
 
     def fence(self, read: ParamReader) -> Fence | None:
         action = read("GF_ACTION")

@@ -69,7 +69,8 @@ _OUTAGE = Numbers(":", (("START", NON_NEGATIVE), ("DURATION", POSITIVE)), exampl
     "vehicle_params",
     multiple=True,
     metavar="NAME=VALUE",
-    help="Set a vehicle parameter before the flight (ArduPilot names, e.g. WPNAV_SPEED=800).",
+    help="Set a vehicle parameter before the flight, by the autopilot's own name "
+    "(e.g. WPNAV_SPEED=800 on ArduPilot, MPC_XY_CRUISE=8 on PX4).",
 )
 @click.option(
     "--set",

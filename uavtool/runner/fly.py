@@ -227,7 +227,7 @@ def fly(
         if learnt:
             say(learnt)
         if config.vehicle_params:
-            set_vehicle_params(link, config.vehicle_params)
+            set_vehicle_params(link, config.vehicle_params, autopilot)
         check_home(link)
         if config.camera != "sim":
             check_camera(camera)

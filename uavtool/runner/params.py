@@ -5,10 +5,12 @@ from __future__ import annotations
 
 import struct
 
+from uavtool.autopilot import Autopilot
 from uavtool.checks import Range, coerce
 from uavtool.errors import ParamError
 from uavtool.link import VehicleLink
 from uavtool.mavlink.dialect import mavlink as M
+from uavtool.runner.preflight import read_param
 
 _TRIES = 3
 _WAIT_S = 1.0
@@ -25,25 +27,37 @@ def parse_param(text: str) -> tuple[str, float]:
     name, sep, value = text.partition("=")
     name = name.strip().upper()
     if not sep or not name:
-        raise ParamError(f"--param {text!r}: expected NAME=VALUE, e.g. WPNAV_SPEED=800")
+        raise ParamError(
+            f"--param {text!r}: expected NAME=VALUE, e.g. WPNAV_SPEED=800 (ArduPilot) or "
+            "MPC_XY_CRUISE=8 (PX4)"
+        )
     if len(name) > _NAME_LEN or not name.isascii():
         raise ParamError(f"--param {name!r}: a parameter name is at most 16 ASCII characters")
     number: float = coerce(value, float, name=f"--param {name}", bounds=_FLOAT32, error=ParamError)
     return name, number
 
 
-def set_vehicle_params(link: VehicleLink, params: tuple[tuple[str, float], ...]) -> None:
+def set_vehicle_params(
+    link: VehicleLink, params: tuple[tuple[str, float], ...], autopilot: Autopilot
+) -> None:
     """Set each parameter and wait for the vehicle to echo it; ParamError if it never does,
-    or if it echoes another value (it refused this one and kept its own)."""
+    or if it echoes another value (it refused this one and kept its own). On an autopilot
+    that wants each parameter's own type (PX4), the parameter is read first."""
     for name, value in params:
+        param_type = M.MAV_PARAM_TYPE_REAL32
+        if autopilot.param_types_matter:
+            current = read_param(link, name, None)
+            if current is None:
+                raise ParamError(f"--param {name}: the vehicle has no such parameter")
+            param_type = int(current.param_type)
         for _ in range(_TRIES):
             link.send(
                 M.MAVLink_param_set_message(
                     link.target_system,
                     link.target_component,
                     name.encode(),
-                    value,
-                    M.MAV_PARAM_TYPE_REAL32,
+                    autopilot.param_encoded(value, param_type),
+                    param_type,
                 )
             )
             deadline = link.clock() + _WAIT_S
@@ -60,7 +74,7 @@ def set_vehicle_params(link: VehicleLink, params: tuple[tuple[str, float], ...])
             break
         else:
             raise ParamError(f"--param {name}: the vehicle did not confirm it (unknown parameter?)")
-        kept = float(echoed[-1].param_value)
+        kept = autopilot.param_value(echoed[-1])
         if kept != _as_float32(value):
             raise ParamError(f"--param {name}={value:g}: the vehicle refused it and kept {kept:g}")
 

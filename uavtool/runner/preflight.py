@@ -65,13 +65,11 @@ def check_gimbal(
     )
     if info is not None:
         low, high = math.degrees(info.pitch_min), math.degrees(info.pitch_max)
-    elif (v1 := autopilot.mount_v1(_reader(link, on_wait))) is not None:
+    elif (v1 := autopilot.mount_v1(param_reader(link, autopilot, on_wait))) is not None:
         low, high = v1
     else:
-        raise PreflightError(
-            f"the vehicle has no gimbal: {autopilot.gimbal_fix(_reader(link, on_wait))}; "
-            "or fly with --no-gimbal"
-        )
+        fix = autopilot.gimbal_fix(param_reader(link, autopilot, on_wait))
+        raise PreflightError(f"the vehicle has no gimbal: {fix}; or fly with --no-gimbal")
     missing = [p for p in need_pitch_deg if not low - 0.5 <= p <= high + 0.5]
     if missing:
         raise PreflightError(
@@ -94,7 +92,7 @@ def check_fence(
     horizontal one closer than ``reach_m`` (the search square's corners). The vehicle would
     refuse the move or breach the fence and return home mid-mission. A vehicle whose
     parameters do not answer passes."""
-    fence = autopilot.fence(_reader(link, on_wait))
+    fence = autopilot.fence(param_reader(link, autopilot, on_wait))
     if fence is None:
         return
     if fence.alt_max_m is not None and fence.alt_max_m < climb_to_m:
@@ -115,13 +113,19 @@ def check_fence(
         )
 
 
-def _reader(link: VehicleLink, on_wait: Callable[[], None] | None) -> ParamReader:
-    return lambda name: _param(link, name, on_wait)
+def param_reader(
+    link: VehicleLink, autopilot: Autopilot, on_wait: Callable[[], None] | None
+) -> ParamReader:
+    def read(name: str) -> float | None:
+        msg = read_param(link, name, on_wait)
+        return None if msg is None else autopilot.param_value(msg)
+
+    return read
 
 
-def _param(link: VehicleLink, name: str, on_wait: Callable[[], None] | None) -> float | None:
-    """The vehicle's parameter ``name``, or None if it does not answer."""
-    value = _ask(
+def read_param(link: VehicleLink, name: str, on_wait: Callable[[], None] | None) -> Any:
+    """The vehicle's PARAM_VALUE for ``name``, or None if it does not answer."""
+    return _ask(
         link,
         lambda: link.send(
             M.MAVLink_param_request_read_message(
@@ -132,7 +136,6 @@ def _param(link: VehicleLink, name: str, on_wait: Callable[[], None] | None) -> 
         on_wait,
         lambda msg: _param_name(msg) == name,
     )
-    return None if value is None else float(value.param_value)
 
 
 def _param_name(msg: Any) -> str:
