@@ -5,24 +5,20 @@ from __future__ import annotations
 
 import math
 
-from uavtool.autopilot.base import Autopilot, Fence, ParamReader, Sent, set_mode_long
+from uavtool.autopilot.base import (
+    Autopilot,
+    Fence,
+    ParamReader,
+    Sent,
+    position_target,
+    set_mode_long,
+)
 from uavtool.geo import GeoPoint, geo_from_enu
 from uavtool.link import VehicleLink
 from uavtool.mavlink.dialect import COPTER_MODE_NAMES, COPTER_MODES
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mission import Arm, Command, GoTo, SetGimbal, SetMode, Takeoff
 
-# SET_POSITION_TARGET: use the position (and yaw when given), ignore velocity, acceleration
-# and yaw rate.
-_POS_ONLY = (
-    M.POSITION_TARGET_TYPEMASK_VX_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_VY_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_VZ_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_AX_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_AY_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_AZ_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_YAW_RATE_IGNORE
-)
 _FENCE_ALT_MAX, _FENCE_CIRCLE = 1, 2
 """FENCE_TYPE bits (ArduPilot's AC_FENCE_TYPE_ALT_MAX and AC_FENCE_TYPE_CIRCLE)."""
 SERVO_MOUNT_FIX = (
@@ -66,30 +62,8 @@ class ArduPilot(Autopilot):
         if isinstance(cmd, GoTo):
             x, y, z = cmd.pos_enu_m
             target = geo_from_enu(home, x, y, 0.0)
-            mask = _POS_ONLY | (
-                M.POSITION_TARGET_TYPEMASK_YAW_IGNORE if cmd.heading_deg is None else 0
-            )
-            yaw = 0.0 if cmd.heading_deg is None else math.radians(cmd.heading_deg)
-            link.send(
-                M.MAVLink_set_position_target_global_int_message(
-                    0,
-                    link.target_system,
-                    link.target_component,
-                    M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
-                    mask,
-                    target.lat_e7,
-                    target.lon_e7,
-                    z,
-                    0,
-                    0,
-                    0,
-                    0,
-                    0,
-                    0,
-                    yaw,
-                    0,
-                )
-            )
+            frame = M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
+            link.send(position_target(link, frame, target, z, cmd.heading_deg))
             return Sent(0)  # position targets have no ACK
         raise TypeError(f"not a vehicle command: {cmd!r}")
 

@@ -128,3 +128,29 @@ def set_mode_long(link: VehicleLink, custom_mode: int, custom_sub_mode: int = 0)
 def finite(value: float | None) -> float:
     """NaN for "not given" (MAVLink's convention for an unused float parameter)."""
     return math.nan if value is None else float(value)
+
+
+# SET_POSITION_TARGET: use the position (and yaw when given), ignore velocity, acceleration
+# and yaw rate.
+_POSITION_ONLY = (
+    M.POSITION_TARGET_TYPEMASK_VX_IGNORE
+    | M.POSITION_TARGET_TYPEMASK_VY_IGNORE
+    | M.POSITION_TARGET_TYPEMASK_VZ_IGNORE
+    | M.POSITION_TARGET_TYPEMASK_AX_IGNORE
+    | M.POSITION_TARGET_TYPEMASK_AY_IGNORE
+    | M.POSITION_TARGET_TYPEMASK_AZ_IGNORE
+    | M.POSITION_TARGET_TYPEMASK_YAW_RATE_IGNORE
+)
+
+
+def position_target(
+    link: VehicleLink, frame: int, target: GeoPoint, alt_m: float, heading_deg: float | None
+) -> Any:
+    """A SET_POSITION_TARGET_GLOBAL_INT to ``target`` at ``alt_m`` (in ``frame``'s sense),
+    facing ``heading_deg`` (None: any heading)."""
+    mask = _POSITION_ONLY | (M.POSITION_TARGET_TYPEMASK_YAW_IGNORE if heading_deg is None else 0)
+    yaw = 0.0 if heading_deg is None else math.radians(heading_deg)
+    return M.MAVLink_set_position_target_global_int_message(
+        0, link.target_system, link.target_component, frame, mask, target.lat_e7,
+        target.lon_e7, alt_m, 0, 0, 0, 0, 0, 0, yaw, 0,
+    )  # fmt: skip

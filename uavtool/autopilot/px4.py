@@ -17,7 +17,15 @@ import struct
 from collections.abc import Callable
 from typing import Any
 
-from uavtool.autopilot.base import Autopilot, Fence, ParamReader, Sent, finite, set_mode_long
+from uavtool.autopilot.base import (
+    Autopilot,
+    Fence,
+    ParamReader,
+    Sent,
+    finite,
+    position_target,
+    set_mode_long,
+)
 from uavtool.autopilot.px4_events import EventDecoder, fetch_decoder
 from uavtool.errors import LinkError
 from uavtool.geo import GeoPoint, geo_from_enu
@@ -45,15 +53,6 @@ SETPOINT_S = 0.25
 """How often offboard setpoints go out (PX4 wants at least 2 Hz, and fails over without)."""
 OFFBOARD_AFTER_S = 0.5
 """Setpoints streamed this long before OFFBOARD is asked for (PX4 refuses it without)."""
-_SETPOINT_MASK = (
-    M.POSITION_TARGET_TYPEMASK_VX_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_VY_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_VZ_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_AX_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_AY_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_AZ_IGNORE
-    | M.POSITION_TARGET_TYPEMASK_YAW_RATE_IGNORE
-)
 _NAMED_FOR_MISSION = {"AUTO.RTL": "RTL", "AUTO.LAND": "LAND"}
 
 _OFF, _ASKED, _ON = 0, 1, 2
@@ -255,22 +254,8 @@ class PX4(Autopilot):
     def _send_setpoint(self, link: VehicleLink, cmd: GoTo, home: GeoPoint) -> None:
         x, y, z = cmd.pos_enu_m
         target = geo_from_enu(home, x, y, 0.0)
-        no_yaw = cmd.heading_deg is None
-        link.send(
-            M.MAVLink_set_position_target_global_int_message(
-                0,
-                link.target_system,
-                link.target_component,
-                M.MAV_FRAME_GLOBAL_INT,
-                _SETPOINT_MASK | (M.POSITION_TARGET_TYPEMASK_YAW_IGNORE if no_yaw else 0),
-                target.lat_e7,
-                target.lon_e7,
-                _amsl(link, home, z),
-                0, 0, 0, 0, 0, 0,
-                0.0 if no_yaw else math.radians(cmd.heading_deg or 0.0),
-                0,
-            )
-        )  # fmt: skip
+        frame, alt = M.MAV_FRAME_GLOBAL_INT, _amsl(link, home, z)
+        link.send(position_target(link, frame, target, alt, cmd.heading_deg))
         self._setpoint_sent = link.clock()
 
     def return_home(self, link: VehicleLink) -> None:
