@@ -52,7 +52,7 @@ _OUTAGE = Numbers(":", (("START", NON_NEGATIVE), ("DURATION", POSITIVE)), exampl
     default=None,
     metavar="N|max",
     help="Cap on the built-in vehicle's pace, vehicle seconds per wall second. It never changes "
-    "the flight (lockstep). Default: max (as fast as the CPU allows); 1 with --rerun.",
+    "the flight (lockstep). Default: max (as fast as the CPU allows); 1 with --rerun spawn|web.",
 )
 @click.option(
     "--record",
@@ -109,7 +109,8 @@ _OUTAGE = Numbers(":", (("START", NON_NEGATIVE), ("DURATION", POSITIVE)), exampl
     "rerun_target",
     default=None,
     metavar="spawn|web|FILE.rrd",
-    help="Stream the flight live to Rerun: the native viewer, the web viewer, or a file.",
+    help="Stream the flight to Rerun: live to the native viewer or the web viewer (at real-time "
+    "pace), or to a .rrd file (at full speed).",
 )
 @click.option(
     "--no-gimbal",
@@ -177,7 +178,7 @@ def fly(
         scene=scene,
         target=target,
         camera=camera,
-        speedup=_speedup(speedup, live=rerun_target is not None),
+        speedup=_speedup(speedup, live=_rerun_target(rerun_target) in _LIVE_VIEWERS),
         record=record,
         no_record=no_record,
         params=params,
@@ -204,6 +205,18 @@ def fly(
     )
     click.echo(format_summary(summary))
     sys.exit(EXIT_CODES[summary.outcome.status.value])
+
+
+_LIVE_VIEWERS = ("spawn", "web")
+
+
+def _rerun_target(text: str | None) -> str | None:
+    """``spawn``, ``web`` or a ``.rrd`` file; a typo is an error, not a file of that name."""
+    if text is None or text in _LIVE_VIEWERS or text.lower().endswith(".rrd"):
+        return text
+    raise click.BadParameter(
+        f"{text!r}: expected spawn, web or a file ending in .rrd", param_hint="--rerun"
+    )
 
 
 def _speedup(text: str | None, *, live: bool) -> float | None:
