@@ -23,8 +23,10 @@ GCS_SYSID = 255
 GCS_COMPID = M.MAV_COMP_ID_MISSIONPLANNER
 ANNOUNCE_S = 1.0
 """How often a link that has not heard a vehicle yet sends its heartbeat (MAVProxy's rate)."""
-Tap = Callable[[str, bytes], None]
-"""Called with ``("in" | "out", frame bytes)`` for every whole frame that crosses the link."""
+Tap = Callable[[str, bytes, Any], None]
+"""Called with ``("in" | "out", frame bytes, message)`` for every whole frame that crosses
+the link: for an incoming frame, the pymavlink message the link decoded from those bytes (in
+:data:`~uavtool.mavlink.dialect.DIALECT`); None for an outgoing one."""
 
 # What the runner needs, and how often (Hz); requested with SET_MESSAGE_INTERVAL.
 STREAMS: dict[int, float] = {
@@ -103,7 +105,7 @@ class VehicleLink:
         out = []
         for frame in self._parser.feed(data):
             if self.tap is not None:
-                self.tap("in", frame.raw)
+                self.tap("in", frame.raw, frame.msg)
             msg = frame.msg
             if self._accept(msg) and self.freshness.fresh(msg):
                 self._update(msg)
@@ -151,7 +153,7 @@ class VehicleLink:
         frame = bytes(msg.pack(self._mav))
         self._mav.seq = (self._mav.seq + 1) % 256
         if self.tap is not None:
-            self.tap("out", frame)
+            self.tap("out", frame, None)
         self.transport.send(frame)
 
     def heartbeat(self) -> None:

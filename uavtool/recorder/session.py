@@ -16,6 +16,7 @@ import time
 from collections.abc import Callable
 from contextlib import ExitStack
 from dataclasses import dataclass, field
+from typing import Any
 
 from uavtool import __version__
 from uavtool.autopilot import for_vehicle
@@ -46,16 +47,16 @@ class _Tap:
     """Every frame crossing the link: held until the file exists, then written; frames from
     other systems also go to the watch."""
 
-    held: list[tuple[str, bytes, int]] = field(default_factory=list)
+    held: list[tuple[str, bytes, int, Any]] = field(default_factory=list)
     recorder: PassiveRecorder | None = None
     watch: VehicleWatch | None = None
     clock: Callable[[], float] = time.monotonic
 
-    def __call__(self, direction: str, frame: bytes) -> None:
+    def __call__(self, direction: str, frame: bytes, decoded: Any = None) -> None:
         if self.recorder is not None:
-            self.recorder.mavlink(direction, frame)
+            self.recorder.mavlink(direction, frame, decoded)
         else:
-            self.held.append((direction, frame, time.time_ns()))
+            self.held.append((direction, frame, time.time_ns(), decoded))
         watch = self.watch
         if watch is not None and direction == "in" and frame_ids(frame)[0] != watch.target[0]:
             watch.foreign(frame, self.clock())
@@ -98,9 +99,11 @@ def record(
         writer = stack.enter_context(RecordingWriter(partial, metadata=meta))
         started.append(True)
         recorder = PassiveRecorder(writer, clock_ns=time.time_ns, origin=origin)
-        for direction, frame, t_ns in tap.held:
+        for direction, frame, t_ns, decoded in tap.held:
             recorder.counts[direction] += 1
-            writer.write_mavlink(frame, direction=_direction(direction), log_time_ns=t_ns)
+            writer.write_mavlink(
+                frame, direction=_direction(direction), log_time_ns=t_ns, decoded=decoded
+            )
         tap.held.clear()
         tap.recorder = recorder
         assert tap.watch is not None

@@ -4,7 +4,10 @@ mission's observations (README, "Recording flights you don't fly")."""
 
 from __future__ import annotations
 
+from typing import Any
+
 from uavtool.geo import GeoPoint
+from uavtool.mavlink.dialect import DIALECT
 from uavtool.mission import Telemetry
 from uavtool.mission.codec import encode, encode_observation
 from uavtool.recorder.frames import Frame
@@ -67,13 +70,15 @@ class PassiveRecorder:
         writer.add_json_topic(TELEMETRY, schema_name="uavtool.Telemetry", schema=TELEMETRY_SCHEMA)
         writer.add_json_topic(FRAMES, schema_name="uavtool.Frame", schema=FRAME_SCHEMA)
 
-    def mavlink(self, direction: str, frame: bytes) -> None:
-        """The link's tap: every whole frame, as it crossed the link."""
+    def mavlink(self, direction: str, frame: bytes, decoded: Any = None) -> None:
+        """The link's tap: every whole frame, as it crossed the link (and the message the
+        link decoded from it, if any)."""
         self.counts[direction] += 1
         self.writer.write_mavlink(
             frame,
             direction=Direction.IN if direction == "in" else Direction.OUT,
             log_time_ns=self.clock_ns(),
+            decoded=decoded if self.writer.dialect == DIALECT else None,
         )
 
     def telemetry(self, t: Telemetry) -> None:

@@ -143,11 +143,17 @@ def mavlink_schema(dialect: str, msgid: int) -> tuple[str, bytes]:
     return f"{dialect}.{cls.msgname}", dumps(schema)
 
 
+_PLAIN, _FLOAT, _FLOATS = 0, 1, 2
+
+
 @cache
-def _float_fields(dialect: str, msgid: int) -> tuple[tuple[str, bool], ...]:
+def _view_fields(dialect: str, msgid: int) -> tuple[tuple[str, int], ...]:
+    """Each field of a message type in declaration order, with how its JSON view is made:
+    as it is (text for char fields), a float (null when not finite), floats (likewise)."""
     cls = dialect_module(dialect).mavlink_map[msgid]
     return tuple(
-        (name, length > 0) for name, ftype, length in _fields(cls) if ftype in _FLOAT_TYPES
+        (name, (_FLOATS if length else _FLOAT) if ftype in _FLOAT_TYPES else _PLAIN)
+        for name, ftype, length in _fields(cls)
     )
 
 
@@ -159,10 +165,6 @@ def _fields(cls: Any) -> list[tuple[str, str, int]]:
         (name, ftype, lengths[name])
         for name, ftype in zip(cls.fieldnames, cls.fieldtypes, strict=True)
     ]
-
-
-def _finite_or_none(x: float) -> float | None:
-    return x if math.isfinite(x) else None
 
 
 class MavlinkDecoder:
@@ -181,6 +183,12 @@ class MavlinkDecoder:
             msg = self._mav.decode(bytearray(frame))
         except (self._error, IndexError, ValueError):
             return None
+        return self.view(msg)
+
+    def view(self, msg: Any) -> tuple[int, str, dict[str, Any]] | None:
+        """``(msgid, MSGNAME, payload)`` of a message this dialect decoded (from a frame's
+        bytes: a message built in Python, not yet packed, has no float32 rounding), or None
+        if its id is not in the dialect."""
         msgid = msg.get_msgId()
         if msgid not in self._known:
             return None
@@ -191,12 +199,14 @@ class MavlinkDecoder:
                 "seq": msg.get_seq(),
             }
         }
-        for name in msg.fieldnames:
-            payload[name] = msg.format_attr(name)
-        for name, is_array in _float_fields(self.dialect, msgid):
-            value = payload[name]
-            if is_array:
-                payload[name] = [_finite_or_none(v) for v in value]
+        for name, kind in _view_fields(self.dialect, msgid):
+            value = getattr(msg, name)
+            if kind == _PLAIN:
+                if isinstance(value, bytes):  # a char field: text (pymavlink's format_attr)
+                    value = value.decode(errors="backslashreplace").rstrip("\x00")
+            elif kind == _FLOAT:
+                value = value if math.isfinite(value) else None
             else:
-                payload[name] = _finite_or_none(value)
+                value = [v if math.isfinite(v) else None for v in value]
+            payload[name] = value
         return msgid, msg.get_type(), payload

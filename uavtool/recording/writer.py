@@ -216,10 +216,13 @@ class RecordingWriter:
         direction: Direction,
         log_time_ns: int,
         publish_time_ns: int | None = None,
+        decoded: Any = None,
     ) -> None:
         """Write one whole MAVLink frame to ``/mavlink/raw`` (see `rawframe`) and, if it
         decodes, its JSON view to ``/mavlink/<in|out>/<MSGNAME>``. Unknown or corrupt frames
-        are kept raw only."""
+        are kept raw only. ``decoded``: the pymavlink message already decoded from exactly
+        these bytes with this recording's dialect (a link's parser has done it), which saves
+        decoding the frame again."""
         frame = bytes(frame)
         with self._lock:
             self._check_open()
@@ -231,10 +234,10 @@ class RecordingWriter:
                 meta = {"dialect": self.dialect}
                 raw_id = self._channel(MAVLINK_RAW, MAVLINK_RAW, PROTOBUF_ENCODING, schema_id, meta)
             self._add(raw_id, log_time_ns, publish_time_ns, rawframe.encode(direction, frame))
-            decoded = self._decoder.decode(frame)
-            if decoded is None:
+            view = self._decoder.decode(frame) if decoded is None else self._decoder.view(decoded)
+            if view is None:
                 return
-            msgid, msg_name, payload = decoded
+            msgid, msg_name, payload = view
             key = (direction, msgid)
             channel_id = self._channels.get(key)
             if channel_id is None:

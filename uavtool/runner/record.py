@@ -24,6 +24,7 @@ from typing import Any
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.geo import GeoPoint, geo_from_enu
 from uavtool.images import png_encode
+from uavtool.mavlink.dialect import DIALECT
 from uavtool.mission import Level, ModelBuilt, Observation, Output, Photo, Telemetry
 from uavtool.mission.codec import encode_observation, encode_output
 from uavtool.mission.schema import observation_schema, output_schema
@@ -109,11 +110,13 @@ class MissionRecorder:
         self._outputs = 0
         self._markers = RouteMarkers()
 
-    def mavlink(self, direction: str, frame: bytes) -> None:
+    def mavlink(self, direction: str, frame: bytes, decoded: Any = None) -> None:
+        """The link's tap (:data:`~uavtool.link.client.Tap`)."""
         self.writer.write_mavlink(
             frame,
             direction=Direction.IN if direction == "in" else Direction.OUT,
             log_time_ns=self.clock_ns(),
+            decoded=decoded if self.writer.dialect == DIALECT else None,
         )
 
     def target(self, png: bytes) -> None:

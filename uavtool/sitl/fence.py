@@ -56,6 +56,9 @@ class Breach:
         return f"Fence breached: {names}"
 
 
+_NONE = FenceType(0)
+
+
 class Fence:
     """FENCE_* parameters applied to positions in metres NED around home."""
 
@@ -78,7 +81,7 @@ class Fence:
     def types(self) -> FenceType:
         """The fences in force now (none while FENCE_ENABLE is 0)."""
         if not self.params["FENCE_ENABLE"]:
-            return FenceType(0)
+            return _NONE
         return FenceType(int(self.params["FENCE_TYPE"])) & _SIMULATED
 
     @property
@@ -109,6 +112,9 @@ class Fence:
     def check(self, pos_ned_m: list[float]) -> Breach | None:
         """Check the vehicle's position; a :class:`Breach` when it newly left the fence."""
         types = self.types
+        if not types:  # no fence in force (FENCE_ENABLE 0, the default): nothing is breached
+            self.breaches = _NONE
+            return None
         new = FenceType(0)
         distance_m = 0.0
         alt_m = -pos_ned_m[2]
