@@ -27,19 +27,30 @@ from uavtool.mission.observations import (
 )
 from uavtool.mission.outputs import Output
 
+_PLAIN = frozenset({int, float, str, bool, type(None)})
+_FIELDS: dict[type, tuple[str, ...]] = {}
+"""Each dataclass's field names, as encoded (a Photo's image left out): looked up once."""
+
 
 def encode(value: Any) -> Any:
     """A dataclass tree as JSON-ready data: ``{"type": ClassName, field: …}``; arrays and
     tuples become lists, enums their value, bytes ``{"sha256", "size"}``; a Photo's image is
     left out."""
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        out: dict[str, Any] = {"type": type(value).__name__}
-        for f in dataclasses.fields(value):
-            if f.name == "image_rgb":
-                continue
-            if f.name == "roll_deg" and isinstance(value, CameraPose) and value.roll_deg == 0.0:
+    kind = type(value)
+    if kind in _PLAIN:
+        return value
+    if kind is tuple or kind is list:
+        return [encode(v) for v in value]
+    names = _FIELDS.get(kind)
+    if names is None and dataclasses.is_dataclass(value) and not isinstance(value, type):
+        names = tuple(f.name for f in dataclasses.fields(value) if f.name != "image_rgb")
+        _FIELDS[kind] = names
+    if names is not None:
+        out: dict[str, Any] = {"type": kind.__name__}
+        for name in names:
+            if name == "roll_deg" and kind is CameraPose and value.roll_deg == 0.0:
                 continue  # a level camera is written as before rolls were recorded
-            out[f.name] = encode(getattr(value, f.name))
+            out[name] = encode(getattr(value, name))
         return out
     if isinstance(value, np.ndarray):
         return value.tolist()

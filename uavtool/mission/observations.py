@@ -22,8 +22,9 @@ class Telemetry:
 
     ``time_boot_ms`` is vehicle time (the mission's only clock); ``pos_enu_m`` z is the
     altitude above home; ``gimbal_*`` is the camera's attitude relative to the horizon
-    (pitch) and the vehicle's nose (yaw); ``mode`` is the autopilot's mode name
-    (ArduCopter's, e.g. ``GUIDED``), ``landed`` is true on the ground.
+    (pitch) and the vehicle's nose (yaw); ``mode`` is in the mission's vocabulary
+    (``GUIDED``, ``RTL``, ``LAND``; any other mode by its autopilot's own name, e.g. PX4's
+    ``POSCTL``), ``landed`` is true on the ground.
     """
 
     time_boot_ms: int
