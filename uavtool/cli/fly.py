@@ -160,6 +160,7 @@ def fly(
       uavtool fly --visit-all --scene blocked-front
       uavtool fly --connect tcp:127.0.0.1:5760     # ArduPilot SITL (sim_vehicle.py)
       uavtool fly --connect tcp:127.0.0.1:5760 --no-gimbal   # a camera fixed down
+      uavtool fly --connect udpin:0.0.0.0:14540    # PX4 SITL (its API link)
     """
     from uavtool.mission.params import Params, parse_settings, with_overrides
     from uavtool.runner.fly import FlyConfig
