@@ -10,8 +10,6 @@ from pathlib import Path
 
 import click
 
-from uavtool.sweep.spec import TableFormat
-
 
 @click.command()
 @click.argument("spec", type=click.Path(path_type=Path))
@@ -86,6 +84,7 @@ def sweep(
     """
     from uavtool.cli.fly import EXIT_CODES
     from uavtool.sweep import format_progress, load_spec, run_sweep
+    from uavtool.sweep.spec import TableFormat
 
     loaded = load_spec(spec, overrides)
     if csv:
