@@ -98,6 +98,7 @@ def refly_config(path: Path, *, out: Path, workdir: Path) -> FlyConfig:
                 hfov_deg=float(json.loads(flight["hfov_deg"])),
                 size_px=tuple(int(v) for v in json.loads(flight["size_px"])),  # type: ignore[arg-type]
                 target=_target_file(reader, path, workdir) if flight["target"] == "file" else None,
+                no_gimbal=json.loads(flight.get("no_gimbal", "false")) is True,
             )
         except (KeyError, ValueError, TypeError, IndexError) as exc:
             raise ReflyInputError(

@@ -401,6 +401,9 @@ def flight_metadata(config: FlyConfig, scene: Scene) -> dict[str, dict[str, str]
             "hfov_deg": json.dumps(config.hfov_deg),
             "size_px": json.dumps(list(config.size_px)),
             "target": "file" if config.target else "scene",
+            # Written only when set, so the recordings of flights with a gimbal (the goldens
+            # among them) stay as they were.
+            **({"no_gimbal": "true"} if config.no_gimbal else {}),
         },
     }
 
