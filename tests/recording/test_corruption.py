@@ -289,3 +289,23 @@ def test_reading_less_than_the_statistics_count_fails(tmp_path: Path) -> None:
     assert code == 2  # channel 1 is /mavlink/raw: the sample writes a frame first
     _one_line_error(err, path)
     assert not (tmp_path / "x.tlog").exists()
+
+
+def test_a_flipped_metadata_byte_is_found_and_refused(tmp_path: Path) -> None:
+    """No chunk CRC covers a metadata record; the data section's CRC (which uavtool writes)
+    does. A recorded max_looks 3 -> 2 changed nothing in a replay (the flight needed 2 looks),
+    so `replay --check` said identical on a file whose parameters were not the ones flown."""
+    path = tmp_path / "flight.mcap"
+    flown = CliRunner().invoke(cli, ["fly", "-q", "--record", str(path)])
+    assert flown.exit_code == 0, flown.output
+    code, out, _ = _run("info", str(path))
+    assert code == 0 and "health:    whole, indexed, CRCs checked" in out
+    data = bytearray(path.read_bytes())
+    at = data.index(b'"max_looks": 3') + len(b'"max_looks": ')
+    data[at] = ord("2")
+    path.write_bytes(bytes(data))
+    code, out, err = _run("info", str(path))
+    assert code == 2 and "health:    DAMAGED" in out and "data section" in out
+    code, out, err = _run("replay", "--check", str(path))
+    assert code == 2 and "identical" not in out
+    _one_line_error(err, path)

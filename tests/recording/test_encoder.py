@@ -42,7 +42,7 @@ def _ours(ops: list[Op]) -> bytes:
 
 def _theirs(ops: list[Op]) -> bytes:
     out = io.BytesIO()
-    w = Writer(out, chunk_size=1 << 62, compression=CompressionType.ZSTD)
+    w = Writer(out, chunk_size=1 << 62, compression=CompressionType.ZSTD, enable_data_crcs=True)
     w.start(profile="", library="lib/1")
     for kind, *args in ops:
         if kind == "meta":
@@ -127,7 +127,7 @@ def test_recording_writer_file_equals_the_bare_mcap_writer_file(tmp_path: Path) 
         for i in range(50):
             writer.write_json("/obs", {"step": i}, log_time_ns=T0_NS + 300 * i)
     out = io.BytesIO()
-    w = Writer(out, chunk_size=1 << 62, compression=CompressionType.ZSTD)
+    w = Writer(out, chunk_size=1 << 62, compression=CompressionType.ZSTD, enable_data_crcs=True)
     w.start(profile="", library=LIBRARY)
     w.add_metadata(
         TOOL_METADATA, {"version": __version__, "dialect": "ardupilotmega", "mavlink": "2.0"}

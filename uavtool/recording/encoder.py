@@ -1,12 +1,16 @@
 """`McapEncoder`: writes MCAP records to a binary file, chunk by chunk.
 
-It writes the very bytes mcap's own `Writer` writes with ``compression=ZSTD`` and every other
-option at its default (all indexes, statistics, schemas and channels repeated in the summary,
-summary offsets, CRCs) when the same calls close chunks at the same points — the tests check
-this byte for byte. It exists for speed: mcap's `Writer` builds each message through a
-dataclass and a handful of `struct.pack` calls (about three quarters of the writer's time on
-small JSON messages); here a message is one `struct.pack` and two appends, and per-chunk
-statistics are taken from the message index when the chunk closes.
+It writes the very bytes mcap's own `Writer` writes with ``compression=ZSTD`` and
+``enable_data_crcs=True``, every other option at its default (all indexes, statistics, schemas
+and channels repeated in the summary, summary offsets, CRCs) when the same calls close chunks
+at the same points — the tests check this byte for byte. The data section's CRC covers what
+no chunk CRC does (the metadata records: the flight's parameters, scene and outcome), so a
+reader can tell a flipped metadata byte from a whole file.
+
+It exists for speed: mcap's `Writer` builds each message through a dataclass and a handful
+of `struct.pack` calls (about three quarters of the writer's time on small JSON messages);
+here a message is one `struct.pack` and two appends, and per-chunk statistics are taken from
+the message index when the chunk closes.
 
 Not thread-safe: `RecordingWriter` serializes calls. Every ``*_ns`` is an unsigned 64-bit
 integer; out-of-range values raise `struct.error` before anything is written.
@@ -61,6 +65,7 @@ class McapEncoder:
     def __init__(self, file: BinaryIO, *, library: str, profile: str = "") -> None:
         self._file = file
         self._pos = 0  # bytes written so far = offset of the next record
+        self._data_crc = 0  # CRC-32 of the data section written so far
         self._chunk = bytearray()  # records of the open chunk, uncompressed
         # channel id -> [log time, offset in chunk, log time, offset, ...] for the open chunk
         self._index: dict[int, list[int]] = {}
@@ -80,6 +85,7 @@ class McapEncoder:
     def _write(self, data: bytes) -> None:
         self._file.write(data)
         self._pos += len(data)
+        self._data_crc = zlib.crc32(data, self._data_crc)
 
     def add_metadata(self, name: str, pairs: Mapping[str, str]) -> None:
         """Write a metadata record (outside chunks) and hand it to the OS."""
@@ -175,7 +181,7 @@ class McapEncoder:
         """Close the open chunk, then write the data end, the summary, the footer and the
         closing magic, and flush the file (it stays open)."""
         self.close_chunk()
-        self._write(_record(_DATA_END, _U32.pack(0)))  # no data-section CRC, as mcap's default
+        self._write(_record(_DATA_END, _U32.pack(self._data_crc)))
         summary_start = self._pos
         counts = b"".join(struct.pack("<HQ", c, n) for c, n in self._counts.items())
         statistics = struct.pack(

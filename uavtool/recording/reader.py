@@ -199,6 +199,16 @@ class RecordingReader:
                 raise CorruptRecordingError(
                     self.path, f"byte {d.offset}: {what} is damaged ({d.problem})"
                 )
+        # A metadata record has no CRC of its own: the data section's (when the file has one)
+        # is what says its values are the ones written.
+        crc = self._layout.data_crc
+        if crc and self._crc32(self._layout.data_end) != crc:
+            damage = self.verify()
+            raise (
+                self._corrupt(damage[0])
+                if damage
+                else CorruptRecordingError(self.path, "the data section fails its CRC")
+            )
 
     def describe(self, damage: Damage) -> str:
         """One line: where the damage is, what it held and what was lost."""
