@@ -11,7 +11,7 @@ from click.testing import CliRunner
 
 from tests.recording.sample import write_sample
 from uavtool.cli import cli
-from uavtool.recording import RecordingWriter
+from uavtool.recording import RecordingReader, RecordingWriter
 from uavtool.replay.refly import compare_recordings
 from uavtool.sitl.lockstep import SIM_EPOCH_NS
 
@@ -87,3 +87,34 @@ def test_compare_ignores_the_software_version_only(tmp_path: Path) -> None:
     assert compare_recordings(tmp_path / "0.mcap", tmp_path / "1.mcap") == (0, None)
     _, diff = compare_recordings(tmp_path / "0.mcap", tmp_path / "2.mcap")
     assert diff == 'metadata mission.params: "a" recorded, "b" re-flown'
+
+
+def _crafted(path: Path, **changes: dict[str, str]) -> Path:
+    """The golden's metadata with ``changes`` merged in, and nothing else: what a hostile
+    recording could say (its CRCs are right)."""
+    with RecordingReader(GOLDEN) as reader:
+        meta = {name: dict(pairs) for name, pairs in reader.metadata if name != "uavtool"}
+    for name, pairs in changes.items():
+        meta[name] = {**meta[name], **pairs}
+    with RecordingWriter(path, metadata=meta, fsync=False) as writer:
+        writer.add_json_topic("/mission/observations", schema_name="x", schema={})
+        writer.write_json("/mission/observations", {"step": 1}, log_time_ns=SIM_EPOCH_NS + 1)
+    return path
+
+
+def test_refly_never_hands_a_recorded_camera_to_opencv(tmp_path: Path) -> None:
+    """A recording's camera would be opened by OpenCV/FFmpeg: a URL it fetches, a device, a
+    file. Only the simulated camera is flown again; nothing is opened."""
+    for camera in ("http://127.0.0.1:9/x.mjpg", "opencv:0", "/etc/passwd", "\x1b]52;c;x\x07"):
+        crafted = _crafted(tmp_path / "camera.mcap", vehicle={"camera": camera})
+        result = CliRunner().invoke(cli, ["replay", "--refly", str(crafted)])
+        assert result.exit_code == 2, result.output
+        assert "only a flight with the simulated camera can be flown again" in result.output
+        assert "\x1b" not in result.output and "\x07" not in result.output
+
+
+def test_refly_refuses_a_camera_size_before_allocating_it(tmp_path: Path) -> None:
+    crafted = _crafted(tmp_path / "big.mcap", flight={"size_px": "[20000, 20000]"})
+    result = CliRunner().invoke(cli, ["replay", "--refly", str(crafted)])
+    assert result.exit_code == 2, result.output
+    assert "size_px 20000x20000 is outside 16..8192 pixels a side" in result.output

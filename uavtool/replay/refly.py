@@ -75,6 +75,13 @@ def refly_config(path: Path, *, out: Path, workdir: Path) -> FlyConfig:
                 "`uavtool fly`"
             )
         flight = meta["flight"]
+        camera = vehicle.get("camera", "sim")
+        if camera != "sim":
+            # Anything else is a device or a URL for OpenCV/FFmpeg to open: never from a file.
+            raise ReflyInputError(
+                f"{path}: recorded with the camera {camera[:40]!r}; only a flight with the "
+                "simulated camera can be flown again"
+            )
         try:
             scene = scene_from_dict(json.loads(meta["scene"]["json"]), source=f"{path}: scene")
             params: Params = from_dict(
@@ -83,7 +90,7 @@ def refly_config(path: Path, *, out: Path, workdir: Path) -> FlyConfig:
             wind = json.loads(flight["wind"])
             config = FlyConfig(
                 scene=scene,
-                camera=vehicle.get("camera", "sim"),
+                camera="sim",
                 record=out,
                 params=params,
                 vehicle_params=tuple(
@@ -96,7 +103,7 @@ def refly_config(path: Path, *, out: Path, workdir: Path) -> FlyConfig:
                     (float(a), float(d)) for a, d in json.loads(flight["link_outages_s"])
                 ),
                 hfov_deg=float(json.loads(flight["hfov_deg"])),
-                size_px=tuple(int(v) for v in json.loads(flight["size_px"])),  # type: ignore[arg-type]
+                size_px=_size_px(json.loads(flight["size_px"])),
                 target=_target_file(reader, path, workdir) if flight["target"] == "file" else None,
                 no_gimbal=json.loads(flight.get("no_gimbal", "false")) is True,
             )
@@ -106,6 +113,21 @@ def refly_config(path: Path, *, out: Path, workdir: Path) -> FlyConfig:
                 "the recording cannot be flown again"
             ) from None
     return config
+
+
+_SIDE_PX = (16, 8192)
+"""The image sides a re-flight accepts (as ``uavtool scene --size``): a recording asking for
+more is refused before anything is allocated."""
+
+
+def _size_px(value: object) -> tuple[int, int]:
+    if not isinstance(value, list) or len(value) != 2:
+        raise ValueError(f"size_px {value!r} is not [width, height]")
+    w, h = (int(v) for v in value)
+    lo, hi = _SIDE_PX
+    if not (lo <= w <= hi and lo <= h <= hi):
+        raise ValueError(f"size_px {w}x{h} is outside {lo}..{hi} pixels a side")
+    return w, h
 
 
 def refly(
