@@ -15,9 +15,9 @@ from mcap.records import Chunk
 from mcap.records import Message as McapMessage
 from mcap.stream_reader import StreamReader, breakup_chunk
 
-from tests.recording.sample import write_sample
+from tests.recording.sample import T0_NS, write_sample
 from uavtool.cli import cli
-from uavtool.recording import RecordingReader, recover, summarize
+from uavtool.recording import RecordingReader, RecordingWriter, recover, summarize
 from uavtool.recording.errors import CorruptRecordingError
 from uavtool.recording.records import chunk_payload, iter_records
 from uavtool.replay import load_flight
@@ -309,3 +309,21 @@ def test_a_flipped_metadata_byte_is_found_and_refused(tmp_path: Path) -> None:
     code, out, err = _run("replay", "--check", str(path))
     assert code == 2 and "identical" not in out
     _one_line_error(err, path)
+
+
+def test_info_prints_no_terminal_escape_from_the_file(tmp_path: Path) -> None:
+    """A recording's words reach the terminal as text: OSC 0 (window title), OSC 52
+    (clipboard), BEL, NUL, a forged line break and a right-to-left override are escaped."""
+    path = tmp_path / "hostile.mcap"
+    hostile = "\x1b]0;owned\x07\x1b]52;c;ZWNobyBoaQ==\x07\x00\nhealth:    whole\u202etxt.exe"
+    with RecordingWriter(path, metadata={"outcome": {"reason": hostile}}, fsync=False) as w:
+        w.add_json_topic("/x", schema_name="x", schema={})
+        w.write_json("/x", {"a": 1}, log_time_ns=T0_NS)
+    code, out, _ = _run("info", str(path))
+    assert code == 0, out
+    for unsafe in ("\x1b", "\x07", "\x00", "\u202e"):
+        assert unsafe not in out
+    assert "\\x1b]0;owned\\x07" in out and "\\x0ahealth:" in out and "\\u202etxt" in out
+    assert [line for line in out.splitlines() if line.startswith("health:")] == [
+        "health:    whole, indexed, CRCs checked"
+    ]  # no forged line

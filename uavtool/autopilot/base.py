@@ -11,6 +11,7 @@ from uavtool.geo import GeoPoint
 from uavtool.link import VehicleLink
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mission import Command
+from uavtool.terminal import safe_text
 
 ParamReader = Callable[[str], float | None]
 """Reads one of the vehicle's parameters by name; None when it does not answer."""
@@ -71,7 +72,7 @@ class Autopilot:
         """(MAV_SEVERITY, text) when ``msg`` is the vehicle saying something (STATUSTEXT,
         and PX4's events); None for any other message."""
         if msg.get_type() == "STATUSTEXT":
-            return int(msg.severity), str(msg.text)
+            return int(msg.severity), safe_text(str(msg.text).strip())
         return None
 
     def param_value(self, msg: Any) -> float:

@@ -33,6 +33,7 @@ from uavtool.link import VehicleLink
 from uavtool.link.client import GCS_COMPID, GCS_SYSID
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mission import Arm, Command, GoTo, SetGimbal, SetMode, Takeoff
+from uavtool.terminal import safe_text
 
 MAIN_MODES = {1: "MANUAL", 2: "ALTCTL", 3: "POSCTL", 4: "AUTO", 5: "ACRO", 6: "OFFBOARD",
               7: "STABILIZED", 8: "RATTITUDE"}  # fmt: skip
@@ -128,7 +129,7 @@ class PX4(Autopilot):
             return None
         # PX4 says much twice in a row, as a STATUSTEXT and as an event: once is enough (a
         # repeat of the same kind is news again, e.g. the reason for a second refusal).
-        text, kind = said[1].strip(), msg.get_type()
+        text, kind = safe_text(said[1].strip()), msg.get_type()
         last, self._last_said = self._last_said, (kind, text)
         if last[1] == text and last[0] != kind:
             self._last_said = ("", "")

@@ -12,6 +12,7 @@ from uavtool.recording import foxglove
 from uavtool.recording.reader import RecordingReader
 from uavtool.recording.topics import IMAGE
 from uavtool.recording.values import CompressedImage
+from uavtool.terminal import safe_text
 
 OUTCOME_METADATA = "outcome"  # the record the mission runner writes when it finishes
 RECORD_METADATA = "record"  # `uavtool record` writes it first: a flight it did not fly
@@ -190,7 +191,8 @@ def format_info(info: RecordingInfo) -> str:
     for t in info.topics:
         kind = t.schema_name or t.message_encoding
         lines.append(f"  {t.topic:<{width}}  {t.count:>8} msgs  {t.rate_hz:9.2f} Hz  {kind}")
-    return "\n".join(lines)
+    # Names and values come from the file: no escape sequence of theirs reaches the terminal.
+    return "\n".join(safe_text(line) for line in lines)
 
 
 def _ending(info: RecordingInfo) -> str:
