@@ -126,6 +126,30 @@ def test_change_speed_limits_ground_speed(client: Client, vehicle: Sitl) -> None
     assert max(speeds) == pytest.approx(3.0, abs=0.05)
 
 
+def test_speeds_asked_for_stay_within_the_speed_parameters_ranges(client: Client) -> None:
+    """DO_CHANGE_SPEED 1e38 and a 1e6 m/s velocity stream fly no faster than WPNAV_SPEED's
+    top (20 m/s), as ArduCopter bounds them (a 2 km move reached 70.6 m/s, a velocity stream
+    503 m/s)."""
+    client.takeoff(5)
+    assert client.command(M.MAV_CMD_DO_CHANGE_SPEED, 1, 1e38, -1).result == ACCEPTED
+    position_only, velocity_only = 0b110111111000, 0b110111000111
+    client.send(
+        M.MAVLink_set_position_target_local_ned_message(
+            0, 1, 1, M.MAV_FRAME_LOCAL_NED, position_only, 2000, 0, -5, 0, 0, 0, 0, 0, 0, 0, 0
+        )
+    )
+    client.pump(15.0)
+    for _ in range(15):  # a stream, as an attacker would send it
+        client.send(
+            M.MAVLink_set_position_target_local_ned_message(
+                0, 1, 1, M.MAV_FRAME_LOCAL_NED, velocity_only, 0, 0, 0, 1e6, 0, 0, 0, 0, 0, 0, 0
+            )
+        )
+        client.pump(1.0)
+    speeds = [m.groundspeed for m in client.received if m.get_type() == "VFR_HUD"]
+    assert 19.0 < max(speeds) <= 20.05
+
+
 @pytest.mark.parametrize("frame", [M.MAV_FRAME_GLOBAL_INT, M.MAV_FRAME_GLOBAL_RELATIVE_ALT_INT])
 def test_reposition_honours_altitude_frame(client: Client, vehicle: Sitl, frame: int) -> None:
     client.takeoff(5)

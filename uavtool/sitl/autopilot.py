@@ -20,7 +20,7 @@ from uavtool.sitl.crash import Collisions
 from uavtool.sitl.fence import Fence
 from uavtool.sitl.mount import Mount
 from uavtool.sitl.obstacles import Prism
-from uavtool.sitl.params import ParamStore
+from uavtool.sitl.params import ParamStore, highest
 from uavtool.sitl.physics import Multicopter, State, Target
 from uavtool.sitl.prearm import boot_failure
 from uavtool.sitl.shutter import Shutter
@@ -268,6 +268,7 @@ class Autopilot:
             return failed("Guided: vehicle not armed")
         if not all(math.isfinite(v) for v in vel_ned_ms):
             return denied("Guided: target velocity is not finite")
+        vel_ned_ms = _bounded_velocity(vel_ned_ms)
         self.taking_off = False
         self._velocity_deadline_ns = (
             self.now_ns + 3 * _NS
@@ -310,13 +311,15 @@ class Autopilot:
             return denied("Change speed: speed is not finite")
         if speed_ms < 0:  # -1 means "no change"
             return ACCEPTED
+        # Each speed within its parameter's range, as ArduCopter bounds what it is asked for
+        # (1e38 m/s was taken as it came).
         if speed_type in (0, 1):
-            self.speed_override_ms = max(0.2, speed_ms)
+            self.speed_override_ms = min(max(0.2, speed_ms), _MAX_XY_MS)
             self.vehicle.limits.speed_xy_ms = self.speed_override_ms
         elif speed_type == 2:
-            self.vehicle.limits.speed_up_ms = max(0.1, speed_ms)
+            self.vehicle.limits.speed_up_ms = min(max(0.1, speed_ms), _MAX_UP_MS)
         elif speed_type == 3:
-            self.vehicle.limits.speed_dn_ms = max(0.1, speed_ms)
+            self.vehicle.limits.speed_dn_ms = min(max(0.1, speed_ms), _MAX_DN_MS)
         else:
             return denied(f"Change speed: unknown speed type {speed_type}")
         return ACCEPTED
@@ -526,3 +529,19 @@ class Autopilot:
         ):
             return int(mavlink.MAV_LANDED_STATE_LANDING)
         return int(mavlink.MAV_LANDED_STATE_IN_AIR)
+
+
+_MAX_XY_MS = highest("WPNAV_SPEED") / 100.0
+_MAX_UP_MS = highest("WPNAV_SPEED_UP") / 100.0
+_MAX_DN_MS = highest("WPNAV_SPEED_DN") / 100.0
+"""The fastest the vehicle is ever asked to go: the top of each speed parameter's range."""
+
+
+def _bounded_velocity(vel_ned_ms: tuple[float, float, float]) -> tuple[float, float, float]:
+    """A velocity target scaled down to the horizontal speed limit and clamped to the climb
+    and descent limits (north, east, down)."""
+    n, e, d = vel_ned_ms
+    across = math.hypot(n, e)
+    if across > _MAX_XY_MS:
+        n, e = n * _MAX_XY_MS / across, e * _MAX_XY_MS / across
+    return n, e, min(max(d, -_MAX_UP_MS), _MAX_DN_MS)

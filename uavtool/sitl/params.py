@@ -93,6 +93,11 @@ PARAM_SPECS: tuple[ParamSpec, ...] = (
 _SPECS_BY_NAME = {spec.name: spec for spec in PARAM_SPECS}
 
 
+def highest(name: str) -> float:
+    """The top of a parameter's documented range (ArduCopter's @Range)."""
+    return _SPECS_BY_NAME[name].high
+
+
 def coerce(mav_type: int, value: float) -> float:
     """``value`` as the parameter type stores it (float32 rounding, integer clamping)."""
     if mav_type == _REAL32:
