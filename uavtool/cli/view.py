@@ -21,7 +21,12 @@ from uavtool.errors import InputError
     metavar="OUT.rrd",
     help="Write a Rerun file instead of opening a viewer (headless).",
 )
-@click.option("--web", is_flag=True, help="Serve the web viewer on localhost and print its URL.")
+@click.option(
+    "--web",
+    is_flag=True,
+    help="Serve the web viewer and print its localhost URL. Rerun listens on every network "
+    "interface (it has no option to bind one): firewall the ports on a shared network.",
+)
 @click.option(
     "--compare",
     type=click.Path(path_type=Path),
