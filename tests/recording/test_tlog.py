@@ -21,7 +21,9 @@ from uavtool.recording import (
     TopicNotFoundError,
     export_tlog,
     import_tlog,
+    summarize,
 )
+from uavtool.recording.info import format_info
 
 # pymavlink's mavutil picks MAVLink 2 from an environment variable at import: run it in a
 # child process so the test process stays clean.
@@ -84,6 +86,9 @@ def test_import_keeps_every_frame_byte_for_byte(tmp_path: Path) -> None:
     assert raw[7].log_time_ns == (1_700_000_000_000_000 + 7000) * 1000
     assert isinstance(heartbeat.value, JsonDocument)
     assert heartbeat.value.payload["header"]["sysid"] == 255
+    report = format_info(summarize(rec))
+    assert "imported:  a telemetry log" in report  # no mission ran: nothing "did not finish"
+    assert "did not finish" not in report
 
 
 def test_tlog_round_trip_is_lossless(tmp_path: Path) -> None:

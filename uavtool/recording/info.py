@@ -199,6 +199,8 @@ def _ending(info: RecordingInfo) -> str:
     """The line on how the recording ended: the mission's outcome, or why `record` stopped."""
     if info.outcome is not None:
         return "outcome:   " + ", ".join(f"{k}={v}" for k, v in info.outcome.items())
+    if "import" in info.metadata_names:
+        return "imported:  a telemetry log (no mission ran in uavtool, so no outcome)"
     if not info.from_record:
         return "outcome:   unknown (no 'outcome' record: the mission did not finish)"
     r = info.record_result
