@@ -23,3 +23,8 @@ def _escape(c: str) -> str:
     if code < 0x100:
         return f"\\x{code:02x}"
     return f"\\u{code:04x}" if code < 0x10000 else f"\\U{code:08x}"
+
+
+def counted(n: int, noun: str, plural: str | None = None) -> str:
+    """``1 flight``, ``0 flights``, ``3 flights`` (``plural`` when it is not noun + s)."""
+    return f"{n} {noun if n == 1 else plural or noun + 's'}"

@@ -61,9 +61,9 @@ def test_a_changed_parameter_reports_the_flights_that_differ(
     assert (paper["matched_poi_before"], paper["matched_poi_after"]) == (3, -1)
     assert paper["decision_changed"] is True
     changed = sum(bool(r["decision_changed"]) for r in rows.values())
+    changes = "changes its" if changed == 1 else "change their"
     assert (
-        f"decisions      {changed} of 3 flights change their decision under the new"
-        in result.output
+        f"decisions      {changed} of 3 flights {changes} decision under the new" in result.output
     )
 
 

@@ -9,6 +9,8 @@ from types import FrameType
 
 import click
 
+from uavtool.terminal import counted
+
 
 @click.command()
 @click.option(
@@ -152,6 +154,6 @@ def record(
     click.echo(
         f"wrote {summary.path}: {summary.duration_s:.1f} s ({summary.stop.value}), "
         f"{summary.messages_in} MAVLink frames in, {summary.messages_out} out, "
-        f"{summary.telemetry} telemetry samples, {summary.frames} frames, {summary.photos} photos, "
-        f"{summary.events} events"
+        f"{counted(summary.telemetry, 'telemetry sample')}, {counted(summary.frames, 'frame')}, "
+        f"{counted(summary.photos, 'photo')}, {counted(summary.events, 'event')}"
     )

@@ -10,6 +10,7 @@ from pathlib import Path
 import click
 
 from uavtool.errors import InputError
+from uavtool.terminal import counted
 
 
 @click.command()
@@ -69,8 +70,9 @@ def view(
     )
     c = result.counts
     summary = (
-        f"{c.frames} frames, {c.telemetry} telemetry samples, {c.shapes} shapes, "
-        f"{c.recognitions} recognitions, {c.models} model"
+        f"{counted(c.frames, 'frame')}, {counted(c.telemetry, 'telemetry sample')}, "
+        f"{counted(c.shapes, 'shape')}, {counted(c.recognitions, 'recognition')}, "
+        f"{counted(c.models, 'model')}"
     )
     if save is not None:
         click.echo(f"wrote {save}: {summary}")

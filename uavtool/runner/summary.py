@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from uavtool.mission import Status, Telemetry
+from uavtool.terminal import counted
 
 if TYPE_CHECKING:
     from uavtool.runner.fly import FlightSummary
@@ -23,7 +24,7 @@ def format_summary(s: FlightSummary) -> str:
         "",
         f"outcome        {o.status.value}: {o.reason}",
         f"flight         {s.flight_time_s:.1f} s sim, route {s.route_length_m:.1f} m, "
-        f"{s.frames} photos, {s.wall_time_s:.1f} s wall",
+        f"{counted(s.frames, 'photo')}, {s.wall_time_s:.1f} s wall",
     ]
     visited = [
         f"poi {k}" + (f" ({e.visited[i]})" if i < len(e.visited) else "")

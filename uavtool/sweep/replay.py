@@ -27,6 +27,7 @@ from uavtool.sweep.cluster import open_client
 from uavtool.sweep.dispatch import run_tasks
 from uavtool.sweep.progress import Progress, ProgressCallback
 from uavtool.sweep.table import write_table
+from uavtool.terminal import counted
 
 IDENTICAL, DIFFERS, DIVERGED, VISION_ONLY, ERROR = (
     "identical",
@@ -250,7 +251,10 @@ def format_replay_summary(batch: BatchReplay, *, total: int, changed_params: boo
     lines.append("results        " + ", ".join(f"{k} {v}" for k, v in counts if v))
     changed = batch.decisions_changed
     what = "under the new parameters" if changed_params else "with the recorded parameters"
-    lines.append(f"decisions      {len(changed)} of {n} flights change their decision {what}")
+    changes = "changes its" if len(changed) == 1 else "change their"
+    lines.append(
+        f"decisions      {len(changed)} of {counted(n, 'flight')} {changes} decision {what}"
+    )
     lines += [f"  {p}" for p in changed[:20]]
     if len(changed) > 20:
         lines.append(f"  … and {len(changed) - 20} more (see the table)")

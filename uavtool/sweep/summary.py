@@ -9,6 +9,8 @@ from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
 
+from uavtool.terminal import counted
+
 _MAX_GROUPS = 8  # a numeric input with more distinct values is binned
 _BINS = 5
 
@@ -149,14 +151,14 @@ def format_summary(s: Summary) -> str:
         at_risk = sum(m <= 0 for m in s.margins)
         lines.append(
             f"score margin   median {margin['median']:+.3f}, worst {margin['min']:+.3f} "
-            f"(target minus best other building; {at_risk} flights ≤ 0)"
+            f"(target minus best other building; {counted(at_risk, 'flight')} ≤ 0)"
         )
     if s.clearance_min_m is not None:
         lines.append(f"clearance      {s.clearance_min_m:.2f} m at the closest")
     if s.flight_time_median_s is not None:
         lines.append(f"flight time    median {s.flight_time_median_s:.1f} s (vehicle)")
     if s.errors:
-        lines.append(f"errors         {s.errors} flights raised (see the error column)")
+        lines.append(f"errors         {counted(s.errors, 'flight')} raised (see the error column)")
     for key, rates in s.conditions:
         lines.append(f"by {key}:")
         lines += [
