@@ -35,6 +35,18 @@ def test_without_a_gimbal_exit_2_on_the_ground_naming_px4_parameters(tmp_path: P
     assert len(result.stderr.strip().splitlines()) == 1
 
 
+def test_px4s_geofence_below_the_second_overview_stops_the_run_on_the_ground(
+    tmp_path: Path,
+) -> None:
+    """GF_ACTION (an integer PX4 sends bytewise) and GF_MAX_VER_DIST read from PX4 itself."""
+    fenced = {**PX4_GIMBAL, "GF_ACTION": "2", "GF_MAX_VER_DIST": "60"}
+    with px4(tmp_path, params=fenced) as port:
+        result = fly(f"udpin:0.0.0.0:{port}", tmp_path)
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert "GF_MAX_VER_DIST=60 m" in result.stderr and "set GF_MAX_VER_DIST=" in result.stderr
+    assert "taking off" not in result.stdout
+
+
 def test_with_a_gimbal_the_mission_completes_and_every_photo_is_where_its_pose_says(
     tmp_path: Path,
 ) -> None:
