@@ -122,7 +122,12 @@ class _Bare:
     def __init__(self, path: Path, *, fsync: bool = False) -> None:
         self._fsync = fsync  # inline, after each chunk: what our writer did before
         self._file = path.open("wb")
-        self.w = Writer(self._file, chunk_size=1 << 62, compression=CompressionType.ZSTD)
+        self.w = Writer(
+            self._file,
+            chunk_size=1 << 62,
+            compression=CompressionType.ZSTD,
+            enable_data_crcs=True,  # as RecordingWriter: the data section's CRC
+        )
         self.w.start(profile="", library=LIBRARY)
         tool = {"version": __version__, "dialect": DEFAULT_DIALECT, "mavlink": "2.0"}
         self.w.add_metadata(TOOL_METADATA, tool)
