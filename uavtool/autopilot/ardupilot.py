@@ -10,6 +10,7 @@ from uavtool.autopilot.base import (
     Fence,
     ParamReader,
     Sent,
+    point_mount,
     position_target,
     set_mode_long,
 )
@@ -48,17 +49,7 @@ class ArduPilot(Autopilot):
             link.command_long(M.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, math.nan, 0, 0, cmd.alt_m)
             return Sent(M.MAV_CMD_NAV_TAKEOFF)
         if isinstance(cmd, SetGimbal):
-            link.command_long(
-                M.MAV_CMD_DO_MOUNT_CONTROL,
-                cmd.pitch_deg,
-                0.0,
-                cmd.yaw_deg,
-                0,
-                0,
-                0,
-                M.MAV_MOUNT_MODE_MAVLINK_TARGETING,
-            )
-            return Sent(M.MAV_CMD_DO_MOUNT_CONTROL)
+            return point_mount(link, cmd)
         if isinstance(cmd, GoTo):
             x, y, z = cmd.pos_enu_m
             target = geo_from_enu(home, x, y, 0.0)

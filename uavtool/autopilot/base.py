@@ -10,7 +10,7 @@ from typing import Any
 from uavtool.geo import GeoPoint
 from uavtool.link import VehicleLink
 from uavtool.mavlink.dialect import mavlink as M
-from uavtool.mission import Command
+from uavtool.mission import Command, SetGimbal
 from uavtool.terminal import safe_text
 
 ParamReader = Callable[[str], float | None]
@@ -126,9 +126,13 @@ def set_mode_long(link: VehicleLink, custom_mode: int, custom_sub_mode: int = 0)
     )
 
 
-def finite(value: float | None) -> float:
-    """NaN for "not given" (MAVLink's convention for an unused float parameter)."""
-    return math.nan if value is None else float(value)
+def point_mount(link: VehicleLink, cmd: SetGimbal) -> Sent:
+    """Point a mount with gimbal protocol v1 (DO_MOUNT_CONTROL, MAVLink targeting)."""
+    link.command_long(
+        M.MAV_CMD_DO_MOUNT_CONTROL, cmd.pitch_deg, 0.0, cmd.yaw_deg, 0, 0, 0,
+        M.MAV_MOUNT_MODE_MAVLINK_TARGETING,
+    )  # fmt: skip
+    return Sent(M.MAV_CMD_DO_MOUNT_CONTROL)
 
 
 # SET_POSITION_TARGET: use the position (and yaw when given), ignore velocity, acceleration

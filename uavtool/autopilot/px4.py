@@ -6,8 +6,9 @@ in every hint.
 
 PX4 has no GUIDED mode. The adapter emulates one: after the mission asks for GUIDED, the
 modes the adapter drives the vehicle through — Hold (AUTO.LOITER, where DO_REPOSITION moves
-it), AUTO.TAKEOFF and OFFBOARD — read as GUIDED; any other mode the vehicle shows ends that (whoever
-switched: the mission to RTL, a pilot, a failsafe), so a later Hold reads as AUTO.LOITER.
+it), AUTO.TAKEOFF and OFFBOARD — read as GUIDED; any other mode the vehicle shows ends that
+(whoever switched: the mission to RTL, a pilot, a failsafe), so a later Hold reads as
+AUTO.LOITER.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from uavtool.autopilot.base import (
     Fence,
     ParamReader,
     Sent,
-    finite,
+    point_mount,
     position_target,
     set_mode_long,
 )
@@ -70,9 +71,13 @@ def px4_mode(custom_mode: int) -> tuple[int, int]:
     return (custom_mode >> 16) & 0xFF, (custom_mode >> 24) & 0xFF
 
 
+def _sub_modes(main: int) -> dict[int, str]:
+    return AUTO_SUB_MODES if main == _AUTO else POSCTL_SUB_MODES if main == 3 else {}
+
+
 def px4_mode_name(main: int, sub: int) -> str:
     name = MAIN_MODES.get(main, f"MODE{main}")
-    subs = AUTO_SUB_MODES if main == _AUTO else POSCTL_SUB_MODES if main == 3 else {}
+    subs = _sub_modes(main)
     if sub in subs:
         return f"{name}.{subs[sub]}"
     return name if main != _AUTO or sub == 0 else f"{name}.{sub}"
@@ -81,7 +86,7 @@ def px4_mode_name(main: int, sub: int) -> str:
 _BY_NAME = {
     px4_mode_name(main, sub): (main, sub)
     for main in MAIN_MODES
-    for sub in [0, *(AUTO_SUB_MODES if main == _AUTO else POSCTL_SUB_MODES if main == 3 else {})]
+    for sub in [0, *_sub_modes(main)]
     if not (main == _AUTO and sub == 0)
 }
 
@@ -99,6 +104,7 @@ def _amsl(link: VehicleLink, home: GeoPoint, up_m: float) -> float:
 
 class PX4(Autopilot):
     name = "PX4"
+    param_types_matter = True
 
     def __init__(self, events: EventDecoder | None = None, *, movement: str = "reposition") -> None:
         if movement not in ("reposition", "offboard"):
@@ -183,11 +189,7 @@ class PX4(Autopilot):
             link.command_long(M.MAV_CMD_NAV_TAKEOFF, nan, 0, 0, nan, nan, nan, amsl)
             return Sent(M.MAV_CMD_NAV_TAKEOFF)
         if isinstance(cmd, SetGimbal) and self._gimbal_v1:
-            link.command_long(
-                M.MAV_CMD_DO_MOUNT_CONTROL, cmd.pitch_deg, 0.0, cmd.yaw_deg, 0, 0, 0,
-                M.MAV_MOUNT_MODE_MAVLINK_TARGETING,
-            )  # fmt: skip
-            return Sent(M.MAV_CMD_DO_MOUNT_CONTROL)
+            return point_mount(link, cmd)
         if isinstance(cmd, SetGimbal):
             if not self._gimbal_control:  # PX4 denies PITCHYAW from a GCS without control
                 link.command_long(
@@ -214,7 +216,7 @@ class PX4(Autopilot):
             target = geo_from_enu(home, x, y, 0.0)
             # PX4 takes DO_REPOSITION as COMMAND_INT only in MAV_FRAME_GLOBAL_INT (above sea
             # level), and its yaw in radians.
-            yaw = finite(None if cmd.heading_deg is None else math.radians(cmd.heading_deg))
+            yaw = math.nan if cmd.heading_deg is None else math.radians(cmd.heading_deg)
             link.send(
                 M.MAVLink_command_int_message(
                     link.target_system,
@@ -297,8 +299,6 @@ class PX4(Autopilot):
             return float(msg.param_value)
         raw = struct.pack("<f", float(msg.param_value))
         return float(struct.unpack_from(code, raw)[0])
-
-    param_types_matter = True
 
     def param_encoded(self, value: float, param_type: int) -> float:
         code = _INT_CODES.get(param_type)

@@ -7,7 +7,6 @@ from __future__ import annotations
 from typing import Any
 
 from uavtool.geo import GeoPoint
-from uavtool.mavlink.dialect import DIALECT
 from uavtool.mission import Telemetry
 from uavtool.mission.codec import encode, encode_observation
 from uavtool.recorder.frames import Frame
@@ -78,7 +77,7 @@ class PassiveRecorder:
             frame,
             direction=Direction.IN if direction == "in" else Direction.OUT,
             log_time_ns=self.clock_ns(),
-            decoded=decoded if self.writer.dialect == DIALECT else None,
+            decoded=decoded,
         )
 
     def telemetry(self, t: Telemetry) -> None:

@@ -185,6 +185,11 @@ class MavlinkDecoder:
             return None
         return self.view(msg)
 
+    def owns(self, msg: Any) -> bool:
+        """Whether ``msg`` is a message of this decoder's dialect (its class, not another
+        dialect's class of the same id)."""
+        return type(msg) is self._known.get(msg.get_msgId())
+
     def view(self, msg: Any) -> tuple[int, str, dict[str, Any]] | None:
         """``(msgid, MSGNAME, payload)`` of a message this dialect decoded (from a frame's
         bytes: a message built in Python, not yet packed, has no float32 rounding), or None

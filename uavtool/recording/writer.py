@@ -221,8 +221,8 @@ class RecordingWriter:
         """Write one whole MAVLink frame to ``/mavlink/raw`` (see `rawframe`) and, if it
         decodes, its JSON view to ``/mavlink/<in|out>/<MSGNAME>``. Unknown or corrupt frames
         are kept raw only. ``decoded``: the pymavlink message already decoded from exactly
-        these bytes with this recording's dialect (a link's parser has done it), which saves
-        decoding the frame again."""
+        these bytes (a link's parser has done it); used when it is of this recording's
+        dialect, which saves decoding the frame again."""
         frame = bytes(frame)
         with self._lock:
             self._check_open()
@@ -234,7 +234,10 @@ class RecordingWriter:
                 meta = {"dialect": self.dialect}
                 raw_id = self._channel(MAVLINK_RAW, MAVLINK_RAW, PROTOBUF_ENCODING, schema_id, meta)
             self._add(raw_id, log_time_ns, publish_time_ns, rawframe.encode(direction, frame))
-            view = self._decoder.decode(frame) if decoded is None else self._decoder.view(decoded)
+            if decoded is not None and self._decoder.owns(decoded):
+                view = self._decoder.view(decoded)
+            else:
+                view = self._decoder.decode(frame)
             if view is None:
                 return
             msgid, msg_name, payload = view

@@ -24,7 +24,6 @@ from typing import Any
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.geo import GeoPoint, geo_from_enu
 from uavtool.images import png_encode
-from uavtool.mavlink.dialect import DIALECT
 from uavtool.mission import Level, ModelBuilt, Observation, Output, Photo, Telemetry
 from uavtool.mission.codec import encode_observation, encode_output
 from uavtool.mission.schema import observation_schema, output_schema
@@ -116,7 +115,7 @@ class MissionRecorder:
             frame,
             direction=Direction.IN if direction == "in" else Direction.OUT,
             log_time_ns=self.clock_ns(),
-            decoded=decoded if self.writer.dialect == DIALECT else None,
+            decoded=decoded,
         )
 
     def target(self, png: bytes) -> None:
