@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import logging
 import math
+import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -97,14 +98,12 @@ class GcsSession:
     def handle(self, frame: Frame) -> None:
         msg = frame.msg
         signing = self.sitl.signing
-        if (
-            signing is not None
-            and not signing.verify(frame.raw)
-            and msg.get_msgId() not in _UNSIGNED_OK
-        ):
+        verified = signing is None or signing.verify(frame.raw)
+        if not verified and msg.get_msgId() not in _UNSIGNED_OK:
             self.rejected_unsigned += 1
             return
-        self.link.heard_ns = self.ap.now_ns
+        if verified:  # with a key, an unsigned radio report never holds a UDP peer's place
+            self.link.heard(time.monotonic_ns())
         handler = self._handlers.get(msg.get_type())
         if handler is None or not self._addressed_to_us(msg):
             return

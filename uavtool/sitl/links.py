@@ -12,6 +12,8 @@ import errno
 import logging
 import socket
 import struct
+import sys
+from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -25,11 +27,22 @@ log = logging.getLogger(__name__)
 _KINDS = ("tcpin", "udpin", "udpout", "tcp")
 _TCP_BACKLOG_LIMIT = 4 << 20  # bytes queued for a slow TCP client before we drop it
 MAX_UDP_PEERS = 16
-"""Peers one ``udpin`` endpoint serves at once; datagrams from more are dropped until one
-expires (ArduPilot has a fixed number of MAVLink channels; routers bound their tables)."""
+"""Peers one ``udpin`` endpoint serves at once (ArduPilot has a fixed number of MAVLink
+channels; routers bound their tables). When more write, :meth:`UdpSocket.expire` decides who
+keeps a place: see there."""
 UDP_PEER_TIMEOUT_NS = 10_000_000_000
-"""A ``udpin`` peer heard from for this long (vehicle time) is forgotten, as MAVLink routers
-expire their UDP routes; ground stations send a HEARTBEAT every second."""
+"""A ``udpin`` peer not heard from for this long (real time) is forgotten, as MAVLink routers
+expire their UDP routes. Peers are timed in real time whatever the speed-up: a ground station
+sends a HEARTBEAT every second of its own clock."""
+UDP_PEER_LIVE_NS = 2_000_000_000
+"""A peer heard from within this long is live (a ground station's HEARTBEAT comes every
+second); a longer gap ends its steady contact."""
+UDP_PEER_STEADY_NS = 500_000_000
+"""A live peer heard from without a gap for at least this long is in steady contact: it came
+back, as a ground station does, where a spoofed or flooding source writes once."""
+_RECENT_UDP_PEERS = 4096
+"""Peers that lost their place, remembered so that one that comes back (a ground station's
+next HEARTBEAT) keeps its steady contact; a flood of new addresses must outpace this."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -102,7 +115,17 @@ class Link:
         self.frames_sent = 0
         self.unsendable = 0  # messages refused because a value did not fit its field
         self.faults = 0  # unexpected errors while serving this peer
-        self.heard_ns: int | None = None  # vehicle time of the last frame accepted from it
+        self.heard_ns: int | None = None  # real time (monotonic) of the last frame accepted
+        self.live_since_ns: int | None = None  # start of its contact without a gap > LIVE
+        self.earlier: tuple[int, int] | None = None  # (heard_ns, live_since_ns) before a restart
+
+    def heard(self, now_ns: int) -> None:
+        """A frame from the peer was accepted at ``now_ns`` (``time.monotonic_ns``)."""
+        last, since = (self.heard_ns, self.live_since_ns) if self.earlier is None else self.earlier
+        self.earlier = None
+        if last is None or since is None or now_ns - last > UDP_PEER_LIVE_NS:
+            since = now_ns
+        self.heard_ns, self.live_since_ns = now_ns, since
 
     def send(self, msg: Any) -> None:
         """Pack ``msg`` with this link's sequence numbers and send it. A message with a value
@@ -241,7 +264,8 @@ class UdpSocket(_Socketed):
         self.endpoint = endpoint
         self._make_link = make_link
         self.links: dict[tuple[str, int], Link] = {}
-        self.peers_refused = 0  # datagrams dropped because MAX_UDP_PEERS were being served
+        self.peers_refused = 0  # peers turned away or evicted because MAX_UDP_PEERS wrote
+        self._recent: OrderedDict[tuple[str, int], tuple[int, int]] = OrderedDict()
         if endpoint.kind == "udpin":
             self.sock = _open(endpoint, socket.SOCK_DGRAM)
         else:
@@ -281,19 +305,27 @@ class UdpSocket(_Socketed):
             if self.endpoint.kind == "udpout":
                 addr = (self.endpoint.host, self.endpoint.port)
             link = self.links.get(addr)
-            if link is None:
-                if len(self.links) >= MAX_UDP_PEERS:
-                    self.peers_refused += 1
-                    continue
+            if link is None:  # served for now; expire() decides whether it keeps a place
                 link = self._make_link(f"udp:{addr[0]}:{addr[1]}", self._sender(addr))
+                link.earlier = self._recent.pop(addr, None)
                 self.links[addr] = link
             out.append((link, data))
         return out
 
     def expire(self, now_ns: int) -> list[Link]:
         """Forget ``udpin`` peers that are closed, sent nothing we accepted, or went silent
-        for ``UDP_PEER_TIMEOUT_NS``; return their links. The ``udpout`` peer is configured
-        and stays."""
+        for ``UDP_PEER_TIMEOUT_NS``, then the peers beyond ``MAX_UDP_PEERS``; return their
+        links. ``now_ns`` is ``time.monotonic_ns()``. The ``udpout`` peer is configured and
+        stays.
+
+        When more than ``MAX_UDP_PEERS`` write, the first to go are the peers not live (least
+        recently heard first), then the live ones that wrote once rather than in steady
+        contact (least recently heard first), and last the peers in steady contact (the most
+        recent contact first). A spoofed source that writes every few seconds, or a flood of
+        new addresses, therefore never keeps a ground station out: its first HEARTBEAT takes
+        a one-off's place at once, and from its second on it is in steady contact and stays.
+        Sixteen sources in steady contact keep their places, as a router keeps live routes.
+        """
         if self.endpoint.kind != "udpin":
             return []
         gone = [
@@ -301,16 +333,56 @@ class UdpSocket(_Socketed):
             for addr, link in self.links.items()
             if link.closed or link.heard_ns is None or now_ns - link.heard_ns > UDP_PEER_TIMEOUT_NS
         ]
-        return [self.links.pop(addr) for addr in gone]
+        out = [self.links.pop(addr) for addr in gone]
+        excess = len(self.links) - MAX_UDP_PEERS
+        if excess > 0:
+            order = sorted(self.links, key=lambda addr: _standing(self.links[addr], now_ns))
+            for addr in order[:excess]:
+                link = self.links.pop(addr)
+                self._remember(addr, link)
+                out.append(link)
+            self.peers_refused += excess
+        return out
+
+    def _remember(self, addr: tuple[str, int], link: Link) -> None:
+        if link.heard_ns is None or link.live_since_ns is None:
+            return
+        self._recent[addr] = (link.heard_ns, link.live_since_ns)
+        self._recent.move_to_end(addr)
+        while len(self._recent) > _RECENT_UDP_PEERS:
+            self._recent.popitem(last=False)
+
+
+def _standing(link: Link, now_ns: int) -> tuple[int, int]:
+    """Order in which ``udpin`` peers lose their place (the smallest first)."""
+    heard = link.heard_ns or 0
+    since = link.live_since_ns or heard
+    if now_ns - heard > UDP_PEER_LIVE_NS:
+        return (0, heard)
+    if heard - since < UDP_PEER_STEADY_NS:
+        return (1, heard)
+    return (2, -since)
 
 
 def _open(endpoint: Endpoint, kind: int) -> socket.socket:
     sock = socket.socket(socket.AF_INET, kind)
-    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    if kind == socket.SOCK_STREAM:
+        # TCP: only lets us listen again while old connections linger in TIME_WAIT.
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    elif sys.platform == "win32":  # pragma: no cover - Windows only
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_EXCLUSIVEADDRUSE, 1)  # type: ignore[attr-defined]
+    # UDP: no SO_REUSEADDR nor SO_REUSEPORT, so no other socket can bind our port and take
+    # the datagrams ground stations send us.
     try:
         sock.bind((endpoint.host, endpoint.port))
     except OSError as exc:
         sock.close()
+        if exc.errno == errno.EADDRINUSE:
+            raise LinkError(
+                f"{endpoint}: cannot listen: port {endpoint.port} is in use by another program"
+                f" (another uavtool sitl?); stop it, or choose another port"
+                f" (e.g. {endpoint.kind}:{endpoint.host}:{endpoint.port + 1}, or --instance 1)"
+            ) from None
         raise LinkError(f"{endpoint}: cannot listen: {exc.strerror or exc}") from None
     sock.setblocking(False)
     return sock

@@ -285,7 +285,7 @@ class Sitl:
                 self._sockets.remove(sock)
                 self._forget(sock.link)
             elif isinstance(sock, UdpSocket):
-                for link in sock.expire(self.now_ns):
+                for link in sock.expire(time.monotonic_ns()):
                     link.closed = True
                     self._forget(link)
 
@@ -306,6 +306,12 @@ class Sitl:
             if wait < -_MAX_LAG_S and self.speedup < 100:
                 self._pacing_reset = True  # we were starved; don't burst to catch up
             self.poll(wait)
+            # Serve what arrives until the next step is due: incoming traffic must not make
+            # sim time run ahead of the speed-up (a ground station's stream did, a flood 5x).
+            while not self._pacing_reset and (wait := due - time.perf_counter()) > 0:
+                if self._stop.is_set():
+                    return
+                self.poll(wait)
 
     def start(self) -> Sitl:
         """Run in a daemon thread; returns self."""
