@@ -16,6 +16,7 @@ from uavtool.mavlink import new_encoder
 from uavtool.sitl import Sitl, SitlConfig, links
 from uavtool.sitl.links import MAX_UDP_PEERS, UdpSocket
 from uavtool.sitl.server import MAX_LINK_FAULTS
+from uavtool.sitl.signing import SIGNING_EPOCH_UNIX_US, SigningStreams
 
 KEY = bytes(range(32))
 ARM = M.MAV_CMD_COMPONENT_ARM_DISARM
@@ -193,3 +194,35 @@ def test_a_message_that_does_not_fit_is_not_sent_and_the_link_goes_on(
     session.send(M.MAVLink_gimbal_manager_status_message(0, 0, 1, 300, 1, 0, 0))
     assert session.link.unsendable == 1
     assert client.command(M.MAV_CMD_GET_HOME_POSITION).result == M.MAV_RESULT_ACCEPTED
+
+
+def test_a_signed_ground_station_connecting_late_at_speedup_10_is_answered() -> None:
+    # Sim time runs 10x: after 8 s of wall time the vehicle's simulated clock is 72 s ahead
+    # of the ground station's, more than the minute a new stream may lag.
+    config = SitlConfig(endpoints=("tcpin:127.0.0.1:0",), speedup=10, signing_key=KEY)
+    with Sitl(config) as sitl:
+        t0 = time.monotonic()
+        while sitl.now_ns < 80 * 10**9:
+            time.sleep(0.1)
+            assert time.monotonic() - t0 < 30, "the vehicle does not run"
+        gcs = Client.tcp(sitl.ports[0], signing_key=KEY)
+        gcs.wait_for("HEARTBEAT")
+        assert gcs.command(ARM, 1).result == M.MAV_RESULT_ACCEPTED
+        gcs.close()
+        assert sitl.autopilot.armed
+
+
+def test_the_signing_time_never_goes_backwards_when_the_clock_does() -> None:
+    now_us = [1_800_000_000 * 10**6]  # a wall clock the test can set back, as NTP can
+    streams = SigningStreams(KEY, unix_us=lambda: now_us[0])
+
+    def signed_at(unix_s: float, link_id: int) -> bytes:
+        enc = new_encoder(sysid=255, compid=190, signing_key=KEY, link_id=link_id)
+        enc.signing.timestamp = int((unix_s - SIGNING_EPOCH_UNIX_US / 1e6) * 100_000)
+        return bytes(M.MAVLink_heartbeat_message(6, 8, 0, 0, 0, 3).pack(enc))
+
+    captured = signed_at(1_800_000_000 - 120, link_id=1)  # two minutes old
+    assert not streams.verify(captured)
+    now_us[0] -= 3600 * 10**6  # the machine's clock steps back an hour
+    assert not streams.verify(captured)  # still two minutes older than the vehicle's time
+    assert streams.verify(signed_at(1_800_000_000 - 30, link_id=2))  # within the minute

@@ -86,10 +86,7 @@ class Sitl:
         self.signing = (
             None
             if config.signing_key is None
-            else SigningStreams(
-                config.signing_key,
-                unix_us=lambda: self.telemetry.start_unix_us + self.now_ns // 1000,
-            )
+            else SigningStreams(config.signing_key, unix_us=lambda: time.time_ns() // 1000)
         )
         self.sessions: list[GcsSession] = []
         self.faults = 0  # unexpected errors while serving peers, all links together

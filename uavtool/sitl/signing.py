@@ -34,8 +34,10 @@ StreamKey = tuple[int, int, int]  # (system id, component id, link id)
 class SigningStreams:
     """The signing key and every stream's newest verified timestamp, for one vehicle.
 
-    ``unix_us`` reads the vehicle's clock (its simulated wall time), so that a lockstep
-    flight's decisions do not depend on the machine's clock.
+    ``unix_us`` reads the real time (µs since 1970), as ArduPilot's signing time follows
+    GPS time: never the simulation's clock, which runs ahead of ground stations' clocks at
+    a speed-up above 1 and would refuse every new stream after a minute's lead. The time
+    never goes backwards, even when ``unix_us`` does.
     """
 
     def __init__(self, key: bytes, *, unix_us: Callable[[], int]) -> None:
@@ -48,7 +50,8 @@ class SigningStreams:
     def now(self) -> int:
         """The newest time the vehicle knows: its clock, or a verified timestamp ahead of it."""
         clock = (self._unix_us() - SIGNING_EPOCH_UNIX_US) // 10
-        return max(self._newest, clock)
+        self._newest = max(self._newest, clock)
+        return self._newest
 
     def verify(self, raw: bytes) -> bool:
         """True if ``raw`` (one whole MAVLink frame) is signed with our key and is no replay."""
