@@ -15,6 +15,7 @@ from uavtool.errors import ParamError
 from uavtool.geo import GeoPoint, enu_from_geo
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mission import Arm, GoTo, SetGimbal, SetMode, Takeoff
+from uavtool.mission.base import Envelope
 from uavtool.runner.params import set_vehicle_params
 from uavtool.runner.preflight import PreflightError, check_fence, check_gimbal, param_reader
 
@@ -136,15 +137,18 @@ def test_the_fence_is_px4s_geofence(
     assert (fence.alt_param, fence.radius_param) == ("GF_MAX_VER_DIST", "GF_MAX_HOR_DIST")
 
 
+_ENVELOPE = Envelope(altitude_m=65.3, distance_m=57.0)
+
+
 def test_preflight_stops_at_px4s_geofence_with_its_parameter_named() -> None:
     fake = FakePX4({}, params={"GF_ACTION": 2, "GF_MAX_VER_DIST": 50, "GF_MAX_HOR_DIST": 0})
     with pytest.raises(PreflightError, match=r"GF_MAX_VER_DIST=50 m .* set GF_MAX_VER_DIST=71"):
-        check_fence(link_to(fake), PX4(), 65.3, 57.0)
+        check_fence(link_to(fake), PX4(), _ENVELOPE)
     fake = FakePX4({}, params={"GF_ACTION": 2, "GF_MAX_VER_DIST": 0, "GF_MAX_HOR_DIST": 40})
     with pytest.raises(PreflightError, match=r"GF_MAX_HOR_DIST=40 m from home"):
-        check_fence(link_to(fake), PX4(), 65.3, 57.0)
+        check_fence(link_to(fake), PX4(), _ENVELOPE)
     fake = FakePX4({}, params={"GF_ACTION": 2, "GF_MAX_VER_DIST": 120, "GF_MAX_HOR_DIST": 200})
-    check_fence(link_to(fake), PX4(), 65.3, 57.0)  # room enough: passes
+    check_fence(link_to(fake), PX4(), _ENVELOPE)  # room enough: passes
 
 
 def test_offboard_streams_setpoints_then_asks_for_offboard() -> None:

@@ -26,11 +26,12 @@ from uavtool.mission import (
     GoTo,
     LinkLost,
     LinkRestored,
-    Mission,
+    MissionInputs,
     Observation,
     Outcome,
     Output,
     Params,
+    SearchMission,
     SetMode,
     TakePhoto,
 )
@@ -183,7 +184,7 @@ class _Link:
 
 
 def run(
-    mission: Mission,
+    mission: SearchMission,
     fake: FakeVehicle,
     *,
     script: tuple[Inject, ...] = (),
@@ -249,7 +250,7 @@ def target_rgb(scene: Scene, intrinsics: Intrinsics = INTRINSICS) -> U8Array:
 class Flown:
     """A finished run: the mission, its target picture, the vehicle and what was flown."""
 
-    mission: Mission
+    mission: SearchMission
     target_rgb: U8Array
     fake: FakeVehicle
     flight: Flight
@@ -271,7 +272,7 @@ def fly(
     """A fresh mission looking for ``target_scene``'s (default ``scene``'s) target, flown on
     a fresh vehicle in ``scene`` (``vehicle``: :class:`FakeVehicle` options)."""
     target = target_rgb(target_scene or scene)
-    mission = Mission(params or Params(), target)
+    mission = SearchMission(params or Params(), MissionInputs(target))
     fake = FakeVehicle(scene, **vehicle)
     return Flown(mission, target, fake, run(mission, fake, script=script, max_steps=max_steps))
 

@@ -29,13 +29,14 @@ from uavtool.mission import (
     GoTo,
     LinkLost,
     LinkRestored,
-    Mission,
     MissionInputError,
+    MissionInputs,
     MissionStateError,
     ModelBuilt,
     Params,
     Photo,
     Plan,
+    SearchMission,
     SetMode,
     Status,
     Takeoff,
@@ -311,7 +312,7 @@ def test_stepping_after_an_abort_raises(paper: Scene) -> None:
 
 
 def test_stepping_before_start_raises(paper: Scene) -> None:
-    mission = Mission(Params(), target_rgb(paper))
+    mission = SearchMission(Params(), MissionInputs(target_rgb(paper)))
     telemetry = Telemetry(
         100, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.0, "STABILIZE", False, True, 0.0, 0.0, 100
     )
@@ -322,4 +323,4 @@ def test_stepping_before_start_raises(paper: Scene) -> None:
 def test_target_without_a_shape_is_an_input_error() -> None:
     grey = np.full((480, 640, 3), 128, dtype=np.uint8)
     with pytest.raises(MissionInputError, match="target image"):
-        Mission(Params(), grey)
+        SearchMission(Params(), MissionInputs(grey))

@@ -5,13 +5,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from uavtool.mission import Mission, Params
+from uavtool.mission import MissionInputs, Params, SearchMission
 
 
-def _mission() -> Mission:
+def _mission() -> SearchMission:
     target = np.full((120, 160, 3), 128, np.uint8)
     target[40:80, 50:110] = (210, 40, 40)
-    return Mission(Params(), target)
+    return SearchMission(Params(), MissionInputs(target))
 
 
 def test_floor_over_tiers_and_unknown_roofs() -> None:

@@ -19,12 +19,13 @@ from uavtool.mission import (
     CommandResult,
     LinkLost,
     LinkRestored,
-    Mission,
     MissionInputError,
+    MissionInputs,
     Observation,
     Output,
     Photo,
     Plan,
+    SearchMission,
     Telemetry,
 )
 from uavtool.mission.codec import decode_observation, encode_observation, encode_output
@@ -80,7 +81,8 @@ def test_replaying_the_observations_reproduces_every_output(
     flown one said (no hidden state shared between missions, nothing but observations read)."""
     flown: Flown = request.getfixturevalue(flight_name)
     params = flown.mission.params
-    first, second = Mission(params, flown.target_rgb), Mission(params, flown.target_rgb)
+    inputs = MissionInputs(flown.target_rgb)
+    first, second = SearchMission(params, inputs), SearchMission(params, inputs)
     out1, out2 = first.start(), second.start()
     for obs in flown.flight.observations:
         decoded = _through_json(obs)
@@ -94,7 +96,7 @@ def test_replaying_the_observations_reproduces_every_output(
 
 def test_a_replay_that_stops_early_is_a_prefix(troubled_flight: Flown) -> None:
     flown = troubled_flight
-    mission = Mission(flown.mission.params, flown.target_rgb)
+    mission = SearchMission(flown.mission.params, MissionInputs(flown.target_rgb))
     outputs = mission.start()
     half = len(flown.flight.observations) // 2
     for obs in flown.flight.observations[:half]:

@@ -117,4 +117,6 @@ def test_refly_refuses_a_camera_size_before_allocating_it(tmp_path: Path) -> Non
     crafted = _crafted(tmp_path / "big.mcap", flight={"size_px": "[20000, 20000]"})
     result = CliRunner().invoke(cli, ["replay", "--refly", str(crafted)])
     assert result.exit_code == 2, result.output
-    assert "size_px 20000x20000 is outside 16..8192 pixels a side" in result.output
+    assert "flight.size_px is malformed: 20000x20000 is outside 16..8192 pixels a side" in (
+        result.output
+    )

@@ -92,7 +92,7 @@ def test_other_tool_version_with_same_behaviour_passes(
     old = tmp_path / "old.mcap"
     flight = load_flight(PAPER)
     result = replay(flight)
-    write_replay(PAPER, old, result.outputs, result.glbs, flight.params, outcome=result.outcome)
+    write_replay(PAPER, old, result.outputs, result.blobs, flight.params, outcome=result.outcome)
     assert load_flight(old).tool_version == "0.0.1-older"
     code, out = run("replay", "--check", "-q", str(old))
     assert code == 0, out

@@ -11,10 +11,11 @@ from click.testing import CliRunner
 
 from uavtool.cli import cli
 from uavtool.geo import geo_from_enu
-from uavtool.mission import Params, Status
+from uavtool.mission import Params, SearchMission, Status
 from uavtool.mission.params import with_overrides
 from uavtool.mission.scenario import NO_GIMBAL_REASON
-from uavtool.runner.fly import FlyConfig, flight_metadata, fly
+from uavtool.plugins import ref_of
+from uavtool.runner.fly import FlyConfig, describe, fly
 from uavtool.runner.placement import place_scene
 from uavtool.runner.preflight import PreflightError
 from uavtool.runner.summary import format_summary
@@ -126,9 +127,12 @@ def test_scene_origin_scene_refuses_a_far_vehicle_with_the_home_to_use() -> None
 def test_the_metadata_says_which_origin() -> None:
     scene = load_scene("paper")
     origin = {
-        (connect, where): flight_metadata(FlyConfig(connect=connect, scene_origin=where), scene)[
-            "vehicle"
-        ]["scene_origin"]
+        (connect, where): describe(
+            FlyConfig(connect=connect, scene_origin=where, params=Params()),
+            scene,
+            ref_of(SearchMission),
+            has_target=True,
+        ).to_metadata()["vehicle"]["scene_origin"]
         for connect in (None, "tcp:127.0.0.1:5760")
         for where in ("vehicle", "scene")
     }

@@ -19,6 +19,7 @@ from uavtool.errors import UavtoolError
 # (module, attribute) of every top-level command, in the order `--help` lists them.
 _COMMANDS: tuple[tuple[str, str], ...] = (
     ("uavtool.cli.fly", "fly"),
+    ("uavtool.cli.missions", "missions"),
     ("uavtool.cli.replay", "replay"),
     ("uavtool.cli.record", "record"),
     ("uavtool.cli.sitl", "sitl"),

@@ -1,4 +1,5 @@
-"""``uavtool fly``: fly the search-and-analyze mission and record it."""
+"""``uavtool fly``: fly a mission (the built-in search-and-analyze one by default) and record
+it."""
 
 from __future__ import annotations
 
@@ -62,7 +63,19 @@ _OUTAGE = Numbers(":", (("START", NON_NEGATIVE), ("DURATION", POSITIVE)), exampl
 )
 @click.option("--no-record", is_flag=True, help="Do not write a recording.")
 @click.option(
-    "--visit-all", is_flag=True, help="Visit every point of interest, even after a match."
+    "--mission",
+    "mission",
+    default="search",
+    show_default=True,
+    metavar="NAME|module:Class",
+    help="The mission to fly: a registered name (`uavtool missions` lists them) or a "
+    "FlightMission subclass as module:Class.",
+)
+@click.option(
+    "--visit-all",
+    is_flag=True,
+    help="Visit every point of interest, even after a match (the search mission's "
+    "mission.visit_all).",
 )
 @click.option(
     "--param",
@@ -74,10 +87,12 @@ _OUTAGE = Numbers(":", (("START", NON_NEGATIVE), ("DURATION", POSITIVE)), exampl
 )
 @click.option(
     "--set",
+    "--mission-param",
     "settings",
     multiple=True,
     metavar="KEY=VALUE",
-    help="Set a mission parameter (e.g. mission.look_fill=0.6, vectorize.rdp_epsilon_px=2).",
+    help="Set a parameter of the mission (e.g. mission.look_fill=0.6 for the search; "
+    "`uavtool missions NAME` lists a mission's).",
 )
 @click.option("--seed", default=0, show_default=True, type=SEED, help="SITL wind/noise seed.")
 @click.option("--noise", is_flag=True, help="Add seeded sensor noise to simulated photos.")
@@ -134,6 +149,7 @@ def fly(
     speedup: str | None,
     record: Path | None,
     no_record: bool,
+    mission: str,
     visit_all: bool,
     vehicle_params: tuple[str, ...],
     settings: tuple[str, ...],
@@ -147,12 +163,14 @@ def fly(
     scene_origin: str,
     quiet: bool,
 ) -> None:
-    """Search the scene for the target building, photograph it from three sides and build
-    its 3D model; record everything to one MCAP file.
+    """Fly a mission and record everything to one MCAP file: by default the search mission,
+    which finds the target building in the scene, photographs it from three sides and builds
+    its 3D model.
 
     \b
-    Exit codes: 0 completed (target found, model built), 3 partial (target found, no
-    model), 4 no match, 5 crashed, 1 aborted / pilot takeover / link lost, 2 bad input.
+    Exit codes: 0 completed (search: target found, model built), 3 partial (search: target
+    found, no model), 4 no match, 5 crashed, 1 aborted / pilot takeover / link lost or the
+    mission's code failed, 2 bad input.
 
     \b
     Examples:
@@ -161,8 +179,10 @@ def fly(
       uavtool fly --connect tcp:127.0.0.1:5760     # ArduPilot SITL (sim_vehicle.py)
       uavtool fly --connect tcp:127.0.0.1:5760 --no-gimbal   # a camera fixed down
       uavtool fly --connect udpin:0.0.0.0:14540    # PX4 SITL (its API link)
+      uavtool fly --mission orbit --set orbit.step_deg=30   # another mission
     """
-    from uavtool.mission.params import Params, parse_settings, with_overrides
+    from uavtool.mission.params import parse_settings, valid_keys, with_overrides
+    from uavtool.plugins import resolve
     from uavtool.runner.fly import FlyConfig
     from uavtool.runner.fly import fly as fly_mission
     from uavtool.runner.params import parse_param
@@ -170,11 +190,15 @@ def fly(
 
     if record is not None and no_record:
         raise click.UsageError("--record and --no-record exclude each other")
+    mission_cls, _ = resolve(mission)
     overrides = parse_settings(settings)
     if visit_all:
+        if "mission.visit_all" not in valid_keys(mission_cls.params_type):
+            raise InputError(f"--visit-all: the mission {mission!r} has no mission.visit_all")
         overrides["mission.visit_all"] = "true"
-    params = with_overrides(Params(), overrides)
+    params = with_overrides(mission_cls.params_type(), overrides)
     config = FlyConfig(
+        mission=mission,
         connect=connect,
         scene=scene,
         target=target,

@@ -59,6 +59,13 @@ from uavtool.errors import FailureError, InputError
     "metadata alone, and compare the new recording with it message by message (exit 1 at the "
     "first difference). --out keeps the new recording.",
 )
+@click.option(
+    "--mission",
+    default=None,
+    metavar="module:Class",
+    help="The mission's class, when the one RECORDING names is not registered here (a "
+    "recording never makes uavtool import code by itself).",
+)
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar.")
 @click.option(
     "--scheduler",
@@ -77,6 +84,7 @@ def replay(
     target: Path | None,
     update_golden: bool,
     refly: bool,
+    mission: str | None,
     quiet: bool,
     scheduler: str | None,
     workers: int | None,
@@ -96,8 +104,8 @@ def replay(
     from uavtool.cli.replay_batch import is_batch, replay_batch
 
     if is_batch(recording):  # a folder or a glob: many recordings on Dask, one table
-        if refly or update_golden:
-            raise click.UsageError("--refly and --update-golden take one recording")
+        if refly or update_golden or mission:
+            raise click.UsageError("--refly, --update-golden and --mission take one recording")
         replay_batch(
             recording,
             check=check,
@@ -131,9 +139,10 @@ def replay(
     if refly:
         if settings or params_file or vision_only or update_golden or check:
             raise click.UsageError(
-                "--refly flies the recorded configuration as it is: it takes only --out"
+                "--refly flies the recorded configuration as it is: it takes only --out "
+                "(and --mission)"
             )
-        _refly(recording, out)
+        _refly(recording, out, mission)
         return
     if update_golden:
         from uavtool.replay.golden import update_golden as update
@@ -146,7 +155,7 @@ def replay(
         return
     if out is not None:
         refuse_same_file(out, [recording])  # now, not after the whole replay
-    flight = load_flight(recording)
+    flight = load_flight(recording, mission=mission)
     overrides: dict[str, object] = {}
     if params_file is not None:
         overrides.update(_params_file(params_file))
@@ -195,7 +204,7 @@ def replay(
             click.echo("mission stopped there; per-frame vision continues on every recorded frame")
         if out is not None:
             write_replay(
-                recording, out, result.outputs, result.glbs, params, outcome=result.outcome
+                recording, out, result.outputs, result.blobs, params, outcome=result.outcome
             )
             click.echo(f"wrote {out}")
     if changed or vision_only:
@@ -206,10 +215,10 @@ def replay(
         sys.exit(1)
 
 
-def _refly(recording: Path, out: Path | None) -> None:
+def _refly(recording: Path, out: Path | None, mission: str | None) -> None:
     from uavtool.replay.refly import refly
 
-    result = refly(recording, out=out)
+    result = refly(recording, out=out, mission=mission)
     s = result.summary
     click.echo(
         f"{recording}: flown again in lockstep, {s.vehicle_time_s:.1f} s of vehicle time in "

@@ -1,9 +1,14 @@
-"""The search-and-analyze mission (paper section V): a pure state machine from observations
-to outputs, with its parameters. No clock, socket or unseeded random inside; the runner
-(``uavtool.runner``) connects it to a vehicle and a camera, and replay to a recording."""
+"""Missions: pure state machines from observations to outputs, with their parameters. No
+clock, socket or unseeded random inside; the runner (``uavtool.runner``) connects one to a
+vehicle and a camera, and replay to a recording.
 
+:class:`FlightMission` is the base every mission builds on (the public API is
+:mod:`uavtool.api`); :class:`SearchMission` is the built-in search-and-analyze mission
+(paper section V)."""
+
+from uavtool.mission.base import FlightMission, MissionEnd, MissionInputs, Wait
 from uavtool.mission.errors import MissionInputError, MissionStateError
-from uavtool.mission.mission import Mission
+from uavtool.mission.mission import SearchMission
 from uavtool.mission.observations import (
     CommandResult,
     LinkLost,
@@ -22,9 +27,11 @@ from uavtool.mission.outputs import (
     ModelBuilt,
     Outcome,
     Output,
+    Picture,
     Plan,
     PointOfInterest,
     Recognition,
+    Result,
     SetGimbal,
     SetMode,
     Shapes,
@@ -33,7 +40,7 @@ from uavtool.mission.outputs import (
     TakePhoto,
     Viewpoints,
 )
-from uavtool.mission.params import MissionParams, Params
+from uavtool.mission.params import FlightParams, MissionParams, Params
 
 __all__ = [
     "Arm",
@@ -41,12 +48,15 @@ __all__ = [
     "CommandResult",
     "DiagonalView",
     "Event",
+    "FlightMission",
+    "FlightParams",
     "GoTo",
     "Level",
     "LinkLost",
     "LinkRestored",
-    "Mission",
+    "MissionEnd",
     "MissionInputError",
+    "MissionInputs",
     "MissionParams",
     "MissionStateError",
     "ModelBuilt",
@@ -55,9 +65,12 @@ __all__ = [
     "Output",
     "Params",
     "Photo",
+    "Picture",
     "Plan",
     "PointOfInterest",
     "Recognition",
+    "Result",
+    "SearchMission",
     "SetGimbal",
     "SetMode",
     "Shapes",
@@ -66,4 +79,5 @@ __all__ = [
     "Takeoff",
     "Telemetry",
     "Viewpoints",
+    "Wait",
 ]

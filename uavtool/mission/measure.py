@@ -38,7 +38,8 @@ from uavtool.vision import Shape
 from uavtool.vision.vectorize import non_ground
 
 if TYPE_CHECKING:
-    from uavtool.mission.mission import Mission, Wait
+    from uavtool.mission.base import Wait
+    from uavtool.mission.mission import SearchMission
 
 _AGREE = 0.25
 """How far apart the two photos may place one roof (at its height, as a share of the roof's
@@ -46,7 +47,7 @@ size in the first photo) for their outlines to count as the same roof: a centroi
 with the roof's outline, a neighbour stands at least a safety margin away."""
 
 
-def measure_from_above(m: Mission, seen: Survey, order: tuple[int, ...]) -> Wait[Survey]:
+def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -> Wait[Survey]:
     """Photograph, from the overview's altitude, each point of interest (in ``order``) and
     then each obstacle whose roof is still unknown, measure every unknown roof against each
     photo, and return the survey with those roofs, footprints, points of interest and
@@ -142,7 +143,7 @@ def measure_from_above(m: Mission, seen: Survey, order: tuple[int, ...]) -> Wait
     )
 
 
-def _unclassified(m: Mission, seen: Survey) -> list[Shape]:
+def _unclassified(m: SearchMission, seen: Survey) -> list[Shape]:
     """The regions of the higher overview that are not ground and share no pixel with a
     building the vectorizer found (a coloured roof and its walls are one region)."""
     k = seen.photo.intrinsics
@@ -164,7 +165,7 @@ def _pixels(polygon_px: Any) -> Any:
 
 
 def measure_roof(
-    m: Mission,
+    m: SearchMission,
     shape: Shape,
     photo: Photo,
     other: Photo,

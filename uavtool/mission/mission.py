@@ -1,93 +1,53 @@
-"""The search-and-analyze mission (paper section V) as a pure state machine.
+"""The built-in mission (paper section V): search the area for the building in the target
+picture, then photograph it from above, the front and the right and build its 3D model.
 
-Observations go in (:meth:`Mission.step`), outputs come out: commands for the runner to
-execute and results to record. The mission never reads a clock (its time is the vehicle's
-``time_boot_ms``), a socket or a random generator, and never sees the scene's ground truth,
-so a replay that feeds it the recorded observations reproduces every output exactly.
-
-The scenario is written as one generator, read top to bottom in :meth:`Mission._fly`; each
-``yield`` waits for the next observation. What can go wrong anywhere — a command refused or
-unanswered, a move that never arrives, someone else changing the mode, the link going quiet —
-is handled once, in the waiting helpers, which end the flight by raising :class:`_End`.
+It is a :class:`~uavtool.mission.base.FlightMission` like any plug-in: the scenario's steps
+(:mod:`uavtool.mission.scenario` and the modules it calls) use the base's helpers, and this
+class adds what the search knows about the space it flies in — which roofs are measured,
+which are not — so that no way crosses near a roof lower than the altitude that clears it.
 """
 
 from __future__ import annotations
 
-import contextlib
 import math
-from collections.abc import Callable, Generator
-from typing import TypeVar
+from typing import Any, ClassVar
 
-from uavtool.geo import wrap_180
+from uavtool.camera import Intrinsics
 from uavtool.mission.analysis import target_shapes
-from uavtool.mission.errors import MissionStateError
-from uavtool.mission.observations import (
-    CommandResult,
-    LinkLost,
-    LinkRestored,
-    Observation,
-    Photo,
-    Telemetry,
-    U8Array,
-)
+from uavtool.mission.base import Envelope, FlightMission, MissionInputs, Wait
+from uavtool.mission.errors import MissionInputError
 from uavtool.mission.outputs import (
-    Arm,
-    Command,
-    Event,
-    GoTo,
     Level,
     ModelBuilt,
     Outcome,
     Output,
     Plan,
-    SetGimbal,
-    SetMode,
     Shapes,
     Status,
-    Takeoff,
-    TakePhoto,
     Vec3,
     Viewpoints,
 )
-from uavtool.mission.params import MissionParams, Params
+from uavtool.mission.params import Params
 from uavtool.nav.geometry import point_polygon_distance, segment_polygon_distance
 
-T = TypeVar("T")
-Wait = Generator[None, Observation, T]
-"""A step that waits for observations and finally returns a ``T``."""
 
-NADIR_DEG = -90.0
-HORIZONTAL_DEG = 0.0
-
-
-class _End(Exception):  # noqa: N818 - control flow inside the generator, never escapes
-    def __init__(self, status: Status, reason: str) -> None:
-        super().__init__(reason)
-        self.status = status
-        self.reason = reason
-
-
-_HOME_HEIGHT_TOLERANCE_M = 2.0
-"""How far from home's height a vehicle that landed and disarmed after RTL may report itself:
-more than an altimeter drifts in a flight, less than a storey (a roof is no landing)."""
-_FLIES_HOME = frozenset({Status.COMPLETED, Status.PARTIAL, Status.NO_MATCH})
-"""Outcomes after which the mission still flies the way home itself before RTL."""
-
-
-class Mission:
-    """One flight of the mission. Call :meth:`start` once, then :meth:`step` with each
-    observation until :attr:`outcome` is set.
-
-    ``target_rgb`` : (H, W, 3) uint8 — the target building photographed from above; its
-    largest shape is what the mission looks for.
-    Raises :class:`MissionInputError` if the target image holds no shape.
+class SearchMission(FlightMission):
+    """One flight of the built-in mission. ``inputs.target_rgb`` is the target building
+    photographed from above; its largest shape is what the mission looks for.
+    Raises :class:`MissionInputError` if there is no target picture or it holds no shape.
     """
 
-    def __init__(self, params: Params, target_rgb: U8Array) -> None:
-        self.params = params
-        self.target_shapes, self.target = target_shapes(params, target_rgb)
-        self.outcome: Outcome | None = None
-        self.last: Telemetry | None = None
+    name: ClassVar[str] = "search"
+    params_type: ClassVar[type[Any]] = Params
+    needs_target: ClassVar[bool] = True
+    flight_group: ClassVar[str] = "mission"
+
+    def __init__(self, params: Params, inputs: MissionInputs) -> None:
+        super().__init__(params, inputs)
+        self.params: Params = params
+        if inputs.target_rgb is None:
+            raise MissionInputError("the search mission needs a target picture")
+        self.target_shapes, self.target = target_shapes(params, inputs.target_rgb)
         self.visited: list[int] = []
         self.matched_poi = -1
         self.match_score = 0.0
@@ -104,282 +64,55 @@ class Mission:
         """Every measured roof: (footprint, height above home)."""
         self.viewpoints: Viewpoints | None = None
         self.model: ModelBuilt | None = None
-        self._out: list[Output] = []
-        self._next_id = 0
         self._frames_seen = 0
-        self._expected_modes: frozenset[str] = frozenset()
-        self._link_was_lost = False
-        self._airborne = False  # from take-off until landed: disarming in the air is a crash
-        self._landing = False  # RTL or LAND sent: a disarm on the ground at home is the landing
         self.no_model = "unknown"
         """Why no model was built (for a PARTIAL outcome)."""
-        self._deferred: list[Observation] = []
-        self._gen = self._run()
-        self._started = False
 
-    # --- the outside: observations in, outputs out --------------------------------------------
+    # --- the mission's part of the base's contract ---------------------------------------------
 
-    def start(self) -> list[Output]:
-        """The outputs before the first observation (the target's shapes)."""
-        if self._started:
-            raise MissionStateError("the mission was already started")
-        self._started = True
-        self.emit(Shapes(-1, "target", self.target_shapes))
-        next(self._gen)
-        return self._take()
+    def first_outputs(self) -> list[Output]:
+        return [Shapes(-1, "target", self.target_shapes)]
 
-    def step(self, observation: Observation) -> list[Output]:
-        """Feed one observation; returns what the mission does about it (may be empty)."""
-        if not self._started:
-            raise MissionStateError("call start() before step()")
-        if self.outcome is not None:
-            raise MissionStateError("the mission has ended")
-        with contextlib.suppress(StopIteration):  # the flight's generator has finished
-            self._gen.send(observation)
-        return self._take()
-
-    @property
-    def done(self) -> bool:
-        return self.outcome is not None
-
-    def _take(self) -> list[Output]:
-        out, self._out = self._out, []
-        return out
-
-    def emit(self, output: Output) -> None:
-        """Add an output to those the current step returns (the scenario's steps use this)."""
-        self._out.append(output)
-
-    def event(self, level: Level, text: str) -> None:
-        self.emit(Event(level, text))
-
-    def _new_id(self) -> int:
-        self._next_id += 1
-        return self._next_id
-
-    # --- the flight, and how it ends ----------------------------------------------------------
-
-    def _run(self) -> Wait[None]:
+    def fly(self) -> Wait[str]:
         from uavtool.mission.scenario import fly  # noqa: PLC0415 - the scenario uses this module
 
-        try:
-            yield from fly(self)
-            end = (
-                _End(Status.COMPLETED, "model built")
-                if self.model_built
-                else _End(Status.PARTIAL, f"target found; model not built: {self.no_model}")
-            )
-        except _End as exc:
-            end = exc
-        self.event(
-            Level.INFO if end.status is Status.COMPLETED else Level.WARNING,
-            f"mission ends: {end.status.value}: {end.reason}",
-        )
-        try:
-            yield from self._finish(end.status)
-        except _End as exc:
-            self.event(Level.ERROR, f"while finishing: {exc.reason}")
-            # A crash is a crash whatever was achieved before; a flight that did its work but
-            # could not come home and land is not 'completed' (nor 'partial', nor 'no-match').
-            if exc.status is Status.CRASHED or end.status in _FLIES_HOME:
-                end = _End(exc.status, f"{exc.reason}, after '{end.status.value}: {end.reason}'")
-                self.event(Level.ERROR, f"mission ends: {end.status.value}: {end.reason}")
-        self.outcome = Outcome(
-            end.status,
-            end.reason,
+        yield from fly(self)
+        if not self.model_built:
+            raise self.end(Status.PARTIAL, f"target found; model not built: {self.no_model}")
+        return "model built"
+
+    def go_home(self) -> Wait[None]:
+        if self.transit_m is not None:
+            # The vehicle's RTL flies straight home at its own altitude: go home over every
+            # known roof first.
+            home = (0.0, 0.0, self.transit_m)
+            yield from self.travel(home, None, self.transit_m, "home")
+
+    def outcome_for(self, status: Status, reason: str) -> Outcome:
+        return Outcome(
+            status,
+            reason,
             tuple(self.visited),
             self.matched_poi,
             self.match_score,
             self.model_built,
         )
-        self.emit(self.outcome)
 
-    def _finish(self, status: Status) -> Wait[None]:
-        """Bring the vehicle home (or watch someone else do it) until it has landed.
+    @classmethod
+    def envelope(cls, params: Any, intrinsics: Intrinsics) -> Envelope:
+        from uavtool.mission.survey import overview_ceiling_m  # noqa: PLC0415
 
-        Until then a disarm in the air, or anywhere but on the ground at home, is a crash
-        (raised as CRASHED). A vehicle still on the ground lands where it is: RTL would climb.
-        A way home over the known roofs that cannot be flown leaves it to the vehicle's RTL,
-        and then ends ABORTED with its reason; so does a vehicle that never lands.
-        """
-        if status in (Status.LINK_LOST, Status.CRASHED) or self.last is None:
-            return
-        landed = self._landed_and_disarmed
-        way_home: _End | None = None
-        if status is Status.TAKEOVER:
-            self._airborne = False  # the pilot lands where they choose
-            self._expected_modes = frozenset()
-            self.event(Level.INFO, "no more commands; watching until the vehicle lands")
-        elif self.last.landed and self.last.armed:
-            self._airborne = False
-            self.event(Level.INFO, "still on the ground: LAND to disarm (RTL would climb)")
-            yield from self.set_mode("LAND")
-        elif not landed(self.last):
-            if self.transit_m is not None and status in _FLIES_HOME:
-                # The vehicle's RTL flies straight home at its own altitude: go home over
-                # every known roof first.
-                home = (0.0, 0.0, self.transit_m)
-                try:
-                    yield from self.travel(home, None, self.transit_m, "home")
-                except _End as exc:
-                    if exc.status is not Status.ABORTED:
-                        raise
-                    self.event(Level.ERROR, f"the way home failed: {exc.reason}")
-                    way_home = exc
-            self.event(Level.INFO, "returning home (RTL)")
-            self._landing = True
-            yield from self.set_mode("RTL", also=("LAND",))
-        ok = yield from self.wait_until(landed, self.params.mission.land_timeout_s)
-        if not ok:
-            if status in _FLIES_HOME:  # its work done, it did not come back: not a success
-                raise _End(Status.ABORTED, "still flying when the mission stopped watching")
-            self.event(Level.WARNING, "still flying when the mission stopped watching")
-            return
-        self.event(Level.INFO, "landed and disarmed")
-        if way_home is not None:
-            raise _End(Status.ABORTED, f"the way home: {way_home.reason}; landed by RTL")
-
-    @staticmethod
-    def _landed_and_disarmed(t: Telemetry) -> bool:
-        return t.landed and not t.armed
-
-    def _landed_at_home(self, t: Telemetry) -> bool:
-        """A disarm that ends the landing the mission asked for: at home's height, not on a
-        roof nor in the air. (Not by the landed flag: on a lossy link the vehicle's landed
-        state can be older than the heartbeat that says it disarmed.)"""
-        return self._landing and abs(t.pos_enu_m[2]) <= _HOME_HEIGHT_TOLERANCE_M
-
-    # --- waiting: every observation passes through here ---------------------------------------
-
-    def observe(self) -> Wait[Observation]:
-        """The next observation, after the checks that apply everywhere."""
-        while True:
-            if self._deferred:
-                obs = self._deferred.pop(0)
-            else:
-                obs = yield
-            if isinstance(obs, LinkLost):
-                yield from self._wait_for_link(obs)
-                continue
-            if isinstance(obs, LinkRestored):
-                continue
-            if isinstance(obs, Telemetry):
-                self.last = obs
-                if self._airborne and not obs.armed and not self._landed_at_home(obs):
-                    raise _End(
-                        Status.CRASHED,
-                        f"the vehicle disarmed in the air at {obs.pos_enu_m[2]:.1f} m "
-                        "(its crash check: it hit something)",
-                    )
-                self._check_mode(obs)
-            return obs
-
-    def _wait_for_link(self, lost: LinkLost) -> Wait[None]:
-        self._link_was_lost = True
-        self.event(
-            Level.WARNING,
-            f"link lost ({lost.silent_s:.1f} s of silence): waiting; the vehicle's failsafe "
-            "is in charge",
+        return Envelope(
+            altitude_m=overview_ceiling_m(params.mission, intrinsics),
+            distance_m=float(params.mission.search_radius_m) * math.sqrt(2.0),
+            why_up="for its second overview",
+            why_out="the search square's corners are",
+            shrink_up="mission.search_radius_m or mission.assumed_roof_m",
+            shrink_out="mission.search_radius_m (side photos of a building at the edge fly "
+            "farther)",
         )
-        while True:
-            obs = yield
-            if isinstance(obs, LinkRestored):
-                self.event(Level.INFO, f"link restored after {obs.silent_s:.1f} s")
-                return
-            if isinstance(obs, LinkLost):
-                if obs.silent_s > self.params.mission.link_lost_abort_s:
-                    raise _End(Status.LINK_LOST, f"no link for {obs.silent_s:.0f} s")
-                continue
-            self._deferred.append(obs)  # e.g. a command result that arrived before the cut
 
-    def _check_mode(self, t: Telemetry) -> None:
-        # Down from the landing the mission asked for, the autopilot picks its own mode on the
-        # ground (PX4 switches to Hold): nobody took over.
-        touched_down = self._landing and t.landed
-        if not self._expected_modes or t.mode in self._expected_modes or touched_down:
-            self._link_was_lost = False  # the link came back and the vehicle kept its mode
-            return
-        who = "the vehicle's failsafe" if self._link_was_lost else "the pilot or a failsafe"
-        status = Status.LINK_LOST if self._link_was_lost else Status.TAKEOVER
-        raise _End(status, f"mode changed to {t.mode} by {who}")
-
-    def now_ms(self) -> int:
-        return self.last.time_boot_ms if self.last is not None else 0
-
-    def wait_until(self, done: Callable[[Telemetry], bool], timeout_s: float) -> Wait[bool]:
-        """Wait for telemetry that satisfies ``done``; False after ``timeout_s`` of vehicle time."""
-        start_ms = self.now_ms()
-        if self.last is not None and done(self.last):
-            return True
-        while True:
-            obs = yield from self.observe()
-            if isinstance(obs, Telemetry):
-                if done(obs):
-                    return True
-                if obs.time_boot_ms - start_ms > timeout_s * 1000.0:
-                    return False
-
-    def pause(self, duration_s: float) -> Wait[None]:
-        yield from self.wait_until(lambda _t: False, duration_s)
-
-    # --- commands -----------------------------------------------------------------------------
-
-    def command(
-        self,
-        make: Callable[[int], Command],
-        what: str,
-        *,
-        retries: int = -1,
-        done: Callable[[Telemetry], bool] | None = None,
-    ) -> Wait[None]:
-        """Issue a command until the vehicle accepts it, or the telemetry shows it ``done``
-        (its ACK lost on the link); abort (RTL) after the retries."""
-        attempts = 1 + (self.params.mission.command_retries if retries < 0 else retries)
-        detail = ""
-        for attempt in range(1, attempts + 1):
-            cmd = make(self._new_id())
-            self.emit(cmd)
-            result = yield from self._result(cmd.id)
-            if result.accepted or (done is not None and self.last is not None and done(self.last)):
-                return
-            detail = result.detail
-            self.event(Level.WARNING, f"{what}: {detail} (attempt {attempt} of {attempts})")
-            if attempt < attempts:
-                yield from self.pause(self.params.mission.retry_wait_s)
-        raise _End(Status.ABORTED, f"{what} failed {attempts} times: {detail}")
-
-    def _result(self, action_id: int) -> Wait[CommandResult]:
-        while True:
-            obs = yield from self.observe()
-            if isinstance(obs, CommandResult) and obs.action_id == action_id:
-                return obs
-
-    def set_mode(self, mode: str, *, also: tuple[str, ...] = ()) -> Wait[None]:
-        """Switch mode and wait until telemetry shows it; from then on any other mode (except
-        ``also``) means someone else took over."""
-        if self._expected_modes:  # the switch itself is not someone else's doing
-            self._expected_modes = self._expected_modes | {mode, *also}
-        yield from self.command(lambda i: SetMode(i, mode), f"mode {mode}")
-        ok = yield from self.wait_until(lambda t: t.mode == mode, self.params.mission.move_slack_s)
-        if not ok:
-            raise _End(Status.ABORTED, f"the vehicle accepted mode {mode} but never showed it")
-        self._expected_modes = frozenset((mode, *also))
-
-    def move(self, pos_enu_m: Vec3, heading_deg: float | None, what: str) -> Wait[None]:
-        """Fly to a position (and heading) and wait until there and still."""
-        p = self.params.mission
-        for attempt in range(1, p.command_retries + 2):
-            yield from self.command(lambda i: GoTo(i, pos_enu_m, heading_deg), what)
-            timeout_s = _move_time_s(self.last, pos_enu_m, p) + p.move_slack_s
-            arrived = yield from self.wait_until(
-                lambda t: self._arrived(t, pos_enu_m, heading_deg), timeout_s
-            )
-            if arrived:
-                return
-            self.event(
-                Level.WARNING, f"{what}: not reached in {timeout_s:.0f} s (attempt {attempt})"
-            )
-        raise _End(Status.ABORTED, f"{what}: position never reached")
+    # --- flying near roofs ---------------------------------------------------------------------
 
     def travel(
         self, pos_enu_m: Vec3, heading_deg: float | None, transit_m: float, what: str
@@ -437,98 +170,3 @@ class Mission:
         return any(
             segment_polygon_distance(a, there, fp) <= margin_m for fp in self.unknown.values()
         )
-
-    def _arrived(self, t: Telemetry, pos_enu_m: Vec3, heading_deg: float | None) -> bool:
-        p = self.params.mission
-        if _distance(t, pos_enu_m) > p.arrive_radius_m or t.speed_m_s > p.arrive_speed_m_s:
-            return False
-        return heading_deg is None or abs(wrap_180(t.heading_deg - heading_deg)) <= (
-            p.heading_tolerance_deg
-        )
-
-    def photo(self, tag: str, pitch_deg: float) -> Wait[Photo]:
-        """Point the gimbal (if needed), then take a photo and return it."""
-        p = self.params.mission
-        last = self.last
-        if not p.gimbal:
-            pass  # a camera fixed straight down: nothing to point
-        elif last is None or abs(last.gimbal_pitch_deg - pitch_deg) > p.gimbal_tolerance_deg:
-            yield from self.command(lambda i: SetGimbal(i, pitch_deg), f"gimbal to {pitch_deg:g}°")
-            ok = yield from self.wait_until(
-                lambda t: abs(t.gimbal_pitch_deg - pitch_deg) <= p.gimbal_tolerance_deg,
-                p.move_slack_s,
-            )
-            if not ok:
-                self.event(Level.WARNING, f"gimbal did not report {pitch_deg:g}°; photo anyway")
-        cmd = TakePhoto(self._new_id(), tag)
-        self.emit(cmd)
-        while True:
-            obs = yield from self.observe()
-            if isinstance(obs, Photo) and obs.action_id == cmd.id:
-                return obs
-            if isinstance(obs, CommandResult) and obs.action_id == cmd.id and not obs.accepted:
-                raise _End(Status.ABORTED, f"photo {tag!r}: {obs.detail}")
-
-    def end(self, status: Status, reason: str) -> _End:
-        """The exception that ends the flight (``raise mission.end(...)``)."""
-        return _End(status, reason)
-
-    def arm_and_take_off(self, alt_m: float) -> Wait[None]:
-        """GUIDED, arm (retrying while pre-arm checks fail) and climb to ``alt_m``."""
-        p = self.params.mission
-        self.event(Level.INFO, "arming in GUIDED")
-        yield from self.set_mode("GUIDED")
-        start_ms = self.now_ms()
-        refused = 0
-        while True:
-            cmd = Arm(self._new_id())
-            self.emit(cmd)
-            result = yield from self._result(cmd.id)
-            if result.accepted:
-                break
-            if not refused:
-                self.event(Level.WARNING, f"arming refused: {result.detail}; retrying")
-            refused += 1
-            if self.now_ms() - start_ms > p.arm_wait_s * 1000.0:
-                raise _End(
-                    Status.ABORTED, f"arming refused for {p.arm_wait_s:.0f} s: {result.detail}"
-                )
-            yield from self.pause(p.retry_wait_s)
-        ok = yield from self.wait_until(lambda t: t.armed, p.move_slack_s)
-        if not ok:
-            raise _End(Status.ABORTED, "the vehicle accepted arming but never showed armed")
-        self.event(Level.INFO, f"armed; taking off to {alt_m:g} m")
-        # A take-off whose ACK was lost is flying: the vehicle refuses it again, and that is no
-        # failure.
-        yield from self.command(
-            lambda i: Takeoff(i, alt_m), f"take-off to {alt_m:g} m", done=lambda t: not t.landed
-        )
-        self.airborne()
-        climbed = yield from self.wait_until(
-            lambda t: t.pos_enu_m[2] >= alt_m - p.arrive_radius_m,
-            alt_m / p.climb_speed_m_s + p.move_slack_s,
-        )
-        if not climbed:
-            raise _End(Status.ABORTED, f"take-off: {alt_m:g} m never reached")
-
-    def airborne(self) -> None:
-        """From now until the return home, a vehicle that disarms has crashed."""
-        self._airborne = True
-
-
-def _move_time_s(t: Telemetry | None, pos_enu_m: Vec3, p: MissionParams) -> float:
-    """The longest a move should take: across at the slowest cruise speed, up or down at the
-    slowest climb rate."""
-    if t is None:
-        return 0.0
-    across_m = math.hypot(t.pos_enu_m[0] - pos_enu_m[0], t.pos_enu_m[1] - pos_enu_m[1])
-    return across_m / p.cruise_speed_m_s + abs(t.pos_enu_m[2] - pos_enu_m[2]) / p.climb_speed_m_s
-
-
-def _distance(t: Telemetry | None, pos_enu_m: Vec3) -> float:
-    if t is None:
-        return 0.0
-    dx = t.pos_enu_m[0] - pos_enu_m[0]
-    dy = t.pos_enu_m[1] - pos_enu_m[1]
-    dz = t.pos_enu_m[2] - pos_enu_m[2]
-    return math.sqrt(dx * dx + dy * dy + dz * dz)

@@ -39,10 +39,13 @@ from uavtool.vision.model3d import (
 )
 
 if TYPE_CHECKING:
-    from uavtool.mission.mission import Mission, Wait
+    from uavtool.mission.base import Wait
+    from uavtool.mission.mission import SearchMission
 
 
-def photograph_and_model(m: Mission, found: Found, seen: Survey, transit_m: float) -> Wait[None]:
+def photograph_and_model(
+    m: SearchMission, found: Found, seen: Survey, transit_m: float
+) -> Wait[None]:
     """Top, front and right photos from planned viewpoints, then the model. The side photos
     are taken only once the top photo shows the whole building."""
     p = m.params.mission
@@ -153,7 +156,7 @@ def photograph_and_model(m: Mission, found: Found, seen: Survey, transit_m: floa
 
 
 def _diagonal(
-    m: Mission,
+    m: SearchMission,
     model: Model,
     views: tuple[View, View, View],
     sides: SidePlan,

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import Enum
+from typing import Any
 
 from uavtool.nav import Viewpoint, ViewpointFailure
 from uavtool.vision import Shape
@@ -172,11 +173,13 @@ class Status(Enum):
     """How a mission ended (``uavtool fly`` maps each to its exit code)."""
 
     COMPLETED = "completed"
-    """The target was found and its model built."""
+    """The mission did all it set out to do, and the vehicle landed (the built-in mission:
+    the target was found and its model built)."""
     PARTIAL = "partial"
-    """The target was found but no model was built."""
+    """The mission did part of its work (the built-in mission: the target was found but no
+    model was built)."""
     NO_MATCH = "no-match"
-    """The search ended without a match."""
+    """The search ended without a match (what a mission looked for is not there)."""
     ABORTED = "aborted"
     """The mission gave up (a command refused, a position never reached …) and sent RTL."""
     TAKEOVER = "pilot-takeover"
@@ -189,17 +192,46 @@ class Status(Enum):
 
 @dataclass(frozen=True, slots=True)
 class Outcome:
-    """How the mission ended; the last output. ``visited`` lists points of interest in the
-    order photographed; ``matched_poi`` is −1 when none matched."""
+    """How the mission ended; the last output. The built-in mission also says what it found:
+    ``visited`` lists points of interest in the order photographed; ``matched_poi`` is −1
+    when none matched (other missions leave these at their defaults)."""
 
     status: Status
     reason: str
-    visited: tuple[int, ...]
-    matched_poi: int
-    match_score: float
-    model_built: bool
+    visited: tuple[int, ...] = ()
+    matched_poi: int = -1
+    match_score: float = 0.0
+    model_built: bool = False
+
+
+@dataclass(frozen=True, slots=True)
+class Result:
+    """Anything a mission found, as JSON values (numbers, strings, lists, objects) under a
+    ``tag``: recorded and compared by replay like every output."""
+
+    tag: str
+    values: dict[str, Any]
+
+
+@dataclass(frozen=True, slots=True)
+class Picture:
+    """An image a mission made (a mosaic, a map), as PNG bytes: recorded on
+    ``/mission/pictures`` with ``tag`` as its frame id (the output holds its digest)."""
+
+    tag: str
+    png: bytes
 
 
 Output = (
-    Command | Event | Shapes | Plan | Recognition | Viewpoints | DiagonalView | ModelBuilt | Outcome
+    Command
+    | Event
+    | Shapes
+    | Plan
+    | Recognition
+    | Viewpoints
+    | DiagonalView
+    | ModelBuilt
+    | Outcome
+    | Result
+    | Picture
 )

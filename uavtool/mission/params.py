@@ -13,7 +13,7 @@ import json
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeVar, overload
 
 from uavtool.checks import (
     DN,
@@ -40,7 +40,69 @@ _TIMEOUT_S = Range(0.0, 86_400.0, lo_open=True)
 
 
 @dataclass(frozen=True, slots=True)
-class MissionParams:
+class FlightParams:
+    """How any mission flies and how patient it is, read by :class:`~uavtool.mission.base.
+    FlightMission`'s helpers (moves, photos, commands, take-off, landing). Distances in
+    metres, times in seconds of vehicle time (the telemetry's ``time_boot_ms``), angles in
+    degrees. A mission's parameters hold one of these as a group (the built-in mission's is
+    ``mission``, a plug-in's usually ``flight``)."""
+
+    gimbal: bool = True
+    """The vehicle can point its camera. Without a gimbal (``uavtool fly --no-gimbal``) the
+    camera is fixed straight down and no gimbal command is sent (the built-in mission flies
+    its search, and ends at the match as partial: the side photos need a gimbal)."""
+    arrive_radius_m: float = 0.6
+    """A position counts as reached within this distance …"""
+    arrive_speed_m_s: float = 0.3
+    """… and below this ground speed (so the photo is not blurred by motion)."""
+    heading_tolerance_deg: float = 3.0
+    """A commanded heading counts as reached within this."""
+    gimbal_tolerance_deg: float = 2.0
+    """A commanded gimbal pitch counts as reached within this."""
+    cruise_speed_m_s: float = 5.0
+    """Slowest speed a move is expected to make: its timeout is distance / this + slack."""
+    climb_speed_m_s: float = 1.0
+    """Slowest climb or descent rate expected (the timeout of take-off and of every move's
+    vertical part)."""
+    move_slack_s: float = 20.0
+    """Extra time allowed for any move, climb or turn before it counts as failed."""
+    retry_wait_s: float = 2.0
+    """Pause before a refused command is tried again."""
+    arm_wait_s: float = 60.0
+    """Arming is retried this long (pre-arm checks may need time after boot)."""
+    command_retries: int = 3
+    """A refused or unanswered command (or a move that times out) is retried this many times,
+    then the mission aborts with RTL."""
+    link_lost_abort_s: float = 30.0
+    """Silence from the vehicle for longer than this ends the mission (the vehicle's own
+    failsafe flies it); shorter losses are waited out and the mission resumes."""
+    land_timeout_s: float = 300.0
+    """Time allowed for the return and landing before the mission stops watching."""
+
+    RANGES: ClassVar[Mapping[str, Range]] = MappingProxyType(
+        {
+            "arrive_radius_m": _LENGTH_M,
+            "arrive_speed_m_s": _SPEED_M_S,
+            "heading_tolerance_deg": Range(0.0, 180.0, lo_open=True),
+            "gimbal_tolerance_deg": Range(0.0, 90.0, lo_open=True),
+            "cruise_speed_m_s": _SPEED_M_S,
+            "climb_speed_m_s": _SPEED_M_S,
+            "move_slack_s": _WAIT_S,
+            "retry_wait_s": _WAIT_S,
+            "arm_wait_s": _WAIT_S,
+            "command_retries": Range(0, 100),
+            "link_lost_abort_s": _TIMEOUT_S,
+            "land_timeout_s": _TIMEOUT_S,
+        }
+    )
+    """Allowed values of each field (floats must also be finite)."""
+
+    def __post_init__(self) -> None:
+        check_fields(self, self.RANGES, group="flight")
+
+
+@dataclass(frozen=True, slots=True)
+class MissionParams(FlightParams):
     """What the mission does and how patient it is. Distances in metres, times in seconds
     of vehicle time (the telemetry's ``time_boot_ms``), angles in degrees."""
 
@@ -103,38 +165,6 @@ class MissionParams:
     view, smaller perspective steps between its heights; never above the second overview)."""
     visit_all: bool = False
     """Visit every point of interest even after a match (then keep the best-scoring match)."""
-    gimbal: bool = True
-    """The vehicle can point its camera. Without a gimbal (``uavtool fly --no-gimbal``) the
-    camera is fixed straight down: the search is flown, no gimbal command is sent, and the
-    flight ends at the match as partial, since the side photos need a gimbal."""
-    arrive_radius_m: float = 0.6
-    """A position counts as reached within this distance …"""
-    arrive_speed_m_s: float = 0.3
-    """… and below this ground speed (so the photo is not blurred by motion)."""
-    heading_tolerance_deg: float = 3.0
-    """A commanded heading counts as reached within this."""
-    gimbal_tolerance_deg: float = 2.0
-    """A commanded gimbal pitch counts as reached within this."""
-    cruise_speed_m_s: float = 5.0
-    """Slowest speed a move is expected to make: its timeout is distance / this + slack."""
-    climb_speed_m_s: float = 1.0
-    """Slowest climb or descent rate expected (the timeout of take-off and of every move's
-    vertical part)."""
-    move_slack_s: float = 20.0
-    """Extra time allowed for any move, climb or turn before it counts as failed."""
-    retry_wait_s: float = 2.0
-    """Pause before a refused command is tried again."""
-    arm_wait_s: float = 60.0
-    """Arming is retried this long (pre-arm checks may need time after boot)."""
-    command_retries: int = 3
-    """A refused or unanswered command (or a move that times out) is retried this many times,
-    then the mission aborts with RTL."""
-    link_lost_abort_s: float = 30.0
-    """Silence from the vehicle for longer than this ends the mission (the vehicle's own
-    failsafe flies it); shorter losses are waited out and the mission resumes."""
-    land_timeout_s: float = 300.0
-    """Time allowed for the return and landing before the mission stops watching."""
-
     RANGES: ClassVar[Mapping[str, Range]] = MappingProxyType(
         {
             "overview_alt_m": _LENGTH_M,
@@ -154,18 +184,7 @@ class MissionParams:
             "recheck_min_score": FRACTION,
             "recheck_offcentre": NON_NEGATIVE,
             "recheck_climb_m": _GAP_M,
-            "arrive_radius_m": _LENGTH_M,
-            "arrive_speed_m_s": _SPEED_M_S,
-            "heading_tolerance_deg": Range(0.0, 180.0, lo_open=True),
-            "gimbal_tolerance_deg": Range(0.0, 90.0, lo_open=True),
-            "cruise_speed_m_s": _SPEED_M_S,
-            "climb_speed_m_s": _SPEED_M_S,
-            "move_slack_s": _WAIT_S,
-            "retry_wait_s": _WAIT_S,
-            "arm_wait_s": _WAIT_S,
-            "command_retries": Range(0, 100),
-            "link_lost_abort_s": _TIMEOUT_S,
-            "land_timeout_s": _TIMEOUT_S,
+            **FlightParams.RANGES,
         }
     )
     """Allowed values of each field (floats must also be finite)."""
@@ -196,19 +215,28 @@ class Params:
     viewpoints: ViewpointParams = field(default_factory=ViewpointParams)
 
 
-def to_dict(params: Params) -> dict[str, Any]:
-    """A JSON-ready nested dict (tuples become lists)."""
+P = TypeVar("P")
+
+
+def to_dict(params: Any) -> dict[str, Any]:
+    """A JSON-ready nested dict (tuples become lists) of any mission's parameters: a frozen
+    dataclass whose fields are groups (frozen dataclasses) of values, as :class:`Params`."""
     return json.loads(json.dumps(dataclasses.asdict(params)))  # type: ignore[no-any-return]
 
 
-def from_dict(data: dict[str, Any], *, source: str = "parameters") -> Params:
-    """The inverse of :func:`to_dict`; unknown keys are errors listing the valid ones."""
+@overload
+def from_dict(data: dict[str, Any], *, source: str = ...) -> Params: ...
+@overload
+def from_dict(data: dict[str, Any], root: type[P], *, source: str = ...) -> P: ...
+def from_dict(data: dict[str, Any], root: type[Any] = Params, *, source: str = "parameters") -> Any:
+    """The inverse of :func:`to_dict` (for the parameters type ``root``); unknown keys are
+    errors listing the valid ones."""
     if not isinstance(data, dict):
         raise InputError(f"{source}: expected a mapping of parameter groups")
-    return _apply(Params(), _flatten(data), source=source)
+    return _apply(root(), _flatten(data), source=source)
 
 
-def with_overrides(params: Params, pairs: dict[str, Any], *, source: str = "--set") -> Params:
+def with_overrides(params: P, pairs: dict[str, Any], *, source: str = "--set") -> P:
     """``params`` with keys set: dotted (``{"mission.look_fill": "0.6"}``, values as strings
     or JSON types) or nested (``{"mission": {"look_fill": 0.6}}``, as a params file holds)."""
     return _apply(params, _flatten(pairs), source=source)
@@ -225,16 +253,18 @@ def parse_settings(texts: Iterable[str], *, option: str = "--set") -> dict[str, 
     return out
 
 
-def valid_keys() -> tuple[str, ...]:
-    """Every dotted key that ``--set`` accepts."""
-    return tuple(_flatten(to_dict(Params())))
+def valid_keys(root: type[Any] = Params) -> tuple[str, ...]:
+    """Every dotted key that ``--set`` accepts for the parameters type ``root``."""
+    return tuple(_flatten(to_dict(root())))
 
 
 def _flatten(data: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    """``{"group": {"name": v}}`` → ``{"group.name": v}``; deeper mappings stay values (no
+    parameter is one, so they are refused by name, never recursed into)."""
     out: dict[str, Any] = {}
     for key, value in data.items():
         path = f"{prefix}{key}"
-        if isinstance(value, dict):
+        if isinstance(value, dict) and not prefix:
             out.update(_flatten(value, f"{path}."))
         else:
             out[path] = value
@@ -258,9 +288,9 @@ def _suggest(key: str, known: tuple[str, ...]) -> str:
     return f"keys are GROUP.NAME with GROUP one of {', '.join(groups)}"
 
 
-def _apply(params: Params, pairs: dict[str, Any], *, source: str) -> Params:
+def _apply(params: P, pairs: dict[str, Any], *, source: str) -> P:
     grouped: dict[str, dict[str, Any]] = {}
-    known = valid_keys()
+    known = valid_keys(type(params))
     for key, raw in pairs.items():
         if key not in known:
             raise InputError(f"{source}: unknown parameter {key!r}; {_suggest(key, known)}")
@@ -276,6 +306,6 @@ def _apply(params: Params, pairs: dict[str, Any], *, source: str) -> Params:
     for group, values in grouped.items():
         try:
             changed[group] = dataclasses.replace(getattr(params, group), **values)
-        except InputError as exc:
+        except (InputError, ValueError) as exc:  # a plug-in's own checks raise ValueError
             raise InputError(f"{source}: {exc}") from None
-    return dataclasses.replace(params, **changed)
+    return dataclasses.replace(params, **changed)  # type: ignore[type-var]

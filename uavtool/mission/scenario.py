@@ -13,13 +13,14 @@ from uavtool.mission.survey import Survey, overview_heading_deg, survey
 from uavtool.nav import route_length_m, visit_order
 
 if TYPE_CHECKING:
-    from uavtool.mission.mission import Mission, Wait
+    from uavtool.mission.base import Wait
+    from uavtool.mission.mission import SearchMission
 
 
 NO_GIMBAL_REASON = "target found, no model: the vehicle has no gimbal"
 
 
-def fly(m: Mission) -> Wait[None]:
+def fly(m: SearchMission) -> Wait[None]:
     """The whole flight up to (not including) the return home."""
     p = m.params.mission
     yield from m.wait_until(lambda _t: True, 0.0)  # the first telemetry

@@ -99,6 +99,8 @@ def _one(tp: Any) -> dict[str, Any]:
         return {"type": _SCALARS[tp]}
     if tp is bytes:
         return dict(_BYTES)
+    if typing.get_origin(tp) is dict:
+        return {"type": "object", "description": "JSON values, as the mission gave them"}
     if isinstance(tp, type) and issubclass(tp, Enum):
         values = [m.value for m in tp]
         kind = "integer" if all(isinstance(v, int) for v in values) else "string"

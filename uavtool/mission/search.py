@@ -29,7 +29,8 @@ from uavtool.vision import Shape
 from uavtool.vision.vectorize import hue_distance_deg
 
 if TYPE_CHECKING:
-    from uavtool.mission.mission import Mission, Wait
+    from uavtool.mission.base import Wait
+    from uavtool.mission.mission import SearchMission
 
 
 @dataclass(frozen=True, slots=True)
@@ -53,7 +54,7 @@ class _Look:
     alt_m: float  # the altitude commanded for the photo
 
 
-def photo_shapes(m: Mission, photo: Photo, *, nadir: bool = True) -> tuple[Shape, ...]:
+def photo_shapes(m: SearchMission, photo: Photo, *, nadir: bool = True) -> tuple[Shape, ...]:
     """Vectorize a photo (from above, or from the side) and emit its shapes."""
     if nadir:
         shapes = nadir_shapes(m.params, photo.image_rgb)
@@ -63,7 +64,7 @@ def photo_shapes(m: Mission, photo: Photo, *, nadir: bool = True) -> tuple[Shape
     return shapes
 
 
-def look_altitude_m(m: Mission, poi: PointOfInterest, intrinsics: Intrinsics) -> float:
+def look_altitude_m(m: SearchMission, poi: PointOfInterest, intrinsics: Intrinsics) -> float:
     """Where to look at ``poi`` from: its footprint spans ``look_fill`` of the photo, and the
     camera is at least ``min_above_roof_m`` over its roof."""
     p = m.params.mission
@@ -74,7 +75,7 @@ def look_altitude_m(m: Mission, poi: PointOfInterest, intrinsics: Intrinsics) ->
 
 
 def search(
-    m: Mission,
+    m: SearchMission,
     pois: tuple[PointOfInterest, ...],
     order: tuple[int, ...],
     *,
@@ -163,7 +164,7 @@ def search(
 
 
 def _rivals(
-    m: Mission, pois: tuple[PointOfInterest, ...], todo: list[int], matched: int
+    m: SearchMission, pois: tuple[PointOfInterest, ...], todo: list[int], matched: int
 ) -> list[int]:
     """The points of interest still to visit that could be the target as well (its colour,
     within the match's hue gate): a match is final only once none is left unseen, so a slab
@@ -183,7 +184,7 @@ def _rivals(
 
 
 def _measure_from_lower(
-    m: Mission, k: int, poi: PointOfInterest, look: _Look, shape: Shape
+    m: SearchMission, k: int, poi: PointOfInterest, look: _Look, shape: Shape
 ) -> Wait[float | None]:
     """The matched roof's height when the overview could not tell it (cut by its border):
     one more photo straight below the look, ``overview_climb_m`` lower (never closer than
@@ -207,7 +208,9 @@ def _measure_from_lower(
     return roof if roof is not None and roof <= p.assumed_roof_m else None
 
 
-def _look(m: Mission, k: int, n: int, alt_m: float, aimed_rgb: tuple[int, int, int]) -> Wait[_Look]:
+def _look(
+    m: SearchMission, k: int, n: int, alt_m: float, aimed_rgb: tuple[int, int, int]
+) -> Wait[_Look]:
     """Look ``n`` at point of interest ``k`` (a building of colour ``aimed_rgb``): a nadir
     photo, judged and reported."""
     photo = yield from m.photo(f"poi-{k}" if n == 1 else f"poi-{k}-{n}", -90.0)
@@ -230,7 +233,7 @@ def _look(m: Mission, k: int, n: int, alt_m: float, aimed_rgb: tuple[int, int, i
 
 
 def _closer_look(
-    m: Mission, look: _Look, before: list[tuple[Shape, Photo]], index: int
+    m: SearchMission, look: _Look, before: list[tuple[Shape, Photo]], index: int
 ) -> tuple[Vec3, float] | None:
     """Where to look again from, lower, and the roof height measured, when the look was
     taken high over a roof of unknown height (assumed the tallest expected) and its
@@ -279,7 +282,7 @@ def _farthest_pair(
 
 
 def _look_again(
-    m: Mission, look: _Look, roof_m: float, ceiling_m: float
+    m: SearchMission, look: _Look, roof_m: float, ceiling_m: float
 ) -> tuple[Vec3, str] | None:
     """Where to look from again and why, or None when the look was conclusive: a match, no
     candidate, a candidate of another hue, or a clear miss centred in the photo."""

@@ -36,7 +36,8 @@ from uavtool.vision import Shape
 from uavtool.vision.model3d import View, same_colour
 
 if TYPE_CHECKING:
-    from uavtool.mission.mission import Mission, Wait
+    from uavtool.mission.base import Wait
+    from uavtool.mission.mission import SearchMission
 
 # Hue window for "the same building" in the side photos (walls are shaded darker than roofs).
 SIDE_HUE_TOLERANCE_DEG = 15.0
@@ -67,7 +68,7 @@ class SidePlan:
     grown: bool = False
     """A photo showed the building taller than the viewpoints were first planned for."""
 
-    def taller(self, m: Mission, height_m: float) -> None:
+    def taller(self, m: SearchMission, height_m: float) -> None:
         """Plan from now on for a building ``height_m`` tall."""
         self.params = _for_height(m, self.params, height_m)
         self.grown = True
@@ -75,7 +76,7 @@ class SidePlan:
         self.transit_m = max(self.transit_m, clear_m)
         m.transit_m = max(m.transit_m or 0.0, self.transit_m)
 
-    def again(self, m: Mission, vp: Viewpoint) -> Viewpoint:
+    def again(self, m: SearchMission, vp: Viewpoint) -> Viewpoint:
         """``vp`` planned again from its direction for the height learnt since (``vp`` itself
         when nothing was learnt, or no viewpoint fits)."""
         if not self.grown:
@@ -91,7 +92,7 @@ class SidePlan:
         return found
 
 
-def _for_height(m: Mission, params: ViewpointParams, height_m: float) -> ViewpointParams:
+def _for_height(m: SearchMission, params: ViewpointParams, height_m: float) -> ViewpointParams:
     return dataclasses.replace(
         params,
         assumed_height_m=height_m,
@@ -116,7 +117,7 @@ def _towards(
 
 
 def side_view(
-    m: Mission,
+    m: SearchMission,
     plan: SidePlan,
     vp: Viewpoint,
     colour_rgb: tuple[int, int, int],
@@ -179,7 +180,9 @@ def _in_line(shapes: tuple[Shape, ...], rect: Rect, photo: Photo) -> tuple[Shape
     return kept or shapes
 
 
-def _taller_view(m: Mission, plan: SidePlan, vp: Viewpoint, camera_z_m: float) -> Viewpoint | None:
+def _taller_view(
+    m: SearchMission, plan: SidePlan, vp: Viewpoint, camera_z_m: float
+) -> Viewpoint | None:
     """The viewpoint planned again, from the same direction, for a building taller than the
     top of the view over its near wall; None when no viewpoint fits."""
     half_vfov = math.radians(plan.intrinsics.vfov_deg) / 2.0
@@ -198,7 +201,9 @@ def _taller_view(m: Mission, plan: SidePlan, vp: Viewpoint, camera_z_m: float) -
     return found
 
 
-def _backed_away(m: Mission, plan: SidePlan, vp: Viewpoint, step_m: float) -> Viewpoint | None:
+def _backed_away(
+    m: SearchMission, plan: SidePlan, vp: Viewpoint, step_m: float
+) -> Viewpoint | None:
     """``vp`` moved back along its line of sight by ``step_m``; None (and why) when that
     comes within the safety margin of another building."""
     h = math.radians(vp.heading_deg)

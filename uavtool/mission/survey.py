@@ -24,7 +24,8 @@ from uavtool.vision import Shape
 from uavtool.vision.vectorize import hue_distance_deg
 
 if TYPE_CHECKING:
-    from uavtool.mission.mission import Mission, Wait
+    from uavtool.mission.base import Wait
+    from uavtool.mission.mission import SearchMission
 
 
 @dataclass(frozen=True, slots=True)
@@ -62,7 +63,7 @@ class Obstacle:
     footprint: tuple[tuple[float, float], ...]
 
 
-def survey(m: Mission) -> Wait[Survey]:
+def survey(m: SearchMission) -> Wait[Survey]:
     """Photograph the scene from the overview altitude and from ``overview_climb_m`` higher."""
     p = m.params.mission
     low = yield from m.photo("overview", -90.0)
@@ -91,7 +92,7 @@ def survey(m: Mission) -> Wait[Survey]:
 
 
 def points_of_interest(
-    m: Mission,
+    m: SearchMission,
     shapes: tuple[Shape, ...],
     photo: Photo,
     roofs_m: list[float],
@@ -148,7 +149,7 @@ def search_altitude_m(p: MissionParams, intrinsics: Intrinsics) -> float:
 
 
 def _measure(
-    m: Mission, shape: Shape, high: Photo, low: Photo, low_shapes: tuple[Shape, ...]
+    m: SearchMission, shape: Shape, high: Photo, low: Photo, low_shapes: tuple[Shape, ...]
 ) -> float | None:
     """The roof height of ``shape`` (in the higher photo) from the same roof in the lower
     one: same colour, whole in both, where the vertical climb puts it."""
@@ -173,7 +174,7 @@ def _measure(
     return roof_between(best[1], low, shape, high)
 
 
-def same_colour(m: Mission, a_rgb: tuple[int, int, int], b_rgb: tuple[int, int, int]) -> bool:
+def same_colour(m: SearchMission, a_rgb: tuple[int, int, int], b_rgb: tuple[int, int, int]) -> bool:
     """Whether two outlines' colours can be one roof's (``mission.roof_colour_tolerance_dn``
     in every channel)."""
     tol = m.params.mission.roof_colour_tolerance_dn
@@ -187,7 +188,7 @@ def footprint_at(shape: Shape, photo: Photo, roof_m: float) -> tuple[tuple[float
         return ground_polygon(shape.polygon_px, photo.pose, photo.intrinsics, plane_z_m=0.0)
 
 
-def same_building(m: Mission, seen: Survey, target: int) -> frozenset[int]:
+def same_building(m: SearchMission, seen: Survey, target: int) -> frozenset[int]:
     """``target`` and the survey's other shapes of its colour that touch it, within the
     safety margin: the roofs of one stepped building, split in the overview by the walls
     between its tiers, are not obstacles to photographing it."""
@@ -209,7 +210,7 @@ def same_building(m: Mission, seen: Survey, target: int) -> frozenset[int]:
 
 
 def obstacles_around(
-    m: Mission, seen: Survey, target: int
+    m: SearchMission, seen: Survey, target: int
 ) -> list[tuple[tuple[float, float], ...]]:
     """The survey's footprints of every building but the target (and its other roofs), and
     of everything else that is not ground."""
@@ -247,7 +248,7 @@ def beyond_the_frame(seen: Survey) -> list[tuple[tuple[float, float], ...]]:
 
 
 def remeasured_obstacles(
-    m: Mission, seen: Survey, target: int, photo: Photo, shapes: tuple[Shape, ...]
+    m: SearchMission, seen: Survey, target: int, photo: Photo, shapes: tuple[Shape, ...]
 ) -> list[tuple[tuple[float, float], ...]]:
     """The footprints of every building but ``target`` (and its other roofs), those of
     unknown height measured again against a later nadir ``photo`` (its ``shapes``) where it
@@ -268,7 +269,7 @@ def remeasured_obstacles(
 
 
 def _measure_against(
-    m: Mission, shape: Shape, photo: Photo, other: Photo, others: tuple[Shape, ...]
+    m: SearchMission, shape: Shape, photo: Photo, other: Photo, others: tuple[Shape, ...]
 ) -> float | None:
     """The roof height of ``shape`` (in ``photo``) triangulated with the same roof in another
     nadir photo: its colour, whole, nearest where it falls on the ground."""

@@ -45,6 +45,8 @@ class RecordingInfo:
     topics: tuple[TopicInfo, ...]
     metadata_names: tuple[str, ...]
     outcome: dict[str, str] | None
+    mission: str = ""
+    """Which mission flew (name, class, version), "" for a recording of no mission."""
     verified: bool = False  # every chunk was read and checked
     summary_problem: str = ""  # why the summary was not used ("" if used or absent)
     damage: tuple[str, ...] = ()  # each corrupt chunk or damaged record, in words
@@ -111,6 +113,7 @@ def summarize(path: str | Path, *, verify: bool = True) -> RecordingInfo:
             topics=topics,
             metadata_names=tuple(name for name, _ in metadata),
             outcome=outcome,
+            mission=_mission(_last(metadata, "mission")),
             from_record=record_result is not None
             or any(name == RECORD_METADATA for name, _ in metadata),
             record_result=record_result,
@@ -119,6 +122,19 @@ def summarize(path: str | Path, *, verify: bool = True) -> RecordingInfo:
             damage=tuple(reader.describe(d) for d in damage),
             messages_lost=lost,
         )
+
+
+def _mission(record: dict[str, str] | None) -> str:
+    """The mission a recording's ``mission`` record names; one without a name (before
+    missions were plug-ins) flew the built-in search."""
+    if record is None:
+        return ""
+    name = record.get("name", "search")
+    version = record.get("version") or record.get("tool_version", "")
+    where = ", ".join(
+        x for x in (record.get("class", ""), f"version {version}" if version else "") if x
+    )
+    return f"{name} ({where})" if where else name
 
 
 def _last(metadata: list[tuple[str, dict[str, str]]], name: str) -> dict[str, str] | None:
@@ -183,6 +199,8 @@ def format_info(info: RecordingInfo) -> str:
     lines.append(f"messages:  {info.message_count}{readable}")
     others = "".join(f"; {n} on {topic}" for topic, n in info.other_images)
     lines.append(f"frames:    {info.frame_count} on {IMAGE}{others}")
+    if info.mission:
+        lines.append(f"mission:   {info.mission}")
     lines.append(_ending(info))
     if info.metadata_names:
         lines.append("metadata:  " + ", ".join(info.metadata_names))

@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from uavtool.mission import Params, Photo
+from uavtool.mission import Params, Photo, SearchMission
 from uavtool.mission.analysis import judge, nadir_shapes, side_shapes, target_shapes
 from uavtool.replay.load import RecordedFlight
 
@@ -49,7 +49,9 @@ class FrameChange:
 
 def reanalyse_frames(flight: RecordedFlight, params: Params) -> list[FrameChange]:
     """Every recorded photo through the mission's vision with ``params``, beside the recorded
-    results."""
+    results (the built-in mission's vision; none for another mission)."""
+    if not issubclass(flight.mission, SearchMission) or flight.target_rgb is None:
+        return []
     recorded_shapes: dict[int, int] = {}
     recorded_judgement: dict[int, dict[str, Any]] = {}
     poi_colours: dict[int, tuple[int, int, int]] = {}  # what each look was aimed at

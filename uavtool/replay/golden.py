@@ -78,7 +78,9 @@ def update_golden(recording: Path) -> tuple[int, int]:
             f"({result.divergence.reason}); fly this golden again instead"
         )
     tmp = recording.with_suffix(".mcap.tmp")
-    write_replay(recording, tmp, result.outputs, result.glbs, flight.params, outcome=result.outcome)
+    write_replay(
+        recording, tmp, result.outputs, result.blobs, flight.params, outcome=result.outcome
+    )
     tmp.replace(recording)
     digest_path(recording).write_text(digest(result.outputs))
     return len(flight.outputs), len(result.outputs)

@@ -1,20 +1,21 @@
-"""A recorded flight as replay needs it: the parameters, the target picture, every observation
-in the order the mission consumed it (photos with their pixels), and every recorded output.
-Nothing else is read: not the scene, not the vehicle, not the network."""
+"""A recorded flight as replay needs it: the mission and its parameters, the target picture
+(if the mission has one), every observation in the order the mission consumed it (photos with
+their pixels), and every recorded output. Nothing else is read: not the scene, not the
+vehicle, not the network."""
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from uavtool.errors import InputError
+from uavtool.flight import mission_of
 from uavtool.images import png_decode
-from uavtool.mission import Observation, Params
+from uavtool.mission import FlightMission, Observation
 from uavtool.mission.codec import decode_observation
 from uavtool.mission.observations import U8Array
-from uavtool.mission.params import from_dict
+from uavtool.plugins import MissionRef, for_recording, mission_params
 from uavtool.recording import CompressedImage, JsonDocument, RecordingReader
 from uavtool.recording.topics import IMAGE, OBSERVATIONS, OUTPUTS, TARGET
 
@@ -38,9 +39,13 @@ class RecordedOutput:
 @dataclass(frozen=True, slots=True)
 class RecordedFlight:
     path: Path
-    params: Params
+    mission: type[FlightMission]
+    """The class of the mission that flew (a registered one, or the one ``--mission`` named)."""
+    mission_ref: MissionRef
+    params: Any
+    """The recorded parameters, an instance of ``mission.params_type``."""
     params_json: dict[str, Any]
-    target_rgb: U8Array
+    target_rgb: U8Array | None
     observations: tuple[Observation, ...]
     outputs: tuple[RecordedOutput, ...]
     truncated: bool
@@ -52,9 +57,10 @@ class RecordedFlight:
         return any(o.data.get("type") == "Outcome" for o in self.outputs)
 
 
-def load_flight(path: str | Path) -> RecordedFlight:
+def load_flight(path: str | Path, *, mission: str | None = None) -> RecordedFlight:
     """Read a recording made by ``uavtool fly``; raises a one-line InputError naming the file
-    and what is missing or wrong."""
+    and what is missing or wrong. ``mission`` (``--mission``) names the mission's class when
+    the recording's is not registered here."""
     path = Path(path)
     with RecordingReader(path) as reader:
         reader.require_metadata(_NEEDED_METADATA)
@@ -64,13 +70,9 @@ def load_flight(path: str | Path) -> RecordedFlight:
                 f"{path}: not a mission recording (no mission parameters or "
                 f"{OBSERVATIONS}); record one with `uavtool fly`"
             )
-        try:
-            params_json = json.loads(meta["mission"]["params"])
-        except (KeyError, ValueError):
-            raise ReplayInputError(
-                f"{path}: metadata 'mission' holds no readable parameters"
-            ) from None
-        params = from_dict(params_json, source=f"{path}: recorded parameters")
+        ref, params_json = mission_of(meta, source=str(path))
+        cls, ref = for_recording(ref, source=str(path), override=mission)
+        params = mission_params(cls, params_json, source=f"{path}: recorded parameters")
         tool_version = meta.get("uavtool", {}).get("version", "?")
         target: U8Array | None = None
         images: list[bytes] = []
@@ -87,11 +89,16 @@ def load_flight(path: str | Path) -> RecordedFlight:
                 raw_obs.append(dict(value.payload))
             elif entry.topic == OUTPUTS and isinstance(value, JsonDocument):
                 data = dict(value.payload)
-                n, step = int(data.pop("n")), int(data.pop("step"))
+                n, step = data.pop("n", None), data.pop("step", None)
+                if type(n) is not int or type(step) is not int:
+                    raise ReplayInputError(
+                        f"{path}: output {len(outputs) + 1} on {OUTPUTS} has no whole-number "
+                        "n and step"
+                    )
                 outputs.append(RecordedOutput(n, step, data))
         truncated = not reader.health.whole
         _check_counts(reader, path, {OBSERVATIONS: len(raw_obs), OUTPUTS: len(outputs)})
-    if target is None:
+    if target is None and cls.needs_target:
         raise ReplayInputError(f"{path}: the target picture ({TARGET}) is missing")
     observations = []
     for i, data in enumerate(raw_obs, start=1):
@@ -101,10 +108,10 @@ def load_flight(path: str | Path) -> RecordedFlight:
             )
         image = None
         if data.get("type") == "Photo":
-            frame = int(data.get("frame_index", -1))
-            if not 0 <= frame < len(images):
+            frame = data.get("frame_index", -1)
+            if type(frame) is not int or not 0 <= frame < len(images):
                 raise ReplayInputError(
-                    f"{path}: photo frame {frame} (step {i}) is missing from {IMAGE} "
+                    f"{path}: photo frame {frame!r:.20} (step {i}) is missing from {IMAGE} "
                     f"({len(images)} frames recorded)"
                 )
             image = png_decode(images[frame], where=f"{path}: frame {frame}")
@@ -114,6 +121,8 @@ def load_flight(path: str | Path) -> RecordedFlight:
             raise ReplayInputError(f"{path}: step {i}: {exc}") from None
     return RecordedFlight(
         path,
+        cls,
+        ref,
         params,
         params_json,
         target,

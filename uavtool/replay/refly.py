@@ -9,6 +9,7 @@ the same messages, in the same order, with the same times and bytes.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import tempfile
 from collections.abc import Callable
@@ -18,8 +19,8 @@ from pathlib import Path
 from typing import Any
 
 from uavtool.errors import InputError
-from uavtool.mission import Params
-from uavtool.mission.params import from_dict
+from uavtool.flight import FlightDescription
+from uavtool.plugins import for_recording, mission_params
 from uavtool.recording import CompressedImage, RecordingReader
 from uavtool.recording.files import refuse_same_file
 from uavtool.recording.reader import Message
@@ -31,7 +32,9 @@ from uavtool.world import scene_from_dict
 
 # Metadata that names the software, not the flight: a re-flight by a newer version of the
 # same code must still compare equal.
-_VERSION_KEYS = {("uavtool", "version"), ("mission", "tool_version")}
+_VERSION_KEYS = {("uavtool", "version"), ("mission", "tool_version"), ("mission", "version")}
+_DESCRIPTION_RECORDS = frozenset({"mission", "scene", "seeds", "vehicle", "flight"})
+"""The records the flight description is stored in (compared as one description)."""
 
 
 class ReflyInputError(InputError):
@@ -60,74 +63,47 @@ def is_lockstep(path: Path) -> bool:
     return meta.get("vehicle", {}).get("clock") == "lockstep" and "flight" in meta
 
 
-def refly_config(path: Path, *, out: Path, workdir: Path) -> FlyConfig:
+def refly_config(path: Path, *, out: Path, workdir: Path, mission: str | None = None) -> FlyConfig:
     """The :class:`FlyConfig` that made the lockstep recording ``path``, recording to ``out``
-    (a target picture the user gave is written into ``workdir``). Raises ReflyInputError."""
+    (a target picture the user gave is written into ``workdir``). Raises ReflyInputError.
+    ``mission`` (``--mission``) names the mission's class when the recording's is not
+    registered here."""
     with RecordingReader(path) as reader:
         reader.require_metadata(("mission", "scene", "flight", "vehicle"))
         reader.require_intact()  # now, not after flying: the comparison needs all of it
         meta = dict(reader.metadata)
-        vehicle = meta.get("vehicle", {})
         if not is_lockstep(path):
             raise ReflyInputError(
                 f"{path}: not a lockstep flight of the built-in vehicle (metadata 'vehicle' "
                 "clock is not 'lockstep'); only those can be flown again: make one with "
                 "`uavtool fly`"
             )
-        flight = meta["flight"]
-        camera = vehicle.get("camera", "sim")
-        if camera != "sim":
+        d = FlightDescription.from_metadata(meta, source=str(path))
+        if d.camera != "sim":
             # Anything else is a device or a URL for OpenCV/FFmpeg to open: never from a file.
             raise ReflyInputError(
-                f"{path}: recorded with the camera {camera[:40]!r}; only a flight with the "
+                f"{path}: recorded with the camera {d.camera[:40]!r}; only a flight with the "
                 "simulated camera can be flown again"
             )
-        try:
-            scene = scene_from_dict(json.loads(meta["scene"]["json"]), source=f"{path}: scene")
-            params: Params = from_dict(
-                json.loads(meta["mission"]["params"]), source=f"{path}: mission parameters"
-            )
-            wind = json.loads(flight["wind"])
-            config = FlyConfig(
-                scene=scene,
-                camera="sim",
-                record=out,
-                params=params,
-                vehicle_params=tuple(
-                    (str(n), float(v)) for n, v in json.loads(flight["vehicle_params"])
-                ),
-                seed=int(flight["seed"]),
-                noise=bool(json.loads(flight["noise"])),
-                wind=(float(wind[0]), float(wind[1])),
-                link_outages_s=tuple(
-                    (float(a), float(d)) for a, d in json.loads(flight["link_outages_s"])
-                ),
-                hfov_deg=float(json.loads(flight["hfov_deg"])),
-                size_px=_size_px(json.loads(flight["size_px"])),
-                target=_target_file(reader, path, workdir) if flight["target"] == "file" else None,
-                no_gimbal=json.loads(flight.get("no_gimbal", "false")) is True,
-            )
-        except (KeyError, ValueError, TypeError, IndexError) as exc:
-            raise ReflyInputError(
-                f"{path}: metadata 'flight' is incomplete or unreadable ({exc!r}); "
-                "the recording cannot be flown again"
-            ) from None
-    return config
-
-
-_SIDE_PX = (16, 8192)
-"""The image sides a re-flight accepts (as ``uavtool scene --size``): a recording asking for
-more is refused before anything is allocated."""
-
-
-def _size_px(value: object) -> tuple[int, int]:
-    if not isinstance(value, list) or len(value) != 2:
-        raise ValueError(f"size_px {value!r} is not [width, height]")
-    w, h = (int(v) for v in value)
-    lo, hi = _SIDE_PX
-    if not (lo <= w <= hi and lo <= h <= hi):
-        raise ValueError(f"size_px {w}x{h} is outside {lo}..{hi} pixels a side")
-    return w, h
+        if d.scene is None:
+            raise ReflyInputError(f"{path}: metadata 'scene' holds no scene to fly in")
+        cls, ref = for_recording(d.mission, source=str(path), override=mission)
+        return FlyConfig(
+            scene=scene_from_dict(d.scene, source=f"{path}: scene"),
+            camera="sim",
+            record=out,
+            mission=ref.name if mission is None else mission,
+            params=mission_params(cls, d.params, source=f"{path}: mission parameters"),
+            vehicle_params=d.vehicle_params,
+            seed=d.seed,
+            noise=d.noise,
+            wind=d.wind,
+            link_outages_s=d.link_outages_s,
+            hfov_deg=d.hfov_deg,
+            size_px=d.size_px,
+            target=_target_file(reader, path, workdir) if d.target == "file" else None,
+            no_gimbal=d.no_gimbal,
+        )
 
 
 def refly(
@@ -136,6 +112,7 @@ def refly(
     out: Path | None = None,
     progress: Progress | None = None,
     compare: bool = True,
+    mission: str | None = None,
 ) -> ReflyResult:
     """Fly ``path``'s configuration again (to ``out``, or a temporary file that is removed)
     and compare the two recordings message by message."""
@@ -145,7 +122,8 @@ def refly(
     with tempfile.TemporaryDirectory(prefix="uavtool-refly-") as tmp:
         work = Path(tmp)
         target = out if out is not None else work / "reflown.mcap"
-        summary = fly(refly_config(path, out=target, workdir=work), progress=progress)
+        config = refly_config(path, out=target, workdir=work, mission=mission)
+        summary = fly(config, progress=progress)
         count, diff = compare_recordings(path, target) if compare else (0, None)
     return ReflyResult(path, target, count, diff, summary)
 
@@ -215,24 +193,50 @@ def _short(value: Any) -> str:
 def _metadata_difference(
     was: list[tuple[str, dict[str, str]]], now: list[tuple[str, dict[str, str]]]
 ) -> str | None:
-    def comparable(records: list[tuple[str, dict[str, str]]]) -> list[tuple[str, dict[str, str]]]:
-        return [
-            (name, {k: v for k, v in rec.items() if (name, k) not in _VERSION_KEYS})
-            for name, rec in records
-        ]
-
-    a, b = comparable(was), comparable(now)
-    if [n for n, _ in a] != [n for n, _ in b]:
-        return f"metadata records {[n for n, _ in a]} recorded, {[n for n, _ in b]} re-flown"
-    for (name, x), (_, y) in zip(a, b, strict=True):
+    """The first difference in what the two flights were (their descriptions, software
+    versions aside; an older recording's describes the same flight in fewer words), then in
+    any other metadata record (every record, for recordings that describe no flight)."""
+    described = [{"mission", "vehicle", "flight"} <= {n for n, _ in m} for m in (was, now)]
+    rest_a, rest_b = was, now
+    if all(described):
+        try:
+            old = _comparable(FlightDescription.from_metadata(dict(was), source="recorded"))
+            new = _comparable(FlightDescription.from_metadata(dict(now), source="re-flown"))
+        except InputError as exc:
+            return f"metadata: {exc}"
+        for f in dataclasses.fields(FlightDescription):
+            x, y = getattr(old, f.name), getattr(new, f.name)
+            if x != y:
+                if isinstance(x, dict) and isinstance(y, dict):
+                    return f"metadata {f.name}: {_json_difference(x, y)}"
+                return f"metadata {f.name}: {_short_any(x)} recorded, {_short_any(y)} re-flown"
+        rest_a = [(n, r) for n, r in was if n not in _DESCRIPTION_RECORDS]
+        rest_b = [(n, r) for n, r in now if n not in _DESCRIPTION_RECORDS]
+    if [n for n, _ in rest_a] != [n for n, _ in rest_b]:
+        return (
+            f"metadata records {[n for n, _ in rest_a]} recorded, {[n for n, _ in rest_b]} re-flown"
+        )
+    for (name, rec_a), (_, rec_b) in zip(rest_a, rest_b, strict=True):
+        x = {k: v for k, v in rec_a.items() if (name, k) not in _VERSION_KEYS}
+        y = {k: v for k, v in rec_b.items() if (name, k) not in _VERSION_KEYS}
         if x != y:
             key = next(k for k in sorted(set(x) | set(y)) if x.get(k) != y.get(k))
             try:  # a JSON value (the parameters): name the field inside it
                 inner = _json_difference(json.loads(x[key]), json.loads(y[key]))
-            except (KeyError, TypeError, ValueError):
+            except (KeyError, TypeError, ValueError, RecursionError):
                 inner = f"{_short(x.get(key))} recorded, {_short(y.get(key))} re-flown"
             return f"metadata {name}.{key}: {inner}"
     return None
+
+
+def _comparable(d: FlightDescription) -> FlightDescription:
+    """``d`` without the versions of the software that flew it."""
+    return dataclasses.replace(d, mission=dataclasses.replace(d.mission, version=""))
+
+
+def _short_any(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
 
 
 def _target_file(reader: RecordingReader, path: Path, workdir: Path) -> Path:

@@ -17,9 +17,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from uavtool.geo import wrap_180
-from uavtool.mission import Mission, ModelBuilt, Output, Params
+from uavtool.mission import FlightParams, MissionInputs, Output
 from uavtool.mission.codec import encode_output
+from uavtool.plugins import create_mission, flight_params, guarded
 from uavtool.replay.load import RecordedFlight, RecordedOutput
+from uavtool.runner.record import output_bytes
 
 Progress = Callable[[int, int], None]
 """Called with (observations done, total)."""
@@ -63,8 +65,9 @@ class ReplayResult:
     first_difference: Difference | None = None
     divergence: Divergence | None = None
     finished: bool = False
-    glbs: dict[int, bytes] = field(default_factory=dict)
-    """GLB bytes of each replayed model, by output number."""
+    blobs: dict[int, bytes] = field(default_factory=dict)
+    """The bytes each replayed output carries (a model's GLB, a picture's PNG), by output
+    number."""
 
     @property
     def outcome(self) -> dict[str, str] | None:
@@ -85,23 +88,23 @@ class ReplayResult:
 
 def replay(
     flight: RecordedFlight,
-    params: Params | None = None,
+    params: Any = None,
     *,
     progress: Progress | None = None,
 ) -> ReplayResult:
     """Feed the recorded observations to a fresh mission built with ``params`` (default: the
     recorded ones) and compare its outputs with the recording's, step by step."""
     p = params if params is not None else flight.params
-    mission = Mission(p, flight.target_rgb)
-    cmp = _Comparison(flight.outputs, p)
+    mission = create_mission(flight.mission, p, MissionInputs(target_rgb=flight.target_rgb))
+    cmp = _Comparison(flight.outputs, flight_params(flight.mission, p))
     total = len(flight.observations)
-    cmp.emit(0, mission.start())
+    cmp.emit(0, guarded(mission.start))
     for step, obs in enumerate(flight.observations, start=1):
         if mission.done:
             cmp.diverge(step, "the mission ended before the recording did")
             break
         cmp.result.steps = step
-        cmp.emit(step, mission.step(obs))
+        cmp.emit(step, guarded(mission.step, obs))
         if cmp.result.divergence is not None:
             break
         if progress is not None and (step % 200 == 0 or step == total):
@@ -120,10 +123,10 @@ class _Comparison:
     """Positional comparison of all outputs (for ``--check``), and of the commands alone (to
     find where the mission's decisions leave the recording)."""
 
-    def __init__(self, recorded: tuple[RecordedOutput, ...], params: Params) -> None:
+    def __init__(self, recorded: tuple[RecordedOutput, ...], flight: FlightParams) -> None:
         self.result = ReplayResult()
-        self._radius_m = params.mission.arrive_radius_m
-        self._heading_deg = params.mission.heading_tolerance_deg
+        self._radius_m = flight.arrive_radius_m
+        self._heading_deg = flight.heading_tolerance_deg
         self._recorded = iter(recorded)
         self._commands = iter([r for r in recorded if r.data.get("type") in _COMMANDS])
 
@@ -136,8 +139,9 @@ class _Comparison:
             data = encode_output(out)
             n = len(self.result.outputs) + 1
             self.result.outputs.append(RecordedOutput(n, step, data))
-            if isinstance(out, ModelBuilt):
-                self.result.glbs[n] = out.glb
+            blob = output_bytes(out)
+            if blob is not None:
+                self.result.blobs[n] = blob
             if self.result.first_difference is None:
                 self._check(step, n, data, next(self._recorded, None))
             if data["type"] in _COMMANDS and self.result.divergence is None:

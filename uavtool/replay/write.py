@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
-from uavtool.mission import Params
 from uavtool.mission.params import to_dict
 from uavtool.recording import (
     JsonDocument,
@@ -16,32 +16,38 @@ from uavtool.recording import (
     RecordingWriter,
 )
 from uavtool.recording.files import atomic_output
-from uavtool.recording.topics import EVENTS, MODEL, OBSERVATIONS, OUTPUTS
+from uavtool.recording.topics import EVENTS, MODEL, OBSERVATIONS, OUTPUTS, PICTURES
 from uavtool.replay.load import RecordedOutput
 from uavtool.runner.record import MissionRecorder
 
-_REGENERATED = {OUTPUTS, MODEL}
+_REGENERATED = {OUTPUTS, MODEL, PICTURES}
+
+
+_MISSION_KEYS = ("name", "class", "version")
 
 
 def write_replay(
     source: Path,
     out: Path,
     outputs: list[RecordedOutput],
-    glbs: dict[int, bytes],
-    params: Params,
+    blobs: dict[int, bytes],
+    params: Any,
     *,
     outcome: dict[str, str] | None = None,
 ) -> None:
     """Copy ``source``'s inputs into ``out`` and write ``outputs`` (with each model's GLB from
-    ``glbs`` by output number) at the log time of the observation that produced them.
+    ``blobs`` by output number) at the log time of the observation that produced them.
     ``out`` appears only once complete; `SameFileError` if it is ``source``."""
     with RecordingReader(source) as reader, atomic_output(out, inputs=[source]) as tmp:
+        records = dict(reader.metadata)
         meta = {
             name: record
-            for name, record in reader.metadata
+            for name, record in records.items()
             if name not in ("uavtool", "outcome", "mission")
         }
-        meta["mission"] = {"params": json.dumps(to_dict(params))}
+        # Which mission it is stays; the parameters are those replayed.
+        which = {k: v for k, v in records.get("mission", {}).items() if k in _MISSION_KEYS}
+        meta["mission"] = {"params": json.dumps(to_dict(params)), **which}
         meta["replay"] = {"source": str(source)}
         with RecordingWriter(tmp, metadata=meta) as writer:
             recorder = MissionRecorder(writer)
@@ -57,7 +63,7 @@ def write_replay(
                     continue
                 if topic == OBSERVATIONS and isinstance(value, JsonDocument):
                     step = int(value.payload["step"])
-                    pending = _flush(recorder, pending, step - 1, last_t or t, glbs)
+                    pending = _flush(recorder, pending, step - 1, last_t or t, blobs)
                     writer.write_json(
                         OBSERVATIONS,
                         value.payload,
@@ -76,7 +82,7 @@ def write_replay(
                     continue  # other JSON channels: not inputs
                 else:
                     writer.write(topic, value, log_time_ns=t, publish_time_ns=entry.publish_time_ns)
-            _flush(recorder, pending, 1 << 62, last_t or 1, glbs)
+            _flush(recorder, pending, 1 << 62, last_t or 1, blobs)
             writer.add_metadata("outcome", outcome or {"status": "replay-diverged"})
 
 
@@ -85,9 +91,9 @@ def _flush(
     pending: list[RecordedOutput],
     up_to_step: int,
     t: int,
-    glbs: dict[int, bytes],
+    blobs: dict[int, bytes],
 ) -> list[RecordedOutput]:
     while pending and pending[0].step <= up_to_step:
         out = pending.pop(0)
-        recorder.write_output(out.n, out.step, out.data, glb=glbs.get(out.n), log_time_ns=t)
+        recorder.write_output(out.n, out.step, out.data, blob=blobs.get(out.n), log_time_ns=t)
     return pending

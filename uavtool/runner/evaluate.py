@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from uavtool.mission import SearchMission
 from uavtool.world import Scene, building_footprint, building_mesh
 
 if TYPE_CHECKING:
@@ -37,6 +38,8 @@ def evaluate(runner: Runner, scene: Scene | None) -> Evaluation:
     if scene is None:
         return Evaluation()
     mission = runner.mission
+    if not isinstance(mission, SearchMission):  # only the built-in mission has a target
+        return Evaluation(target_building=scene.target)
     outcome = mission.outcome
     plan = mission.plan
     if outcome is None or plan is None:

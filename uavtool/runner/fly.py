@@ -11,25 +11,26 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import itertools
-import json
 import math
 import time
 from collections.abc import Callable, Iterator
 from contextlib import ExitStack, contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from uavtool import __version__
 from uavtool.autopilot import Autopilot, for_vehicle
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.errors import InputError, LinkError
+from uavtool.flight import CONNECT_BUILTIN, FlightDescription
 from uavtool.images import png_decode, png_encode
 from uavtool.link import Clock, Transport, VehicleLink, open_transport
-from uavtool.mission import Level, Mission, Outcome, Params
-from uavtool.mission.params import to_dict
-from uavtool.mission.survey import overview_ceiling_m
+from uavtool.mission import Level, MissionInputs, Outcome, SearchMission
+from uavtool.mission.outputs import Result
+from uavtool.mission.params import to_dict, with_overrides
+from uavtool.plugins import DEFAULT, MissionRef, create_mission, resolve
 from uavtool.recording import RecordingError, RecordingWriter
 from uavtool.recording.files import atomic_output
 from uavtool.runner.camera import open_camera
@@ -65,7 +66,10 @@ class FlyConfig:
     record: Path | None = None
     """None: ``recordings/<UTC time>.mcap``."""
     no_record: bool = False
-    params: Params = field(default_factory=Params)
+    mission: str = DEFAULT
+    """Which mission flies: a registered name (``uavtool missions``) or ``module:Class``."""
+    params: Any = None
+    """The mission's parameters (an instance of its ``Params``); None: its defaults."""
     vehicle_params: tuple[tuple[str, float], ...] = ()
     seed: int = 0
     noise: bool = False
@@ -109,6 +113,13 @@ class FlightSummary:
     stale_dropped: tuple[tuple[str, int], ...] = ()
     """Messages dropped as older than one already taken (late on the link), per message name;
     the recording keeps them."""
+    mission: str = DEFAULT
+    """The mission's name."""
+    searched: bool = True
+    """Whether it was the built-in search (the outcome's visits, match and model mean
+    something)."""
+    results: tuple[Result, ...] = ()
+    """The mission's :class:`Result` outputs, in order."""
 
 
 def default_recording_path(now: datetime | None = None) -> Path:
@@ -144,16 +155,26 @@ def fly(
     wall0 = time.monotonic()
     if config.scene_origin not in SCENE_ORIGINS:
         raise InputError(f"--scene-origin {config.scene_origin}: expected vehicle or scene")
-    if config.no_gimbal and config.params.mission.gimbal:
-        mission_params = dataclasses.replace(config.params.mission, gimbal=False)
-        config = dataclasses.replace(
-            config, params=dataclasses.replace(config.params, mission=mission_params)
+    mission_cls, ref = resolve(config.mission)
+    params = config.params if config.params is not None else mission_cls.params_type()
+    if not isinstance(params, mission_cls.params_type):
+        raise InputError(
+            f"--mission {config.mission}: parameters of type {type(params).__name__}, "
+            f"expected {mission_cls.params_type.__name__}"
         )
+    if config.no_gimbal:
+        params = with_overrides(params, {f"{mission_cls.flight_group}.gimbal": False})
+    config = dataclasses.replace(config, params=params)
     scene = config.scene if isinstance(config.scene, Scene) else load_scene(config.scene)
     w, h = config.size_px
     intrinsics = Intrinsics.from_hfov(width_px=w, height_px=h, hfov_deg=config.hfov_deg)
-    target_png = _read_target(config.target) if config.target else target_picture(scene, intrinsics)
-    mission = Mission(config.params, png_decode(target_png, where="target"))
+    target_png: bytes | None = None
+    if config.target:
+        target_png = _read_target(config.target)
+    elif mission_cls.needs_target:
+        target_png = target_picture(scene, intrinsics)
+    target_rgb = None if target_png is None else png_decode(target_png, where="target")
+    mission = create_mission(mission_cls, params, MissionInputs(target_rgb=target_rgb))
     camera = open_camera(
         config.camera,
         scene=scene,
@@ -186,11 +207,13 @@ def fly(
                     keep_on_error=lambda _exc: bool(flown),
                 )
             )
+            description = describe(config, scene, ref, target_png is not None)
             writer = stack.enter_context(
-                RecordingWriter(partial, metadata=flight_metadata(config, scene))
+                RecordingWriter(partial, metadata=description.to_metadata())
             )
             recorder = MissionRecorder(writer, clock_ns=clock_ns)
-            recorder.target(target_png)
+            if target_png is not None:
+                recorder.target(target_png)
         live = None
         if config.rerun is not None:
             live = LiveView(
@@ -233,9 +256,7 @@ def fly(
             check_camera(camera)
         if not config.no_gimbal:
             check_gimbal(link, autopilot)
-        search = config.params.mission
-        corner_m = search.search_radius_m * math.sqrt(2.0)  # the search square's corners
-        check_fence(link, autopilot, overview_ceiling_m(search, camera.intrinsics), corner_m)
+        check_fence(link, autopilot, mission_cls.envelope(params, camera.intrinsics))
         origin = scene.home
         if config.camera == "sim" and config.connect is not None:
             origin = place_scene(scene, home, config.scene_origin, say)
@@ -265,6 +286,7 @@ def fly(
             _abort(link, autopilot, recorder, "interrupted by the user: RTL sent")
             raise
         except Exception as exc:
+            _return_home(link, autopilot)  # never leave the vehicle flying a stale command
             _failed(recorder, exc)
             raise
         flight_wall_s, vehicle_s = time.perf_counter() - flight_wall0, clock() - vehicle0
@@ -296,6 +318,9 @@ def fly(
             flight_wall_s,
             runner.last_refusal,
             tuple(sorted(link.freshness.dropped_by_type.items())),
+            ref.name,
+            issubclass(mission_cls, SearchMission),
+            tuple(runner.results),
         )
         if recorder is not None:
             recorder.outcome(summary_record(summary))
@@ -304,17 +329,21 @@ def fly(
 
 def summary_record(s: FlightSummary) -> dict[str, object]:
     o = s.outcome
-    record: dict[str, object] = {
-        "status": o.status.value,
-        "reason": o.reason,
-        "visited": list(o.visited),
-        "matched_poi": o.matched_poi,
-        "match_score": round(o.match_score, 4),
-        "model_built": o.model_built,
+    record: dict[str, object] = {"status": o.status.value, "reason": o.reason}
+    if s.searched:
+        record |= {
+            "visited": list(o.visited),
+            "matched_poi": o.matched_poi,
+            "match_score": round(o.match_score, 4),
+            "model_built": o.model_built,
+        }
+    record |= {
         "route_length_m": round(s.route_length_m, 1),
         "flight_time_s": round(s.flight_time_s, 1),
         "frames": s.frames,
     }
+    for result in s.results:
+        record[f"result.{result.tag}"] = result.values
     e = s.evaluation
     if e.matched_building:
         record["matched_building"] = e.matched_building
@@ -373,39 +402,32 @@ def _builtin_sitl(config: FlyConfig, scene: Scene) -> Iterator[LockstepTransport
         transport.close()
 
 
-def flight_metadata(config: FlyConfig, scene: Scene) -> dict[str, dict[str, str]]:
-    """The recording's metadata: a function of the flight's inputs alone (no paths, ports,
-    dates or speed-up), so that the same inputs give the same file; ``flight`` holds what
-    re-flying needs besides the scene, the mission parameters and the target picture."""
+def describe(
+    config: FlyConfig, scene: Scene, mission: MissionRef, has_target: bool
+) -> FlightDescription:
+    """What the flight is, as the recording stores it: a function of the flight's inputs alone
+    (no paths, ports, dates or speed-up), so that the same inputs give the same file."""
     builtin = config.connect is None
-    return {
-        "mission": {"params": json.dumps(to_dict(config.params)), "tool_version": __version__},
-        "scene": {"name": scene.name, "json": json.dumps(scene_to_dict(scene))},
-        "seeds": {
-            "sitl": str(config.seed),
-            "camera_noise": str(config.seed) if config.noise else "",
-        },
-        "vehicle": {
-            "connect": "builtin" if builtin else str(config.connect),
-            "builtin": str(builtin).lower(),
-            "camera": config.camera,
-            "clock": "lockstep" if builtin else "wall",
-            "scene_origin": _origin_name(config),
-        },
-        "flight": {
-            "seed": str(config.seed),
-            "noise": json.dumps(config.noise),
-            "wind": json.dumps(list(config.wind)),
-            "link_outages_s": json.dumps([list(o) for o in config.link_outages_s]),
-            "vehicle_params": json.dumps([list(p) for p in config.vehicle_params]),
-            "hfov_deg": json.dumps(config.hfov_deg),
-            "size_px": json.dumps(list(config.size_px)),
-            "target": "file" if config.target else "scene",
-            # Written only when set, so the recordings of flights with a gimbal (the goldens
-            # among them) stay as they were.
-            **({"no_gimbal": "true"} if config.no_gimbal else {}),
-        },
-    }
+    return FlightDescription(
+        mission=mission,
+        params=to_dict(config.params),
+        scene=scene_to_dict(scene),
+        scene_name=scene.name,
+        connect=CONNECT_BUILTIN if builtin else str(config.connect),
+        camera=config.camera,
+        clock="lockstep" if builtin else "wall",
+        scene_origin=_origin_name(config),
+        seed=config.seed,
+        noise=config.noise,
+        wind=config.wind,
+        link_outages_s=config.link_outages_s,
+        vehicle_params=config.vehicle_params,
+        hfov_deg=config.hfov_deg,
+        size_px=config.size_px,
+        target=("file" if config.target else "scene") if has_target else "none",
+        no_gimbal=config.no_gimbal,
+        tool_version=__version__,
+    )
 
 
 def _origin_name(config: FlyConfig) -> str:
@@ -420,11 +442,15 @@ def _origin_name(config: FlyConfig) -> str:
 def _abort(
     link: VehicleLink, autopilot: Autopilot, recorder: MissionRecorder | None, why: str
 ) -> None:
-    with contextlib.suppress(LinkError):  # best effort: the link may be what failed
-        autopilot.return_home(link)
+    _return_home(link, autopilot)
     if recorder is not None:
         recorder.note(Level.WARNING, why)
         recorder.outcome({"status": "interrupted", "reason": why})
+
+
+def _return_home(link: VehicleLink, autopilot: Autopilot) -> None:
+    with contextlib.suppress(LinkError, OSError):  # best effort: the link may be what failed
+        autopilot.return_home(link)
 
 
 def _failed(recorder: MissionRecorder | None, exc: Exception) -> None:

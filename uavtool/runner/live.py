@@ -24,7 +24,7 @@ class LiveView:
         *,
         scene: Scene | None,
         params: dict[str, Any],
-        target_png: bytes,
+        target_png: bytes | None,
         clock_ns: ClockNs,
     ) -> None:
         from uavtool.view import open_viewer  # noqa: PLC0415 - rerun is heavy; only with --rerun
@@ -40,7 +40,8 @@ class LiveView:
         if scene is not None:
             self.logger.scene(scene)
         self.logger.params(params)
-        self.logger.target(target_png)
+        if target_png is not None:
+            self.logger.target(target_png)
         self._n = 0
         self.clock_ns = clock_ns
 

@@ -19,6 +19,7 @@ from uavtool.camera import CameraPose
 from uavtool.errors import InputError
 from uavtool.link import VehicleLink
 from uavtool.mavlink.dialect import mavlink as M
+from uavtool.mission.base import Envelope
 from uavtool.runner.camera import CameraSource
 
 ANSWER_S = 3.0
@@ -82,34 +83,36 @@ def check_gimbal(
 def check_fence(
     link: VehicleLink,
     autopilot: Autopilot,
-    climb_to_m: float,
-    reach_m: float,
+    envelope: Envelope,
     *,
     on_wait: Callable[[], None] | None = None,
 ) -> None:
     """PreflightError when the vehicle's geofence is on and keeps it from where the mission
-    must fly: an altitude limit below ``climb_to_m`` (the second overview, above home), or a
-    horizontal one closer than ``reach_m`` (the search square's corners). The vehicle would
-    refuse the move or breach the fence and return home mid-mission. A vehicle whose
-    parameters do not answer passes."""
+    must fly (``envelope``): an altitude limit below the highest it climbs, or a horizontal
+    one closer than the farthest it goes. The vehicle would refuse the move or breach the
+    fence and return home mid-mission. A vehicle whose parameters do not answer, or a mission
+    that does not say where it flies, passes."""
+    if envelope.altitude_m is None and envelope.distance_m is None:
+        return
     fence = autopilot.fence(param_reader(link, autopilot, on_wait))
     if fence is None:
         return
-    if fence.alt_max_m is not None and fence.alt_max_m < climb_to_m:
+    up, out = envelope.altitude_m, envelope.distance_m
+    if up is not None and fence.alt_max_m is not None and fence.alt_max_m < up:
         name = fence.alt_param
+        lower = f", or lower {envelope.shrink_up}" if envelope.shrink_up else ""
         raise PreflightError(
             f"the altitude fence is on at {name}={fence.alt_max_m:g} m but the mission climbs "
-            f"to {climb_to_m:.1f} m above home for its second overview: set {name}="
-            f"{math.ceil(climb_to_m) + 5}, or lower mission.search_radius_m or "
-            "mission.assumed_roof_m"
+            f"to {up:.1f} m above home{' ' if envelope.why_up else ''}{envelope.why_up}: "
+            f"set {name}={math.ceil(up) + 5}{lower}"
         )
-    if fence.radius_m is not None and fence.radius_m < reach_m:
+    if out is not None and fence.radius_m is not None and fence.radius_m < out:
         name = fence.radius_param
+        lower = f", or lower {envelope.shrink_out}" if envelope.shrink_out else ""
+        what = envelope.why_out or "the mission flies up to"
         raise PreflightError(
-            f"the fence is on at {name}={fence.radius_m:g} m from home but the search "
-            f"square's corners are {reach_m:.1f} m from home: set {name} above "
-            f"{math.ceil(reach_m)} (more for side photos of a building at the edge), or lower "
-            "mission.search_radius_m"
+            f"the fence is on at {name}={fence.radius_m:g} m from home but {what} "
+            f"{out:.1f} m from home: set {name} above {math.ceil(out)}{lower}"
         )
 
 

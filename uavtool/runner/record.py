@@ -26,6 +26,7 @@ from uavtool.geo import GeoPoint, geo_from_enu
 from uavtool.images import png_encode
 from uavtool.mission import Level, ModelBuilt, Observation, Output, Photo, Telemetry
 from uavtool.mission.codec import encode_observation, encode_output
+from uavtool.mission.outputs import Picture
 from uavtool.mission.schema import observation_schema, output_schema
 from uavtool.recording import (
     CameraCalibration,
@@ -50,6 +51,7 @@ from uavtool.recording.topics import (
     MODEL,
     OBSERVATIONS,
     OUTPUTS,
+    PICTURES,
     POSE,
     SCENE,
     TARGET,
@@ -141,8 +143,8 @@ class MissionRecorder:
         t = self.clock_ns()
         for out in outputs:
             self._outputs += 1
-            glb = out.glb if isinstance(out, ModelBuilt) else None
-            self.write_output(self._outputs, step, encode_output(out), glb=glb, log_time_ns=t)
+            data, blob = encode_output(out), output_bytes(out)
+            self.write_output(self._outputs, step, data, blob=blob, log_time_ns=t)
 
     def write_output(
         self,
@@ -150,11 +152,12 @@ class MissionRecorder:
         step: int,
         data: dict[str, Any],
         *,
-        glb: bytes | None = None,
+        blob: bytes | None = None,
         log_time_ns: int,
     ) -> None:
         """One output in its JSON form (``n``, ``step``, ``encode_output``), plus its Foxglove
-        view: an event as a log line, a model's ``glb`` as a 3D model."""
+        view: an event as a log line, a model's GLB (``blob``) as a 3D model, a picture's PNG
+        as an image."""
         self.writer.write_json(
             OUTPUTS,
             {"n": n, "step": step, **data},
@@ -163,8 +166,11 @@ class MissionRecorder:
         if data.get("type") == "Event":
             entry = LogEntry(_LEVELS[Level(data["level"])], str(data["text"]))
             self.writer.write(EVENTS, entry, log_time_ns=log_time_ns)
-        elif glb is not None:
-            self.writer.write(MODEL, Model3D(glb), log_time_ns=log_time_ns)
+        elif blob is not None and data.get("type") == "ModelBuilt":
+            self.writer.write(MODEL, Model3D(blob), log_time_ns=log_time_ns)
+        elif blob is not None and data.get("type") == "Picture":
+            picture = CompressedImage(blob, frame_id=str(data.get("tag", "")))
+            self.writer.write(PICTURES, picture, log_time_ns=log_time_ns)
         self._scene(self._markers.output(data), log_time_ns)
 
     def _scene(self, markers: SceneMarkers | None, t_ns: int) -> None:
@@ -179,6 +185,15 @@ class MissionRecorder:
 
     def outcome(self, record: dict[str, Any]) -> None:
         self.writer.add_metadata("outcome", {k: _text(v) for k, v in record.items()})
+
+
+def output_bytes(out: Output) -> bytes | None:
+    """The bytes an output carries beside its JSON form (which holds only their digest)."""
+    if isinstance(out, ModelBuilt):
+        return out.glb
+    if isinstance(out, Picture):
+        return out.png
+    return None
 
 
 def _text(value: Any) -> str:

@@ -24,19 +24,21 @@ from uavtool.mission import (
     Command,
     CommandResult,
     Event,
+    FlightMission,
     GoTo,
     Level,
     LinkLost,
     LinkRestored,
-    Mission,
     Observation,
     Outcome,
     Output,
     Photo,
+    Result,
     SetGimbal,
     TakePhoto,
     Telemetry,
 )
+from uavtool.plugins import guarded
 from uavtool.runner.camera import CameraSource
 from uavtool.runner.live import LiveView
 from uavtool.runner.record import MissionRecorder
@@ -79,7 +81,7 @@ class Runner:
         self,
         link: VehicleLink,
         camera: CameraSource,
-        mission: Mission,
+        mission: FlightMission,
         *,
         recorder: MissionRecorder | None,
         live: LiveView | None = None,
@@ -110,6 +112,7 @@ class Runner:
         self.frames = 0
         self.coalesced = 0  # telemetry snapshots superseded before the mission saw them
         self.route: list[tuple[int, tuple[float, float, float]]] = []  # (time_boot_ms, ENU)
+        self.results: list[Result] = []  # the mission's Result outputs
         self._queue: deque[Observation] = deque()
         self._pending: dict[int, tuple[int, int, int]] = {}
         self._unacked: dict[int, tuple[Command, int]] = {}  # MAV_CMD -> (command, last sent ms)
@@ -134,7 +137,7 @@ class Runner:
         if self.scene_origin is not None:
             east, north, _ = enu_from_geo(self.scene_origin, home)
             self.scene_offset = (east, north)
-        self._handle(self.mission.start())
+        self._handle(guarded(self.mission.start))
         clock = self.link.clock
         last_rx = clock()
         while True:
@@ -188,7 +191,7 @@ class Runner:
                 self.recorder.observation(self.step, obs, png)
             if self.live is not None:
                 self.live.observation(self.step, obs, png)
-            outputs = self.mission.step(obs)
+            outputs = guarded(self.mission.step, obs)
             self._handle(outputs)
 
     def _handle(self, outputs: list[Output]) -> None:
@@ -203,6 +206,8 @@ class Runner:
                 self._command(out)
             elif isinstance(out, Event):
                 self.progress(out.text, self.mission.last)
+            elif isinstance(out, Result):
+                self.results.append(out)
 
     # --- vehicle messages -------------------------------------------------------------------
 

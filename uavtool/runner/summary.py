@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+import json
 from typing import TYPE_CHECKING
 
 from uavtool.mission import Status, Telemetry
-from uavtool.terminal import counted
+from uavtool.terminal import counted, safe_text
 
 if TYPE_CHECKING:
     from uavtool.runner.fly import FlightSummary
@@ -26,25 +27,15 @@ def format_summary(s: FlightSummary) -> str:
         f"flight         {s.flight_time_s:.1f} s sim, route {s.route_length_m:.1f} m, "
         f"{counted(s.frames, 'photo')}, {s.wall_time_s:.1f} s wall",
     ]
-    visited = [
-        f"poi {k}" + (f" ({e.visited[i]})" if i < len(e.visited) else "")
-        for i, k in enumerate(o.visited)
-    ]
-    lines.append(f"visited        {', '.join(visited) if visited else 'none'}")
-    if o.matched_poi >= 0:
-        name = f" = building {e.matched_building!r}" if e.matched_building else ""
-        truth = ""
-        if e.target_building:
-            ok = "correct" if e.matched_building == e.target_building else "WRONG"
-            truth = f" ({ok}: the target is {e.target_building!r})"
-        lines.append(f"matched        poi {o.matched_poi}{name}, score {o.match_score:.3f}{truth}")
+    if s.searched:
+        lines += _search_lines(s)
     else:
-        lines.append("matched        nothing")
-    if o.model_built:
-        iou = f", IoU vs ground truth {e.model_iou:.3f}" if e.model_iou is not None else ""
-        lines.append(f"model          built{iou}")
-    else:
-        lines.append("model          not built")
+        lines.append(f"mission        {safe_text(s.mission)}")
+        for result in s.results:
+            values = safe_text(json.dumps(result.values))
+            if len(values) > 200:
+                values = values[:199] + "…"
+            lines.append(f"result         {safe_text(result.tag)}: {values}")
     if s.clearance_m is not None:
         lines.append(
             f"clearance      {s.clearance_m:.2f} m from building {s.clearance_building!r} "
@@ -68,3 +59,29 @@ def format_summary(s: FlightSummary) -> str:
             lines.append(f"last refusal   {s.last_refusal}")
     lines.append(f"recording      {s.recording if s.recording else '(not recorded)'}")
     return "\n".join(lines)
+
+
+def _search_lines(s: FlightSummary) -> list[str]:
+    """What the built-in search found: the points of interest visited, the match, the model."""
+    o, e = s.outcome, s.evaluation
+    lines = []
+    visited = [
+        f"poi {k}" + (f" ({e.visited[i]})" if i < len(e.visited) else "")
+        for i, k in enumerate(o.visited)
+    ]
+    lines.append(f"visited        {', '.join(visited) if visited else 'none'}")
+    if o.matched_poi >= 0:
+        name = f" = building {e.matched_building!r}" if e.matched_building else ""
+        truth = ""
+        if e.target_building:
+            ok = "correct" if e.matched_building == e.target_building else "WRONG"
+            truth = f" ({ok}: the target is {e.target_building!r})"
+        lines.append(f"matched        poi {o.matched_poi}{name}, score {o.match_score:.3f}{truth}")
+    else:
+        lines.append("matched        nothing")
+    if o.model_built:
+        iou = f", IoU vs ground truth {e.model_iou:.3f}" if e.model_iou is not None else ""
+        lines.append(f"model          built{iou}")
+    else:
+        lines.append("model          not built")
+    return lines
