@@ -126,7 +126,7 @@ def _install_package(site: Path) -> None:
     info = site / "hop_pkg-1.2.3.dist-info"
     info.mkdir()
     (info / "METADATA").write_text("Metadata-Version: 2.1\nName: hop-pkg\nVersion: 1.2.3\n")
-    (info / "entry_points.txt").write_text('[uavtool.missions]\nhop = hop_pkg:HopMission\n')
+    (info / "entry_points.txt").write_text("[uavtool.missions]\nhop = hop_pkg:HopMission\n")
     (info / "top_level.txt").write_text("hop_pkg\n")
     (info / "RECORD").write_text("")
 
