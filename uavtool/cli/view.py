@@ -73,6 +73,7 @@ def view(
         f"{counted(c.frames, 'frame')}, {counted(c.telemetry, 'telemetry sample')}, "
         f"{counted(c.shapes, 'shape')}, {counted(c.recognitions, 'recognition')}, "
         f"{counted(c.models, 'model')}"
+        + (f", {counted(c.pictures, 'picture')}" if c.pictures else "")
     )
     if save is not None:
         click.echo(f"wrote {save}: {summary}")

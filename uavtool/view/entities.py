@@ -97,6 +97,11 @@ def log_target(rec: rr.RecordingStream, paths: Paths, *, png: bytes) -> None:
     rec.log(paths.target, rr.EncodedImage(contents=png, media_type="image/png"), static=True)
 
 
+def log_picture(rec: rr.RecordingStream, paths: Paths, *, tag: str, png: bytes) -> None:
+    """An image the mission made (a mosaic, a map), at the time it was made."""
+    rec.log(paths.picture(tag), rr.EncodedImage(contents=png, media_type="image/png"))
+
+
 def log_photo(
     rec: rr.RecordingStream,
     paths: Paths,

@@ -8,6 +8,7 @@ logged at the time of the latest observation, the one that produced them.
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -38,6 +39,7 @@ class LogCounts:
     recognitions: int
     models: int
     texts: int
+    pictures: int = 0
 
 
 def statustext_level(severity: int) -> str:
@@ -62,6 +64,7 @@ class MissionLogger:
         self._photo_tags: list[str] = []
         self._mode: tuple[str, bool] | None = None
         self._texts = 0
+        self._pictures = 0
         ent.log_world(rec, self.paths)
         log_series_styles(rec, self.paths)
 
@@ -127,6 +130,12 @@ class MissionLogger:
         else:  # a command to the vehicle (GoTo, TakePhoto …): one line each
             self._text("commands", _command_text(out), "DEBUG")
 
+    def picture(self, tag: str, png: bytes, *, log_time_ns: int | None = None) -> None:
+        """An image the mission made (its PNG, from ``/mission/pictures``)."""
+        set_times(self.rec, vehicle_ns=self._vehicle_ns, log_ns=log_time_ns)
+        ent.log_picture(self.rec, self.paths, tag=tag, png=png)
+        self._pictures += 1
+
     def statustext(self, severity: int, text: str, *, log_time_ns: int | None = None) -> None:
         """A MAVLink STATUSTEXT from the vehicle."""
         set_times(self.rec, vehicle_ns=self._vehicle_ns, log_ns=log_time_ns)
@@ -155,6 +164,7 @@ class MissionLogger:
             recognitions=f.recognitions,
             models=f.models,
             texts=self._texts,
+            pictures=self._pictures,
         )
 
     # --- observations ----------------------------------------------------------------------------
@@ -234,6 +244,10 @@ _OUTPUT_HANDLERS: dict[str, Callable[[MissionLogger, Mapping[str, Any]], None]] 
     "DiagonalView": lambda self, out: self.findings.diagonal(out),
     "ModelBuilt": lambda self, out: self.findings.model(out),
     "Outcome": MissionLogger._outcome,
+    "Result": lambda self, out: self._text(
+        "mission", f"result {out.get('tag')}: {json.dumps(out.get('values'))[:500]}", "INFO"
+    ),
+    "Picture": lambda _self, _out: None,  # its image comes from /mission/pictures
 }
 
 

@@ -110,6 +110,10 @@ class Paths:
     def target(self) -> str:
         return self._at("target")
 
+    def picture(self, tag: str) -> str:
+        """An image the mission made (a ``Picture`` output), by its tag."""
+        return self._at(f"pictures/{rr_name(tag)}")
+
     @property
     def target_shapes(self) -> str:
         return self._at("target/shapes")
@@ -152,3 +156,8 @@ class Paths:
 def _safe(name: str) -> str:
     # Entity path parts are identifiers; scene names are free text.
     return "".join(c if c.isalnum() or c in "_-" else "_" for c in name) or "_"
+
+
+def rr_name(text: str) -> str:
+    """``text`` as one entity-path part: letters, digits, ``-`` and ``_`` (others as ``_``)."""
+    return "".join(c if c.isalnum() or c in "-_" else "_" for c in text)[:64] or "_"

@@ -10,6 +10,8 @@ from collections import defaultdict, deque
 from pathlib import Path
 from typing import Any
 
+from uavtool.errors import InputError
+from uavtool.flight import scene_data
 from uavtool.geo import GeoPoint
 from uavtool.recording import CompressedImage, JsonDocument, LogEntry, RecordingReader
 from uavtool.recording.topics import FRAMES, IMAGE, TARGET, TELEMETRY, VEHICLE_EVENTS, VISION
@@ -64,12 +66,12 @@ def log_recorded_flight(path: str | Path, reader: RecordingReader, logger: Missi
 
 def log_scene(path: str | Path, metadata: dict[str, dict[str, str]], logger: MissionLogger) -> None:
     """The scene in a recording's ``scene`` metadata, if any, to ``logger``."""
-    scene_json = metadata.get("scene", {}).get("json")
-    if scene_json:
-        try:
-            logger.scene(scene_from_dict(json.loads(scene_json), source=f"{path}: scene metadata"))
-        except (ValueError, SceneError) as exc:
-            raise ViewError(f"{path}: scene metadata unreadable: {exc}") from None
+    try:
+        data = scene_data(metadata, source=str(path))
+        if data is not None:
+            logger.scene(scene_from_dict(data, source=f"{path}: scene metadata"))
+    except (InputError, SceneError) as exc:
+        raise ViewError(f"{path}: scene metadata unreadable: {exc}") from None
 
 
 def _setup(path: str | Path, metadata: dict[str, dict[str, str]], logger: MissionLogger) -> None:

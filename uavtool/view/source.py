@@ -8,21 +8,18 @@ home from HOME_POSITION, and the ground truth from the ``scene`` metadata.
 
 from __future__ import annotations
 
-import json
 from collections import deque
 from pathlib import Path
 
+from uavtool.errors import InputError
+from uavtool.flight import mission_of
 from uavtool.geo import GeoPoint
 from uavtool.recording import CompressedImage, JsonDocument, LogEntry, RecordingReader
+from uavtool.recording.topics import EVENTS, IMAGE, OBSERVATIONS, OUTPUTS, PICTURES, TARGET
 from uavtool.view.errors import ViewError
 from uavtool.view.logger import MissionLogger
 from uavtool.view.recorded import is_recorded_flight, log_recorded_flight, log_scene
 
-OBSERVATIONS = "/mission/observations"
-OUTPUTS = "/mission/outputs"
-IMAGE = "/camera/image"
-TARGET = "/mission/target"
-EVENTS = "/mission/events"
 STATUSTEXT = "/mavlink/in/STATUSTEXT"
 HOME_POSITION = "/mavlink/in/HOME_POSITION"
 _LEVEL_NAMES = {1: "debug", 2: "info", 3: "warning", 4: "error", 5: "error"}
@@ -41,12 +38,15 @@ def log_recording(path: str | Path, logger: MissionLogger) -> None:
         reader.require_metadata(("scene", "mission"))  # else the view would lack them quietly
         metadata = dict(reader.metadata)
         _setup(path, reader, metadata, logger)
-        wanted = [t for t in (OBSERVATIONS, OUTPUTS, IMAGE, EVENTS, STATUSTEXT) if t in present]
+        topics = (OBSERVATIONS, OUTPUTS, IMAGE, PICTURES, EVENTS, STATUSTEXT)
+        wanted = [t for t in topics if t in present]
         images: deque[bytes] = deque()
         for entry in reader.entries(wanted):
             value, t_ns = entry.value, entry.log_time_ns
             if entry.topic == IMAGE and isinstance(value, CompressedImage):
                 images.append(value.data)
+            elif entry.topic == PICTURES and isinstance(value, CompressedImage):
+                logger.picture(value.frame_id, value.data, log_time_ns=t_ns)
             elif isinstance(value, JsonDocument) and entry.topic == OBSERVATIONS:
                 obs = value.payload
                 png = images.popleft() if obs.get("type") == "Photo" and images else None
@@ -74,12 +74,11 @@ def _setup(
     logger: MissionLogger,
 ) -> None:
     log_scene(path, metadata, logger)
-    params_json = metadata.get("mission", {}).get("params")
-    if params_json:
-        try:
-            logger.params(json.loads(params_json))
-        except ValueError:
-            raise ViewError(f"{path}: mission metadata: params are not JSON") from None
+    try:
+        _, params = mission_of(metadata, source=str(path))
+    except InputError as exc:
+        raise ViewError(str(exc)) from None
+    logger.params(params)
     topics = set(reader.topics())
     if TARGET in topics:
         for entry in reader.entries([TARGET]):
