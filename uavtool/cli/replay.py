@@ -119,6 +119,7 @@ def replay(
             quiet=quiet,
         )
         return
+    from uavtool.mission import SearchMission
     from uavtool.mission.params import parse_settings, with_overrides
     from uavtool.recording.files import refuse_same_file
     from uavtool.replay import load_flight, reanalyse_frames
@@ -181,7 +182,7 @@ def replay(
     if not vision_only:
         with (
             click.progressbar(length=len(flight.observations), label="replay", file=sys.stderr)
-            if not quiet
+            if not quiet and sys.stderr.isatty()  # else click prints its label alone
             else _NoBar() as bar
         ):
             last = [0]
@@ -201,7 +202,12 @@ def replay(
             click.echo(f"first difference: {result.first_difference.describe()}")
         if result.divergence is not None:
             click.echo(f"diverged at step {result.divergence.step}: {result.divergence.reason}")
-            click.echo("mission stopped there; per-frame vision continues on every recorded frame")
+            if issubclass(flight.mission, SearchMission):
+                click.echo(
+                    "mission stopped there; per-frame vision continues on every recorded frame"
+                )
+            else:
+                click.echo("mission stopped there")
         if out is not None:
             write_replay(
                 recording, out, result.outputs, result.blobs, params, outcome=result.outcome

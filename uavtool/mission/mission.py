@@ -32,7 +32,9 @@ from uavtool.nav.geometry import point_polygon_distance, segment_polygon_distanc
 
 
 class SearchMission(FlightMission):
-    """One flight of the built-in mission. ``inputs.target_rgb`` is the target building
+    """Find the building in the target picture, photograph it from three sides, model it.
+
+    One flight of the built-in mission. ``inputs.target_rgb`` is the target building
     photographed from above; its largest shape is what the mission looks for.
     Raises :class:`MissionInputError` if there is no target picture or it holds no shape.
     """
