@@ -71,6 +71,7 @@ from uavtool.mission.outputs import (
     TakePhoto,
 )
 from uavtool.mission.params import FlightParams
+from uavtool.vision.detection import Detection, Frame
 
 __all__ = [
     "HORIZONTAL_DEG",
@@ -79,10 +80,12 @@ __all__ = [
     "CameraPose",
     "Command",
     "CommandResult",
+    "Detection",
     "Envelope",
     "Event",
     "FlightMission",
     "FlightParams",
+    "Frame",
     "GoTo",
     "Intrinsics",
     "Level",

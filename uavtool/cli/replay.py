@@ -9,6 +9,7 @@ from pathlib import Path
 import click
 
 from uavtool.errors import FailureError, InputError
+from uavtool.terminal import counted
 
 
 @click.command()
@@ -39,6 +40,14 @@ from uavtool.errors import FailureError, InputError
     help="Write the replay as a new recording.",
 )
 @click.option("--vision-only", is_flag=True, help="Only re-run vectorize/match on every frame.")
+@click.option(
+    "--vision",
+    "vision",
+    default=None,
+    metavar="module:function",
+    help="Run your function on every recorded photo and write its detections to a new "
+    "recording (--out, default RECORDING.vision.mcap) beside the original's channels.",
+)
 @click.option(
     "--target",
     type=click.Path(dir_okay=False, path_type=Path),
@@ -81,6 +90,7 @@ def replay(
     params_file: Path | None,
     out: Path | None,
     vision_only: bool,
+    vision: str | None,
     target: Path | None,
     update_golden: bool,
     refly: bool,
@@ -100,8 +110,18 @@ def replay(
       uavtool replay --check recordings/golden --out check.parquet  # a folder or a glob, on Dask
       uavtool replay --vision-only recorded.mcap --target red.png --out analysed.mcap
       uavtool replay --vision-only 'flights/*.mcap' --target red.png --out photos.csv
+      uavtool replay flight.mcap --vision my_detector:detect --out detected.mcap
     """
     from uavtool.cli.replay_batch import is_batch, replay_batch
+
+    if vision is not None:
+        others = check or settings or params_file or vision_only or target or refly
+        if others or update_golden or mission:
+            raise click.UsageError("--vision takes only --out")
+        if is_batch(recording):
+            raise click.UsageError("--vision takes one recording")
+        _vision(recording, vision, out)
+        return
 
     if is_batch(recording):  # a folder or a glob: many recordings on Dask, one table
         if refly or update_golden or mission:
@@ -219,6 +239,18 @@ def replay(
                 click.echo(change.describe())
     if check and not vision_only and result.first_difference is not None:
         sys.exit(1)
+
+
+def _vision(recording: Path, spec: str, out: Path | None) -> None:
+    from uavtool.replay.vision import load_function, run_vision
+
+    function = load_function(spec)
+    target = out if out is not None else recording.with_suffix(".vision.mcap")
+    run = run_vision(recording, target, spec, function)
+    click.echo(
+        f"{recording}: {spec} on {counted(run.frames, 'photo')}: "
+        f"{counted(run.detections, 'detection')}; wrote {run.out}"
+    )
 
 
 def _refly(recording: Path, out: Path | None, mission: str | None) -> None:

@@ -74,6 +74,7 @@ def view(
         f"{counted(c.shapes, 'shape')}, {counted(c.recognitions, 'recognition')}, "
         f"{counted(c.models, 'model')}"
         + (f", {counted(c.pictures, 'picture')}" if c.pictures else "")
+        + (f", {counted(c.detections, 'detection')}" if c.detections else "")
     )
     if save is not None:
         click.echo(f"wrote {save}: {summary}")

@@ -49,13 +49,16 @@ def recover(src: str | Path, dst: str | Path) -> RecoverResult:
     return RecoverResult(count, channels, metadata, problem, dropped, lost)
 
 
-def _copy(reader: RecordingReader, out: Any, recovered: dict[str, str]) -> tuple[int, int, int]:
+def start_copy(
+    reader: RecordingReader, out: Any, record: tuple[str, dict[str, str]]
+) -> tuple[Any, dict[int, int]]:
+    """An MCAP writer on ``out`` with ``reader``'s metadata (plus ``record``), schemas and
+    channels registered, ready for the messages; and the channel ids, reader's → writer's."""
     writer: Any = McapWriter(out, compression=CompressionType.ZSTD)
     writer.start(profile="", library=LIBRARY)
-    metadata = reader.metadata
-    for name, record in metadata:
-        writer.add_metadata(name, record)
-    writer.add_metadata(RECOVERED_METADATA, recovered)
+    for name, values in reader.metadata:
+        writer.add_metadata(name, values)
+    writer.add_metadata(*record)
     schema_ids = {0: 0}
     for sid, schema in sorted(reader.schemas.items()):
         schema_ids[sid] = writer.register_schema(schema.name, schema.encoding, schema.data)
@@ -67,6 +70,12 @@ def _copy(reader: RecordingReader, out: Any, recovered: dict[str, str]) -> tuple
             schema_ids.get(channel.schema_id, 0),
             dict(channel.metadata),
         )
+    return writer, channel_ids
+
+
+def _copy(reader: RecordingReader, out: Any, recovered: dict[str, str]) -> tuple[int, int, int]:
+    writer, channel_ids = start_copy(reader, out, (RECOVERED_METADATA, recovered))
+    metadata = reader.metadata
     count = 0
     for message in reader.messages():
         writer.add_message(

@@ -102,6 +102,48 @@ def log_picture(rec: rr.RecordingStream, paths: Paths, *, tag: str, png: bytes) 
     rec.log(paths.picture(tag), rr.EncodedImage(contents=png, media_type="image/png"))
 
 
+def log_detections(
+    rec: rr.RecordingStream, paths: Paths, *, detections: Sequence[Mapping[str, Any]]
+) -> int:
+    """A vision function's detections (``replay --vision``) over the latest frame: boxes,
+    polygons and points, labelled with their scores. Returns how many were drawn."""
+    base = f"{paths.overlay}/detections"
+    boxes, box_labels, strips, strip_labels, points, point_labels = [], [], [], [], [], []
+    for d in detections:
+        label = " ".join(p for p in (str(d.get("label", "")), _score_text(d.get("score"))) if p)
+        if "box_px" in d:
+            boxes.append([float(v) for v in d["box_px"]])
+            box_labels.append(label)
+        if "polygon_px" in d:
+            ring = [[float(x), float(y)] for x, y in d["polygon_px"]]
+            strips.append([*ring, ring[0]])
+            strip_labels.append(label)
+        for x, y in d.get("points_px", ()):
+            points.append([float(x), float(y)])
+            point_labels.append(label)
+    rec.log(
+        f"{base}/boxes",
+        rr.Boxes2D(array=boxes, array_format=rr.Box2DFormat.XYXY, labels=box_labels)
+        if boxes
+        else rr.Clear(recursive=False),
+    )
+    rec.log(
+        f"{base}/polygons",
+        rr.LineStrips2D(strips, labels=strip_labels) if strips else rr.Clear(recursive=False),
+    )
+    rec.log(
+        f"{base}/points",
+        rr.Points2D(points, labels=point_labels, radii=3.0)
+        if points
+        else rr.Clear(recursive=False),
+    )
+    return len(detections)
+
+
+def _score_text(score: object) -> str:
+    return f"{score:.2f}" if isinstance(score, (int, float)) else ""
+
+
 def log_photo(
     rec: rr.RecordingStream,
     paths: Paths,

@@ -40,6 +40,7 @@ class LogCounts:
     models: int
     texts: int
     pictures: int = 0
+    detections: int = 0
 
 
 def statustext_level(severity: int) -> str:
@@ -65,6 +66,7 @@ class MissionLogger:
         self._mode: tuple[str, bool] | None = None
         self._texts = 0
         self._pictures = 0
+        self._detections = 0
         ent.log_world(rec, self.paths)
         log_series_styles(rec, self.paths)
 
@@ -136,6 +138,14 @@ class MissionLogger:
         ent.log_picture(self.rec, self.paths, tag=tag, png=png)
         self._pictures += 1
 
+    def detections(self, payload: Mapping[str, Any], *, log_time_ns: int | None = None) -> None:
+        """A vision function's detections on one frame (``/vision/detections``)."""
+        set_times(self.rec, vehicle_ns=self._vehicle_ns, log_ns=log_time_ns)
+        found = payload.get("detections")
+        if isinstance(found, list):
+            items = [d for d in found if isinstance(d, Mapping)]
+            self._detections += ent.log_detections(self.rec, self.paths, detections=items)
+
     def statustext(self, severity: int, text: str, *, log_time_ns: int | None = None) -> None:
         """A MAVLink STATUSTEXT from the vehicle."""
         set_times(self.rec, vehicle_ns=self._vehicle_ns, log_ns=log_time_ns)
@@ -165,6 +175,7 @@ class MissionLogger:
             models=f.models,
             texts=self._texts,
             pictures=self._pictures,
+            detections=self._detections,
         )
 
     # --- observations ----------------------------------------------------------------------------

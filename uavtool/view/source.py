@@ -15,6 +15,7 @@ from uavtool.errors import InputError
 from uavtool.flight import mission_of
 from uavtool.geo import GeoPoint
 from uavtool.recording import CompressedImage, JsonDocument, LogEntry, RecordingReader
+from uavtool.recording.annotations import DETECTIONS
 from uavtool.recording.topics import EVENTS, IMAGE, OBSERVATIONS, OUTPUTS, PICTURES, TARGET
 from uavtool.view.errors import ViewError
 from uavtool.view.logger import MissionLogger
@@ -38,7 +39,7 @@ def log_recording(path: str | Path, logger: MissionLogger) -> None:
         reader.require_metadata(("scene", "mission"))  # else the view would lack them quietly
         metadata = dict(reader.metadata)
         _setup(path, reader, metadata, logger)
-        topics = (OBSERVATIONS, OUTPUTS, IMAGE, PICTURES, EVENTS, STATUSTEXT)
+        topics = (OBSERVATIONS, OUTPUTS, IMAGE, PICTURES, DETECTIONS, EVENTS, STATUSTEXT)
         wanted = [t for t in topics if t in present]
         images: deque[bytes] = deque()
         for entry in reader.entries(wanted):
@@ -54,6 +55,8 @@ def log_recording(path: str | Path, logger: MissionLogger) -> None:
             elif isinstance(value, JsonDocument) and entry.topic == OUTPUTS:
                 out = value.payload
                 logger.output(int(out.get("n", 0)), out, log_time_ns=t_ns)
+            elif isinstance(value, JsonDocument) and entry.topic == DETECTIONS:
+                logger.detections(value.payload, log_time_ns=t_ns)
             elif isinstance(value, JsonDocument) and entry.topic == STATUSTEXT:
                 msg = value.payload
                 logger.statustext(

@@ -1,0 +1,86 @@
+"""Your vision on recorded frames: ``replay REC --vision module:function`` writes the
+function's detections beside the original's channels, for Foxglove, Lichtblick and Rerun."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import jsonschema
+import pytest
+from click.testing import CliRunner
+from foxglove_schemas_protobuf.ImageAnnotations_pb2 import ImageAnnotations
+
+from uavtool.cli import cli
+from uavtool.recording import RecordingReader
+
+GOLDEN = Path(__file__).parents[2] / "recordings" / "golden" / "paper.mcap"
+
+
+def _run(*args: str) -> tuple[int, str]:
+    result = CliRunner().invoke(cli, list(args))
+    return result.exit_code, result.output
+
+
+def _messages(path: Path) -> list[tuple[str, int, bytes]]:
+    with RecordingReader(path) as reader:
+        return [(m.channel.topic, m.log_time_ns, m.data) for m in reader.messages()]
+
+
+def test_detections_are_written_beside_the_original(tmp_path: Path) -> None:
+    out = tmp_path / "detected.mcap"
+    code, text = _run("replay", str(GOLDEN), "--vision", "tests.plugins.detector:red_roofs",
+                      "--out", str(out))  # fmt: skip
+    assert code == 0, text
+    assert "on 10 photos: 7 detections" in text
+    before, after = _messages(GOLDEN), _messages(out)
+    kept = [m for m in after if not m[0].startswith("/vision/")]
+    assert kept == before  # every original message, unchanged and in order
+    with RecordingReader(out) as reader:
+        meta = dict(reader.metadata)
+        schema = json.loads(
+            next(
+                reader.schemas[c.schema_id].data
+                for c in reader.channels.values()
+                if c.topic == "/vision/detections"
+            )
+        )
+        found = [e.value.payload for e in reader.entries(["/vision/detections"])]
+        images = {e.log_time_ns for e in reader.entries(["/camera/image"])}
+    assert meta["vision"] == {"function": "tests.plugins.detector:red_roofs", "source": GOLDEN.name}
+    assert len(found) == 10 and sum(len(f["detections"]) for f in found) == 7
+    for payload in found:
+        jsonschema.validate(payload, schema)  # a standard validator accepts every message
+    annotations = [(t, d) for topic, t, d in after if topic == "/vision/annotations"]
+    assert {t for t, _ in annotations} == images  # stamped like the frame they belong to
+    for (t, data), payload in zip(annotations, found, strict=True):
+        pb = ImageAnnotations.FromString(data)
+        assert (pb.points and len(pb.points) == 3 * len(payload["detections"])) or not pb.points
+        for det in payload["detections"]:
+            x0, y0, x1, y1 = det["box_px"]
+            box = pb.points[0]
+            assert [(p.x, p.y) for p in box.points] == [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+            assert box.timestamp.seconds * 10**9 + box.timestamp.nanos == t
+            assert pb.texts[0].text.startswith("red roof 0.")
+    shown = CliRunner().invoke(cli, ["view", str(out), "--save", str(tmp_path / "d.rrd")])
+    assert shown.exit_code == 0 and "7 detections" in shown.output, shown.output
+
+
+@pytest.mark.parametrize(
+    ("function", "code", "words"),
+    [
+        ("tests.plugins.detector:dicts", 1, "returned a dict, expected uavtool.api.Detection"),
+        ("tests.plugins.detector:raises", 1, "on frame 3 (poi-0) raised ValueError: model weights"),
+        ("tests.plugins.detector:nosuch", 2, "tests.plugins.detector has no function nosuch"),
+        ("no_module_here:f", 2, "cannot import no_module_here"),
+        ("not a spec", 2, "expected module:function"),
+    ],
+)
+def test_a_broken_function_writes_nothing(
+    tmp_path: Path, function: str, code: int, words: str
+) -> None:
+    out = tmp_path / "out.mcap"
+    exit_code, text = _run("replay", str(GOLDEN), "--vision", function, "--out", str(out))
+    assert exit_code == code, text
+    assert words in text and "Traceback" not in text and len(text.strip().splitlines()) == 1
+    assert not out.exists() and list(tmp_path.iterdir()) == []
