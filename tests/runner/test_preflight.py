@@ -84,7 +84,7 @@ def test_no_gimbal_flies_the_search_and_ends_partial(tmp_path: Path) -> None:
 def test_a_vehicle_that_refuses_is_heard_and_summarised(monkeypatch: pytest.MonkeyPatch) -> None:
     """A mount type set at run time on a vehicle that booted without one: ArduCopter's
     "Arm: Mount: check TYPE" is printed as it arrives and repeated in the summary."""
-    monkeypatch.setattr("uavtool.runner.fly.BOOT_ONLY_PARAMS", frozenset())  # set after boot
+    monkeypatch.setattr("uavtool.runner.backends.BOOT_ONLY_PARAMS", frozenset())  # set after boot
     heard: list[str] = []
     config = FlyConfig(
         no_record=True,

@@ -13,8 +13,8 @@ import dataclasses
 import itertools
 import math
 import time
-from collections.abc import Callable, Iterator
-from contextlib import ExitStack, contextmanager
+from collections.abc import Callable
+from contextlib import ExitStack
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
@@ -26,28 +26,27 @@ from uavtool.camera import CameraPose, Intrinsics
 from uavtool.errors import InputError, LinkError
 from uavtool.flight import CONNECT_BUILTIN, FlightDescription
 from uavtool.images import png_decode, png_encode
-from uavtool.link import Clock, Transport, VehicleLink, open_transport
+from uavtool.link import VehicleLink
 from uavtool.mission import Level, MissionInputs, Outcome, SearchMission
 from uavtool.mission.outputs import Result
 from uavtool.mission.params import to_dict, with_overrides
 from uavtool.plugins import DEFAULT, MissionRef, create_mission, resolve
 from uavtool.recording import RecordingError, RecordingWriter
 from uavtool.recording.files import atomic_output
+from uavtool.runner.backends import open_backend
 from uavtool.runner.camera import open_camera
-from uavtool.runner.evaluate import Evaluation, closest_clearance, evaluate
+from uavtool.runner.evaluate import Evaluation, evaluate
 from uavtool.runner.live import LiveView
 from uavtool.runner.params import set_vehicle_params
-from uavtool.runner.placement import SCENE_ORIGINS, place_scene
+from uavtool.runner.placement import SCENE_ORIGINS
 from uavtool.runner.preflight import check_camera, check_fence, check_gimbal, check_home
-from uavtool.runner.record import ClockNs, MissionRecorder
-from uavtool.runner.runner import Progress, Runner, RunnerConfig
+from uavtool.runner.record import MissionRecorder
+from uavtool.runner.runner import Progress, Runner
 from uavtool.world import Scene, load_scene, render, scene_to_dict
 
 if TYPE_CHECKING:
-    from uavtool.sitl.lockstep import LockstepTransport
+    pass
 
-BOOT_ONLY_PARAMS = frozenset({"MNT1_TYPE"})
-"""Parameters ArduPilot reads at boot only: the built-in vehicle boots with them."""
 _TARGET_VIEW_M = 30.0  # the default target picture: from this far above its roof
 
 
@@ -183,18 +182,8 @@ def fly(
     )
     with ExitStack() as stack:
         stack.callback(camera.close)
-        if config.connect is None:
-            lockstep = stack.enter_context(_builtin_sitl(config, scene))
-            transport: Transport = lockstep
-            clock: Clock = lockstep.clock
-            clock_ns: ClockNs = lockstep.recording_ns
-            true_pose: Callable[[], CameraPose] | None = lockstep.camera_pose
-            pace = "as fast as it can" if config.speedup is None else f"≤ {config.speedup:g}x"
-            say(f"built-in SITL in lockstep ({pace}), scene {scene.name!r}")
-        else:
-            transport = open_transport(config.connect, timeout_s=config.connect_timeout_s)
-            stack.callback(transport.close)
-            clock, clock_ns, true_pose = time.monotonic, time.time_ns, None
+        backend = stack.enter_context(open_backend(config, scene, say))
+        clock, clock_ns = backend.clock, backend.clock_ns
         path = None if config.no_record else (config.record or default_recording_path())
         recorder = None
         flown: list[bool] = []  # set once the mission starts: from then on the file is kept
@@ -226,12 +215,11 @@ def fly(
             stack.callback(live.close)
             if live.url:
                 say(f"Rerun web viewer at {live.url}")
-        # The built-in vehicle speaks first; announcing ourselves would change its recordings.
         link = VehicleLink(
-            transport,
+            backend.transport,
             tap=recorder.mavlink if recorder else None,
             clock=clock,
-            announce=config.connect is not None,
+            announce=backend.announce,
         )
         link.wait_vehicle(config.connect_timeout_s)
         home = link.state.home
@@ -257,26 +245,20 @@ def fly(
         if not config.no_gimbal:
             check_gimbal(link, autopilot)
         check_fence(link, autopilot, mission_cls.envelope(params, camera.intrinsics))
-        origin = scene.home
-        if config.camera == "sim" and config.connect is not None:
-            origin = place_scene(scene, home, config.scene_origin, say)
+        simulated = config.camera == "sim"
         runner = Runner(
             link,
             camera,
             mission,
             recorder=recorder,
             live=live,
-            scene_origin=origin if config.camera == "sim" else None,
-            true_pose=true_pose,
+            scene_origin=backend.scene_origin(scene, home, say) if simulated else None,
+            true_pose=backend.true_pose,
             progress=progress,
             vehicle_says=vehicle_says,
             fixed_camera=config.no_gimbal,
             autopilot=autopilot,
-            # A real link may lose a command, its ACK or a position target: send them again
-            # each second (lockstep loses nothing, and its recordings stay byte for byte).
-            config=RunnerConfig(command_resend_s=1.0, target_resend_s=1.0)
-            if config.connect is not None
-            else RunnerConfig(),
+            config=backend.runner_config,
         )
         flight_wall0, vehicle0 = time.perf_counter(), clock()
         flown.append(True)
@@ -290,19 +272,12 @@ def fly(
             _failed(recorder, exc)
             raise
         flight_wall_s, vehicle_s = time.perf_counter() - flight_wall0, clock() - vehicle0
-        evaluation = evaluate(runner, scene if config.camera == "sim" else None)
+        evaluation = evaluate(runner, scene if simulated else None)
         clearance_m: float | None = None
         clearance_building = ""
-        if config.connect is None:
-            clearance_m = lockstep.vehicle.closest_clearance_m
-            clearance_building = lockstep.vehicle.closest_obstacle
-        elif config.camera == "sim":
-            clearance_m, clearance_building = closest_clearance(
-                [p for _, p in runner.route],
-                scene,
-                body_radius_m=_body_radius_m(),
-                offset_en=runner.scene_offset,
-            )
+        if backend.builtin or simulated:  # the built-in vehicle's own, or along the telemetry
+            route = [p for _, p in runner.route]
+            clearance_m, clearance_building = backend.clearance(route, scene, runner.scene_offset)
         summary = FlightSummary(
             outcome,
             evaluation,
@@ -369,37 +344,6 @@ def _read_target(path: Path) -> bytes:
         raise InputError(f"--target {path}: cannot read: {exc.strerror}") from None
     png_decode(data, where=f"--target {path}")  # fail now, not mid-flight
     return data
-
-
-@contextmanager
-def _builtin_sitl(config: FlyConfig, scene: Scene) -> Iterator[LockstepTransport]:
-    # Only when flying the built-in vehicle: a real one needs none of the simulator.
-    from uavtool.sitl import SitlConfig  # noqa: PLC0415
-    from uavtool.sitl.lockstep import SIM_EPOCH_UNIX_S, LockstepTransport  # noqa: PLC0415
-    from uavtool.world.obstacles import scene_obstacles  # noqa: PLC0415
-
-    # The vehicle `fly` starts has a servo mount (ArduCopter's default has none) and holds
-    # its nose on the way (WP_YAW_BEHAVIOR 0): the mission photographs from known headings.
-    mount = 0.0 if config.no_gimbal else 1.0
-    boot: tuple[tuple[str, float], ...] = (("MNT1_TYPE", mount), ("WP_YAW_BEHAVIOR", 0.0))
-    boot += tuple((n, v) for n, v in config.vehicle_params if n in BOOT_ONLY_PARAMS)
-    sitl_config = SitlConfig(
-        params=boot,
-        endpoints=(),
-        obstacles=scene_obstacles(scene),
-        home=scene.home,
-        home_heading_deg=scene.home_heading_deg,
-        seed=config.seed,
-        wind_speed_ms=config.wind[0],
-        wind_dir_deg=config.wind[1],
-        link_outages_s=config.link_outages_s,
-        start_unix_us=SIM_EPOCH_UNIX_S * 1_000_000,
-    )
-    transport = LockstepTransport(sitl_config, speedup=config.speedup)
-    try:
-        yield transport
-    finally:
-        transport.close()
 
 
 def describe(
@@ -472,9 +416,3 @@ def _route_length(route: list[tuple[int, tuple[float, float, float]]]) -> float:
 
 def _flight_time(route: list[tuple[int, tuple[float, float, float]]]) -> float:
     return (route[-1][0] - route[0][0]) / 1000.0 if len(route) > 1 else 0.0
-
-
-def _body_radius_m() -> float:
-    from uavtool.sitl import SitlConfig  # noqa: PLC0415 - the simulator's default body
-
-    return SitlConfig().body_radius_m
