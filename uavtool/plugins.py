@@ -16,6 +16,7 @@ from __future__ import annotations
 import importlib
 import importlib.metadata
 import re
+import sys
 import traceback
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -104,8 +105,18 @@ def resolve(spec: str) -> tuple[type[FlightMission], MissionRef]:
     return cls, MissionRef(name, target, _version_of(target))
 
 
+def code_dir() -> str:
+    """Where ``module:name`` given on the command line is looked for besides the installed
+    packages: the current folder, as uvicorn and gunicorn do (put there on ``sys.path``)."""
+    here = str(Path.cwd())
+    if here not in sys.path:
+        sys.path.insert(0, here)
+    return here
+
+
 def load(target: str, *, what: str) -> type[FlightMission]:
     """Import ``module:Class`` and check it is a mission; PluginError otherwise."""
+    code_dir()
     module_name, _, attr = target.partition(":")
     try:
         module = importlib.import_module(module_name)

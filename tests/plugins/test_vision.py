@@ -84,3 +84,25 @@ def test_a_broken_function_writes_nothing(
     assert exit_code == code, text
     assert words in text and "Traceback" not in text and len(text.strip().splitlines()) == 1
     assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_a_folder_on_dask_with_a_function_from_the_current_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """As uvicorn finds ``main:app``: the module in the current folder, in every worker too."""
+    work = tmp_path / "work"
+    work.mkdir()
+    detector = Path(__file__).with_name("detector.py").read_text()
+    (work / "my_vision.py").write_text(detector)
+    monkeypatch.chdir(work)
+    golden = GOLDEN.parent
+    out = tmp_path / "out"
+    code, text = _run(
+        "replay", str(golden), "--vision", "my_vision:red_roofs", "--out", str(out),
+        "--workers", "1", "-q",
+    )  # fmt: skip
+    assert code == 0, text
+    assert "recordings     5 of 5" in text and "on 52 photos" in text, text
+    written = sorted(p.name for p in out.glob("*.vision.mcap"))
+    assert written == sorted(f"{p.stem}.vision.mcap" for p in golden.glob("*.mcap"))
+    assert (out / "vision.parquet").exists()

@@ -119,8 +119,11 @@ def replay(
         if others or update_golden or mission:
             raise click.UsageError("--vision takes only --out")
         if is_batch(recording):
-            raise click.UsageError("--vision takes one recording")
-        _vision(recording, vision, out)
+            from uavtool.cli.replay_batch import vision_batch
+
+            vision_batch(recording, vision, out, scheduler=scheduler, workers=workers, quiet=quiet)
+        else:
+            _vision(recording, vision, out)
         return
 
     if is_batch(recording):  # a folder or a glob: many recordings on Dask, one table

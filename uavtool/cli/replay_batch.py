@@ -101,3 +101,51 @@ def _read_target(target: Path) -> bytes:
 def _default_table() -> Path:
     stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
     return Path("replays") / f"{stamp}.parquet"
+
+
+def vision_batch(
+    pattern: Path,
+    spec: str,
+    out: Path | None,
+    *,
+    scheduler: str | None,
+    workers: int | None,
+    quiet: bool,
+) -> None:
+    """``--vision`` on many recordings: each one's detections written to ``out`` (a folder,
+    default ``vision-<UTC time>``) as ``<name>.vision.mcap``, with a table of them there."""
+    from uavtool.plugins import code_dir
+    from uavtool.replay.vision import load_function
+    from uavtool.sweep.progress import format_progress
+    from uavtool.sweep.replay import find_recordings
+    from uavtool.sweep.vision import format_vision_summary, vision_many, write_vision_table
+
+    load_function(spec)  # here first: a missing module is one error, not one per recording
+    paths = find_recordings(str(pattern))
+    folder = out if out is not None else Path(f"vision-{datetime.now(UTC):%Y%m%dT%H%M%SZ}")
+    if folder.suffix:
+        raise click.BadParameter(
+            f"{folder}: with many recordings, --out names a folder", param_hint="--out"
+        )
+    folder.mkdir(parents=True, exist_ok=True)
+
+    def draw(text: str) -> None:
+        if not quiet and sys.stderr.isatty():
+            click.echo(f"\r\x1b[2K{text}", nl=False, err=True)
+
+    batch = vision_many(
+        paths,
+        spec=spec,
+        out_dir=folder,
+        code_dir=code_dir(),
+        scheduler=scheduler,
+        workers=workers,
+        progress=lambda p: draw(format_progress(p, noun="recordings")),
+    )
+    if not quiet and sys.stderr.isatty():
+        click.echo(err=True)
+    table = folder / "vision.parquet"
+    write_vision_table(batch, table)
+    click.echo(format_vision_summary(batch, total=len(paths), spec=spec, table=table))
+    if batch.interrupted or any(r.get("error") for r in batch.rows):
+        sys.exit(1)

@@ -24,6 +24,7 @@ from uavtool.errors import FailureError, InputError
 from uavtool.images import png_decode
 from uavtool.mission.codec import decode_observation
 from uavtool.mission.observations import Photo
+from uavtool.plugins import code_dir
 from uavtool.recording import CompressedImage, JsonDocument, RecordingReader
 from uavtool.recording.annotations import (
     DETECTIONS,
@@ -58,6 +59,7 @@ def load_function(spec: str) -> VisionFunction:
     code). PluginError-like one-line InputError when it cannot be loaded."""
     if not _TARGET.match(spec):
         raise InputError(f"--vision {spec!r}: expected module:function")
+    code_dir()
     module_name, _, name = spec.partition(":")
     try:
         module = importlib.import_module(module_name)
