@@ -98,3 +98,19 @@ def test_target_without_vision_only_is_a_usage_error(folder: Path) -> None:
     result = CliRunner().invoke(cli, ["replay", str(folder), "--target", target])
     assert result.exit_code == 2
     assert "--target is for --vision-only" in result.output
+
+
+def test_vision_runs_on_the_photos_of_a_record_file(recorded: Recorded, tmp_path: Path) -> None:
+    """``replay --vision`` takes a recording of ``uavtool record`` as one of ``uavtool fly``."""
+    out = tmp_path / "detected.mcap"
+    result = CliRunner().invoke(
+        cli,
+        ["replay", str(recorded.path), "--vision", "tests.plugins.detector:red_roofs",
+         "--out", str(out)],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    with RecordingReader(out) as reader:
+        found = [e.value.payload for e in reader.entries(["/vision/detections"])]
+        frames = [e.value.payload for e in reader.entries([FRAMES])]
+    assert [f["frame_index"] for f in found] == [f["frame_index"] for f in frames]
+    assert any(f["detections"] for f in found)  # the red building is in some photo
