@@ -12,6 +12,9 @@ and write one test that takes the ``uavtool_recording`` argument; it runs once p
 
     def test_recording_replays(uavtool_recording):
         assert_replays_identically(uavtool_recording)
+
+Recordings of your own mission work the same once its package is installed (registered in
+the ``uavtool.missions`` entry-point group); else pass ``mission="module:Class"``.
 """
 
 from __future__ import annotations
@@ -40,12 +43,13 @@ def pytest_generate_tests(metafunc: Any) -> None:
         metafunc.parametrize("uavtool_recording", paths, ids=[p.name for p in paths])
 
 
-def assert_replays_identically(path: str | Path) -> None:
+def assert_replays_identically(path: str | Path, *, mission: str | None = None) -> None:
     """Replay ``path`` with its recorded parameters; AssertionError with the first difference
-    (step, output, field, recorded vs replayed) unless every output is equal."""
+    (step, output, field, recorded vs replayed) unless every output is equal. ``mission``
+    (``module:Class``) names the mission's class when it is not registered (installed)."""
     from uavtool.replay import load_flight, replay  # noqa: PLC0415 - keep pytest start-up light
 
-    result = replay(load_flight(path))
+    result = replay(load_flight(path, mission=mission))
     if result.first_difference is not None:
         raise AssertionError(f"{path}: {result.first_difference.describe()}")
     if result.divergence is not None:
@@ -54,12 +58,12 @@ def assert_replays_identically(path: str | Path) -> None:
         )
 
 
-def assert_reflies_identically(path: str | Path) -> None:
+def assert_reflies_identically(path: str | Path, *, mission: str | None = None) -> None:
     """Fly ``path``'s configuration again on the built-in vehicle, in lockstep, and compare the
     new recording with it; AssertionError with the first difference. Only for recordings
-    made by ``uavtool fly`` on the built-in vehicle."""
+    made by ``uavtool fly`` on the built-in vehicle; ``mission`` as above."""
     from uavtool.replay.refly import refly  # noqa: PLC0415 - keep pytest start-up light
 
-    result = refly(path)
+    result = refly(path, mission=mission)
     if result.first_difference is not None:
         raise AssertionError(f"{path}: re-flown: {result.first_difference}")

@@ -16,6 +16,8 @@ from click.testing import CliRunner
 
 import uavtool.api
 from uavtool.cli import cli
+from uavtool.plugins import PluginError
+from uavtool.testing import assert_reflies_identically, assert_replays_identically
 from uavtool.recording import RecordingReader
 
 HOP = "tests.plugins.hop:HopMission"
@@ -51,6 +53,15 @@ def test_a_plugin_flies_records_replays_and_re_flies(tmp_path: Path) -> None:
     assert "diverged" in out or "first difference" in out, out
     code, out = _run("replay", "--refly", str(rec), "--mission", HOP)
     assert code == 0 and "identical: the new recording equals the old one" in out, out
+
+
+def test_the_pytest_helpers_take_a_plugin_mission(tmp_path: Path) -> None:
+    rec = tmp_path / "hop.mcap"
+    assert _run("fly", "-q", "--mission", HOP, "--record", str(rec))[0] == 0
+    assert_replays_identically(rec, mission=HOP)
+    assert_reflies_identically(rec, mission=HOP)
+    with pytest.raises(PluginError, match="not registered here"):
+        assert_replays_identically(rec)
 
 
 def test_the_api_example_flies(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
