@@ -17,8 +17,8 @@ from click.testing import CliRunner
 import uavtool.api
 from uavtool.cli import cli
 from uavtool.plugins import PluginError
-from uavtool.testing import assert_reflies_identically, assert_replays_identically
 from uavtool.recording import RecordingReader
+from uavtool.testing import assert_reflies_identically, assert_replays_identically
 
 HOP = "tests.plugins.hop:HopMission"
 ROOT = Path(__file__).parents[2]
