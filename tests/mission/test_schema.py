@@ -45,7 +45,7 @@ def test_type_aliases_are_read_through() -> None:
     assert props["speeds"] == {"type": "array", "items": {"type": "number"}}
     assert props["gusts"]["type"] == "array"
     assert props["gusts"]["items"] == {"type": "number"}
-    assert props["gusts"]["description"] == "null: not set"
+    assert props["gusts"]["description"] == "absent: not set"
     assert props["name"] == {"type": "string"}
     # 2-D arrays are no type Foxglove accepts: named in the description, not typed
     assert "points" not in props

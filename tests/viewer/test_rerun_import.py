@@ -46,6 +46,17 @@ def test_rerun_imports_the_foxglove_channels_as_archetypes(recording: Path, tmp_
         env=env,
         timeout=120,
     )
+    # Rerun's own check of what it wrote: every column deserializes (before LocationFix had a
+    # colour, 229 errors on /vehicle/fix:GeoPoints:colors in the paper golden)
+    verified = subprocess.run(
+        [_rerun(), "rrd", "verify", str(rrd)],
+        check=False,
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
+    assert verified.returncode == 0, verified.stderr[-2000:]
     printed = subprocess.run(
         [_rerun(), "rrd", "print", "-v", str(rrd)],
         check=True,

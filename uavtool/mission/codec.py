@@ -34,8 +34,8 @@ _FIELDS: dict[type, tuple[str, ...]] = {}
 
 def encode(value: Any) -> Any:
     """A dataclass tree as JSON-ready data: ``{"type": ClassName, field: …}``; arrays and
-    tuples become lists, enums their value, bytes ``{"sha256", "size"}``; a Photo's image is
-    left out."""
+    tuples become lists, enums their value, bytes ``{"sha256", "size"}``; a field that is
+    None and a Photo's image are left out."""
     kind = type(value)
     if kind in _PLAIN:
         return value
@@ -50,7 +50,9 @@ def encode(value: Any) -> Any:
         for name in names:
             if name == "roll_deg" and kind is CameraPose and value.roll_deg == 0.0:
                 continue  # a level camera is written as before rolls were recorded
-            out[name] = encode(getattr(value, name))
+            field = getattr(value, name)
+            if field is not None:  # no value: no field (JSON Schema validators accept that)
+                out[name] = encode(field)
         return out
     if isinstance(value, np.ndarray):
         return value.tolist()
@@ -71,6 +73,16 @@ def encode_output(output: Output) -> dict[str, Any]:
 
 def encode_observation(obs: Observation) -> dict[str, Any]:
     return encode(obs)  # type: ignore[no-any-return]
+
+
+def without_nulls(value: Any) -> Any:
+    """``value`` with every null field of its objects left out, as :func:`encode` writes them
+    now (recordings before it wrote ``null``): the same output compares equal from either."""
+    if isinstance(value, dict):
+        return {k: without_nulls(v) for k, v in value.items() if v is not None}
+    if isinstance(value, list):
+        return [without_nulls(v) for v in value]
+    return value
 
 
 def decode_observation(data: dict[str, Any], image_rgb: U8Array | None = None) -> Observation:
@@ -112,7 +124,7 @@ def decode_observation(data: dict[str, Any], image_rgb: U8Array | None = None) -
                 intrinsics,
                 image_rgb,
             )
-    except (KeyError, TypeError, ValueError) as exc:
+    except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise MissionInputError(f"observation {kind}: bad or missing field {exc}") from None
     raise MissionInputError(f"unknown observation type {kind!r}")
 

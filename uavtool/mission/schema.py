@@ -3,7 +3,8 @@ dataclasses themselves so they cannot drift from what is recorded.
 
 One object schema per union: ``type`` names the dataclass, every other property is the union
 of the variants' fields (a field name means the same thing wherever it appears). The rule of
-`uavtool.recording.schemas` holds: one JSON type per field, ``null`` = no value. Nested
+`uavtool.recording.schemas` holds: one JSON type per field; a field with no value is left out
+(no field is required but ``type``). Nested
 lists (polygons, mesh vertices) are left out of ``properties``: Foxglove's and Lichtblick's
 parsers accept no array of arrays and would drop the channel; the values are still in each
 message and listed in the schema's description.
@@ -31,7 +32,7 @@ _BYTES = {
 
 
 class _NestedError(Exception):
-    """A type with no schema Foxglove accepts (an array of arrays)."""
+    """A type with no schema Foxglove accepts (an array of arrays, an object of any keys)."""
 
 
 def _unalias(tp: Any) -> Any:
@@ -89,7 +90,7 @@ def _schema(tp: Any) -> dict[str, Any]:
     else:
         schema = _one(variants[0])
     if nullable:
-        schema["description"] = "null: not set"
+        schema["description"] = "absent: not set"
     return schema
 
 
@@ -100,7 +101,7 @@ def _one(tp: Any) -> dict[str, Any]:
     if tp is bytes:
         return dict(_BYTES)
     if typing.get_origin(tp) is dict:
-        return {"type": "object", "description": "JSON values, as the mission gave them"}
+        raise _NestedError  # any keys: no schema Foxglove's parser takes (it needs properties)
     if isinstance(tp, type) and issubclass(tp, Enum):
         values = [m.value for m in tp]
         kind = "integer" if all(isinstance(v, int) for v in values) else "string"
@@ -135,7 +136,7 @@ def _object(classes: list[Any]) -> dict[str, Any]:
     names = ", ".join(c.__name__ for c in classes)
     description = f"type: {names}"
     if nested:
-        description += "; nested lists not typed here: " + ", ".join(nested)
+        description += "; nested lists and free-form objects not typed here: " + ", ".join(nested)
     return {"type": "object", "description": description, "properties": properties}
 
 
@@ -144,7 +145,7 @@ def _union_schema(union: Any, title: str, head: dict[str, Any], intro: str) -> d
     return {
         "$schema": "https://json-schema.org/draft/2020-12/schema",
         "title": title,
-        "description": f"{intro} {body['description']}. null: no value.",
+        "description": f"{intro} {body['description']}. A field with no value is absent.",
         "type": "object",
         "properties": {**head, **body["properties"]},
         "required": [*head, "type"],

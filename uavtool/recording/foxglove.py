@@ -7,6 +7,7 @@ one clock in every viewer.
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 from foxglove_schemas_protobuf.CameraCalibration_pb2 import (
@@ -119,6 +120,8 @@ def encode(value: FoxgloveValue, t_ns: int) -> bytes:
             value.longitude_deg,
             value.altitude_m,
         )
+        c = pb.color
+        c.r, c.g, c.b, c.a = value.color_rgba
     elif isinstance(value, PosesInFrame):
         _stamp(pb, t_ns)
         pb.frame_id = value.frame_id
@@ -164,7 +167,11 @@ def decode(name: str, data: bytes) -> FoxgloveValue:
             pb.parent_frame_id, pb.child_frame_id, (t.x, t.y, t.z), (r.x, r.y, r.z, r.w)
         )
     if cls is PbLocationFix:
-        return LocationFix(pb.latitude, pb.longitude, pb.altitude, pb.frame_id)
+        fix = LocationFix(pb.latitude, pb.longitude, pb.altitude, pb.frame_id)
+        if pb.HasField("color"):  # older recordings have none: the default colour
+            c = pb.color
+            fix = dataclasses.replace(fix, color_rgba=(c.r, c.g, c.b, c.a))
+        return fix
     if cls is PbPosesInFrame:
         return PosesInFrame(tuple(_pose(p) for p in pb.poses), pb.frame_id)
     if cls is PbLog:

@@ -7,9 +7,10 @@ Foxglove and Lichtblick list and plot every field.
 The rule for JSON channels (`NULL_RULE`): each field has exactly one JSON type — the one its
 values have — because Foxglove's and Lichtblick's schema parsers reject a list of types such
 as ``["number", "null"]`` and then drop the whole channel. A value that is absent or not
-finite (MAVLink's "NaN = unchanged", ±∞, an unset optional) is written as ``null``: JSON has
-no NaN, those viewers read ``null`` as "no value" (a gap in a plot), and the exact bytes stay
-in ``/mavlink/raw``.
+finite (MAVLink's "NaN = unchanged", ±∞, an unset optional) is left out of the message, and
+the schema does not require it: JSON has no NaN, a standard JSON Schema validator rejects
+``null`` for a number, those viewers show a missing field as "no value" (a gap in a plot), and
+the exact bytes stay in the raw frame. An array with any such element is left out whole.
 """
 
 from __future__ import annotations
@@ -69,7 +70,7 @@ _INT_TYPES = {
     "uint64_t",
 }
 _FLOAT_TYPES = {"float", "double"}
-NULL_RULE = "null: no value (not finite, or not set)"
+NULL_RULE = "absent: no value (not finite)"
 
 _HEADER_SCHEMA = {
     "type": "object",
@@ -138,7 +139,8 @@ def mavlink_schema(dialect: str, msgid: int) -> tuple[str, bytes]:
         "description": f"MAVLink message {cls.msgname} (id {msgid}). {description}".strip(),
         "type": "object",
         "properties": properties,
-        "required": ["header", *cls.fieldnames],
+        # A float may be NaN ("unchanged"), hence absent: only the others are always there.
+        "required": ["header", *(n for n, t, _ in _fields(cls) if t not in _FLOAT_TYPES)],
     }
     return f"{dialect}.{cls.msgname}", dumps(schema)
 
@@ -149,7 +151,8 @@ _PLAIN, _FLOAT, _FLOATS = 0, 1, 2
 @cache
 def _view_fields(dialect: str, msgid: int) -> tuple[tuple[str, int], ...]:
     """Each field of a message type in declaration order, with how its JSON view is made:
-    as it is (text for char fields), a float (null when not finite), floats (likewise)."""
+    as it is (text for char fields), a float (absent when not finite), floats (absent when
+    any is not finite)."""
     cls = dialect_module(dialect).mavlink_map[msgid]
     return tuple(
         (name, (_FLOATS if length else _FLOAT) if ftype in _FLOAT_TYPES else _PLAIN)
@@ -210,8 +213,11 @@ class MavlinkDecoder:
                 if isinstance(value, bytes):  # a char field: text (pymavlink's format_attr)
                     value = value.decode(errors="backslashreplace").rstrip("\x00")
             elif kind == _FLOAT:
-                value = value if math.isfinite(value) else None
+                if not math.isfinite(value):
+                    continue
+            elif not all(math.isfinite(v) for v in value):
+                continue
             else:
-                value = [v if math.isfinite(v) else None for v in value]
+                value = list(value)
             payload[name] = value
         return msgid, msg.get_type(), payload

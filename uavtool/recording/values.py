@@ -142,6 +142,8 @@ class LocationFix:
     longitude_deg: float
     altitude_m: float
     frame_id: str = "vehicle"
+    color_rgba: tuple[float, float, float, float] = (1.0, 0.55, 0.0, 1.0)
+    """How a map draws it (0–1 each; orange, as the route): Rerun's MCAP importer needs one."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -13,7 +13,7 @@ from uavtool.errors import InputError
 from uavtool.flight import mission_of
 from uavtool.images import png_decode
 from uavtool.mission import FlightMission, Observation
-from uavtool.mission.codec import decode_observation
+from uavtool.mission.codec import decode_observation, without_nulls
 from uavtool.mission.observations import U8Array
 from uavtool.plugins import MissionRef, for_recording, mission_params
 from uavtool.recording import CompressedImage, JsonDocument, RecordingReader
@@ -95,7 +95,7 @@ def load_flight(path: str | Path, *, mission: str | None = None) -> RecordedFlig
                         f"{path}: output {len(outputs) + 1} on {OUTPUTS} has no whole-number "
                         "n and step"
                     )
-                outputs.append(RecordedOutput(n, step, data))
+                outputs.append(RecordedOutput(n, step, without_nulls(data)))
         truncated = not reader.health.whole
         _check_counts(reader, path, {OBSERVATIONS: len(raw_obs), OUTPUTS: len(outputs)})
     if target is None and cls.needs_target:

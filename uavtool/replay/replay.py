@@ -156,7 +156,7 @@ class _Comparison:
             return True
         if recorded.get("type") != "GoTo" or replayed.get("type") != "GoTo":
             return False
-        a, b = recorded["heading_deg"], replayed["heading_deg"]
+        a, b = recorded.get("heading_deg"), replayed.get("heading_deg")
         if (a is None) != (b is None) or (
             a is not None and abs(wrap_180(a - b)) > self._heading_deg
         ):
