@@ -9,6 +9,7 @@ would hold up the MAVLink loop. A video file is read a frame per request, as a f
 
 from __future__ import annotations
 
+import os
 import threading
 import time
 from collections.abc import Callable
@@ -69,12 +70,22 @@ class OpenCvCamera:
     not known to OpenCV: ``hfov_deg`` says it."""
 
     def __init__(self, source: int | str, *, hfov_deg: float) -> None:
+        # FFmpeg's own log (a refused stream's "[tcp @ …] Connection … refused") too, unless
+        # the user asks for it; read by OpenCV when its FFmpeg backend starts.
+        os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
         import cv2  # noqa: PLC0415
 
         self.name = f"opencv:{source}"
         self.captured_at_s: float | None = None
-        self._cap: Any = cv2.VideoCapture(source)
-        ok, frame = self._cap.read() if self._cap.isOpened() else (False, None)
+        # OpenCV logs each backend it tried ([ WARN] lines) before our one-line error says
+        # the same: silent while opening, as it was before.
+        level = cv2.utils.logging.getLogLevel()
+        cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_SILENT)
+        try:
+            self._cap: Any = cv2.VideoCapture(source)
+            ok, frame = self._cap.read() if self._cap.isOpened() else (False, None)
+        finally:
+            cv2.utils.logging.setLogLevel(level)
         if not ok or frame is None:
             self._cap.release()
             raise CameraError(f"camera {self.name}: cannot open it or read a frame")
