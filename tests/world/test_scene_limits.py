@@ -153,3 +153,16 @@ def test_file_size_is_checked_before_reading(tmp_path: Path) -> None:
     path.write_text(json.dumps({"pad": "x" * limits.MAX_FILE_BYTES}))
     with pytest.raises(SceneError, match=r"big.json: larger than 256 KiB, not a scene"):
         load_scene(path)
+
+
+def test_a_file_that_is_not_a_scene_is_not_echoed_into_the_error(tmp_path: Path) -> None:
+    # /etc/shadow read as YAML is a mapping whose keys are its lines, password hashes and all.
+    shadow = tmp_path / "shadow"
+    shadow.write_text(
+        "root:$6$Zx9SALT$SECRETHASHabc:20228:0:99999:7:::\ndaemon:*:20228:0:99999:7:::\n"
+    )
+    with pytest.raises(SceneError) as info:
+        load_scene(shadow)
+    message = str(info.value)
+    assert "SECRETHASH" not in message and "20228" not in message and "$6$" not in message
+    assert message.startswith(f"{shadow}:1: a key that is not a scene key (is this a scene file?)")

@@ -34,6 +34,14 @@ import click
     help="Use a running Dask scheduler (e.g. tcp://10.0.0.5:8786). Default: a local cluster.",
 )
 @click.option(
+    "--dashboard",
+    default=None,
+    metavar="HOST:PORT",
+    help="Where the local cluster's Dask dashboard listens, e.g. 0.0.0.0:8787 to reach it from "
+    "other machines (anyone who can connect sees the workers, their logs and call stacks).  "
+    "[default: 127.0.0.1, a free port]",
+)
+@click.option(
     "--workers",
     type=int,
     default=None,
@@ -58,6 +66,7 @@ def sweep(
     overrides: tuple[str, ...],
     out: Path | None,
     scheduler: str | None,
+    dashboard: str | None,
     workers: int | None,
     timeout_s: float | None,
     resume: bool,
@@ -98,6 +107,7 @@ def sweep(
         out=out,
         scheduler=scheduler,
         workers=workers,
+        dashboard=dashboard,
         resume=resume,
         plots=not no_plots,
         progress=lambda p: draw(format_progress(p)),

@@ -27,35 +27,77 @@ def default_workers() -> int:
         return os.cpu_count() or 1
 
 
+LOCAL_DASHBOARD = "127.0.0.1:0"
+"""Where the local cluster's dashboard listens unless the user asks: this machine only (it
+shows the workers, their logs and call stacks, and the scheduler's address), a free port."""
+_HOST_PORT_SCHEMES = ("tcp", "tls", "ws", "wss")
+
+
+def check_cluster_options(
+    scheduler: str | None, *, workers: int | None = None, dashboard: str | None = None
+) -> None:
+    """Raise InputError, without connecting to anything, unless ``scheduler`` reads as a Dask
+    scheduler address (``tcp://HOST:PORT``, or ``HOST:PORT``) and the options fit together."""
+    if scheduler is None:
+        if dashboard is not None:
+            _host_port(dashboard, "--dashboard", "127.0.0.1:8787")
+        if workers is not None and workers < 1:
+            raise InputError(f"--workers must be ≥ 1, got {workers}")
+        return
+    if workers is not None:
+        raise InputError("--workers sizes the local cluster; with --scheduler, start workers there")
+    if dashboard is not None:
+        raise InputError(
+            "--dashboard is the local cluster's; with --scheduler, it is the scheduler's"
+        )
+    from distributed.comm.addressing import parse_address  # noqa: PLC0415
+
+    try:
+        scheme, location = parse_address(scheduler)
+    except ValueError as exc:
+        raise InputError(f"--scheduler {scheduler!r}: {exc}; e.g. tcp://HOST:8786") from None
+    if scheme in _HOST_PORT_SCHEMES:
+        _host_port(location, "--scheduler", "tcp://HOST:8786", shown=scheduler)
+
+
+def _host_port(text: str, option: str, example: str, *, shown: str | None = None) -> None:
+    host, sep, port = text.rpartition(":")
+    host = host.removeprefix("[").removesuffix("]")
+    ok = sep and host and not any(c.isspace() for c in host) and port.isdigit()
+    if not ok or not 0 <= int(port) <= 65535:
+        raise InputError(
+            f"{option} {shown or text!r}: expected HOST:PORT with a port 0-65535, e.g. {example}"
+        )
+
+
 @contextmanager
-def open_client(scheduler: str | None = None, *, workers: int | None = None) -> Iterator[Client]:
-    """A connected client; a LocalCluster (closed on exit) unless ``scheduler`` is given.
-    Raises InputError when the scheduler cannot be reached."""
+def open_client(
+    scheduler: str | None = None, *, workers: int | None = None, dashboard: str | None = None
+) -> Iterator[Client]:
+    """A connected client; a LocalCluster (closed on exit, its dashboard on ``dashboard``,
+    default ``LOCAL_DASHBOARD``) unless ``scheduler`` is given. Raises InputError for a bad
+    address or when the scheduler cannot be reached."""
     from distributed import Client, LocalCluster  # noqa: PLC0415
 
+    check_cluster_options(scheduler, workers=workers, dashboard=dashboard)
     _quiet_dask()
     if scheduler is not None:
-        if workers is not None:
-            raise InputError(
-                "--workers sizes the local cluster; with --scheduler, start workers there"
-            )
         try:
             client = Client(scheduler, timeout="10s")
-        except (OSError, TimeoutError) as exc:
+        except (OSError, TimeoutError, ValueError) as exc:
             raise InputError(f"--scheduler {scheduler}: cannot connect: {exc}") from None
         with client:
             yield client
         return
     n = workers if workers is not None else default_workers()
-    if n < 1:
-        raise InputError(f"--workers must be ≥ 1, got {n}")
     # The workers must not hear the terminal's Ctrl-C: see uavtool.sweep.interrupt.
     with sigint_ignored():
         cluster = LocalCluster(
             n_workers=n,
             threads_per_worker=1,
             processes=True,
-            dashboard_address=":0",  # no fixed port: several clusters may run at once
+            # No fixed port by default: several clusters may run at once.
+            dashboard_address=dashboard or LOCAL_DASHBOARD,
             silence_logs=logging.ERROR,
             preload=[PRELOAD],
         )

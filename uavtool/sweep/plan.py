@@ -8,6 +8,7 @@ import dataclasses
 import hashlib
 import itertools
 import json
+import math
 import random
 import re
 from collections.abc import Iterator
@@ -19,6 +20,7 @@ from uavtool.sweep.errors import SpecError
 from uavtool.sweep.scenes import scene_label
 from uavtool.sweep.spec import SceneSource, SweepSpec
 from uavtool.sweep.values import Distribution, Law
+from uavtool.terminal import counted
 
 _DEFAULTS: dict[str, Any] = {
     "seed": 0,
@@ -102,9 +104,38 @@ def _uses(spec: SweepSpec, key: str) -> bool:
     return any(k == key for k, _ in (*spec.grid, *spec.random, *itertools.chain(*spec.cases)))
 
 
+MAX_FLIGHTS = 100_000
+"""Flights one sweep may plan: each is a recording and a row, and the plan is held in memory
+(1000 x 1000 x 1000 grid values asked for 3.5 GB before failing)."""
+
+
+def flight_count(spec: SweepSpec) -> int:
+    """How many flights ``spec`` plans, counted without planning them."""
+    return math.prod(_factors(spec).values())
+
+
+def _factors(spec: SweepSpec) -> dict[str, int]:
+    return {
+        "scene": sum(len(source.seeds) or 1 for source in spec.scenes),
+        "case": len(spec.cases or ((),)),
+        **{f"{key} value": len(values) for key, values in spec.grid},
+        "draw": max(spec.draws, 1),
+    }
+
+
 def plan_flights(spec: SweepSpec) -> list[FlightSpec]:
     """Every flight, in a fixed order: scene, case, grid combination, draw. Raises
-    SpecError when a random draw is not a valid value of its dimension."""
+    SpecError when a random draw is not a valid value of its dimension, or when the spec
+    plans more than ``MAX_FLIGHTS`` (before planning any)."""
+    count = flight_count(spec)
+    if count > MAX_FLIGHTS:
+        sizes = " x ".join(counted(n, what) for what, n in _factors(spec).items())
+        raise SpecError(
+            spec.source,
+            "",
+            f"{count:,} flights ({sizes}): at most {MAX_FLIGHTS:,} in one sweep; use fewer "
+            "grid values or draws, or split it into several sweeps",
+        )
     return list(_flights(spec))
 
 

@@ -9,6 +9,7 @@ completion order; the table is sorted by flight, so it does not depend on either
 
 from __future__ import annotations
 
+import contextlib
 import json
 import time
 from collections.abc import Mapping
@@ -16,7 +17,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from uavtool.sweep.cluster import open_client
+from uavtool.errors import InputError
+from uavtool.sweep.cluster import check_cluster_options, open_client
 from uavtool.sweep.dispatch import run_tasks
 from uavtool.sweep.errors import FlightTimeoutError, OutputExistsError
 from uavtool.sweep.layout import SweepLayout
@@ -52,6 +54,7 @@ def run_sweep(
     out: Path | None = None,
     scheduler: str | None = None,
     workers: int | None = None,
+    dashboard: str | None = None,
     resume: bool = False,
     plots: bool = True,
     progress: ProgressCallback | None = None,
@@ -59,8 +62,11 @@ def run_sweep(
 ) -> SweepResult:
     """Fly every flight of ``spec``. ``exit_codes`` maps a mission status to the exit code
     ``uavtool fly`` gives it (a table column); ``window`` caps the tasks on the scheduler at
-    once (default: a few per worker thread). Raises SpecError, OutputExistsError, or
-    InputError for an unreachable scheduler; Ctrl-C returns what was done (``interrupted``)."""
+    once (default: a few per worker thread); ``dashboard`` is where the local cluster's
+    dashboard listens (default: 127.0.0.1). Raises SpecError, OutputExistsError, or
+    InputError for bad cluster options or an unreachable scheduler (before writing
+    anything); Ctrl-C returns what was done (``interrupted``)."""
+    check_cluster_options(scheduler, workers=workers, dashboard=dashboard)
     flights = plan_flights(spec)
     input_keys = dimension_keys(spec)
     layout = SweepLayout(out if out is not None else spec.out)
@@ -69,6 +75,7 @@ def run_sweep(
             f"{layout.root} already holds a sweep: add --resume to continue it, or choose "
             "another --out"
         )
+    created = not layout.root.exists()
     layout.root.mkdir(parents=True, exist_ok=True)
     layout.remove_partials()
     layout.spec.write_text(spec.text, encoding="utf-8")
@@ -81,7 +88,13 @@ def run_sweep(
     if todo:
         tasks = _Tasks(layout, spec, input_keys, exit_codes)
         try:
-            _fly_all(todo, rows, tasks, scheduler, workers, window, progress)
+            _fly_all(todo, rows, tasks, (scheduler, workers, dashboard), window, progress)
+        except InputError:  # no cluster to fly on: leave no folder behind that we made
+            if created and not rows:
+                layout.spec.unlink(missing_ok=True)
+                with contextlib.suppress(OSError):
+                    layout.root.rmdir()
+            raise
         except KeyboardInterrupt:
             interrupted = True
             # Flights the workers finished before the driver heard of them: the table must say
@@ -122,8 +135,7 @@ def _fly_all(
     todo: list[FlightSpec],
     rows: dict[int, dict[str, Any]],
     tasks: _Tasks,
-    scheduler: str | None,
-    workers: int | None,
+    cluster: tuple[str | None, int | None, str | None],
     window: int | None,
     progress: ProgressCallback | None,
 ) -> None:
@@ -131,7 +143,8 @@ def _fly_all(
     report = progress or (lambda _p: None)
     report(Progress(0, total, skipped))
     root = str(tasks.layout.root.resolve())
-    with open_client(scheduler, workers=workers) as client:
+    scheduler, workers, dashboard = cluster
+    with open_client(scheduler, workers=workers, dashboard=dashboard) as client:
         t0 = time.perf_counter()
         errors = 0
         finished = run_tasks(

@@ -50,6 +50,8 @@ from uavtool.sweep import dimensions
 from uavtool.sweep.errors import SpecError
 from uavtool.sweep.values import Distribution, distribution, value_list
 
+MAX_SPEC_BYTES = 1 << 20
+"""A spec is a few hundred bytes; this bounds what is read and parsed."""
 _TOP = ("sweep", "scenes", "grid", "random", "cases")
 _SWEEP_KEYS = ("out", "format", "retries", "timeout_s")
 _SCENE_KEYS = ("builtin", "files", "hard", "random")
@@ -107,13 +109,21 @@ def load_spec(path: Path, overrides: Sequence[str] = ()) -> SweepSpec:
     syntax, or a bare word). Raises SpecError."""
     source = str(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        with path.open("rb") as file:
+            raw = file.read(MAX_SPEC_BYTES + 1)
     except OSError as exc:
         raise SpecError(source, "", f"cannot read: {exc.strerror}") from None
+    if len(raw) > MAX_SPEC_BYTES:
+        raise SpecError(source, "", f"larger than {MAX_SPEC_BYTES // 1024} KiB: not a sweep spec")
     try:
-        data = tomllib.loads(text)
+        data = tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError as exc:
+        raise SpecError(source, "", f"not UTF-8 text (byte {exc.start})") from None
     except tomllib.TOMLDecodeError as exc:
         raise SpecError(source, "", f"not valid TOML: {exc}") from None
+    except RecursionError:
+        raise SpecError(source, "", "not valid TOML: nested too deeply") from None
+    text = raw.decode("utf-8")
     for override in overrides:
         _apply_override(data, override, source)
     spec = parse_spec(data, source=source, base=path.parent, default_out=Path("sweeps") / path.stem)
@@ -183,7 +193,7 @@ def _apply_override(data: dict[str, Any], text: str, source: str) -> None:
         raise SpecError(source, "", f"--override {text!r}: expected KEY.PATH=VALUE")
     try:
         value = tomllib.loads(f"v = {raw}")["v"]
-    except tomllib.TOMLDecodeError:
+    except (tomllib.TOMLDecodeError, RecursionError):
         value = raw.strip()  # a bare word: a name or a path
     node = data
     parts = key.strip().split(".")

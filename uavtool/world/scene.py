@@ -182,6 +182,12 @@ class _Reader:
         allowed = [*required, *optional]
         for key in value:
             if key not in allowed:
+                if not _plain_key(key):  # not a scene, maybe a secret: never echo its text
+                    self.fail(
+                        path,
+                        f"a key that is not a scene key (is this a scene file?); "
+                        f"allowed: {', '.join(allowed)}",
+                    )
                 hint = difflib.get_close_matches(str(key), allowed, n=1)
                 extra = f" (did you mean {hint[0]!r}?)" if hint else ""
                 self.fail((*path, str(key)), f"unknown key{extra}; allowed: {', '.join(allowed)}")
@@ -223,6 +229,13 @@ class _Reader:
         if not ok:
             self.fail(path, f"expected [r, g, b] with integers 0-255, got {_clip(repr(value))}")
         return (items[0], items[1], items[2])
+
+
+def _plain_key(key: object) -> bool:
+    """A key worth naming in an error: a short word such as ``colour`` or ``top-m``, not a line
+    of some other file (``root:$6$…`` from /etc/shadow read as YAML)."""
+    text = str(key)
+    return len(text) <= 32 and text.replace("-", "_").replace(" ", "_").isidentifier()
 
 
 def _kind(value: object) -> str:
