@@ -47,6 +47,16 @@ BAD_SCENES: dict[str, str] = {
     "int-400-digits.yaml": _scene(_BLOCK.format(fp=_SQUARE, top="9" * 400)),
     "int-5000-digits.yaml": _scene(_BLOCK.format(fp=_SQUARE, top="9" * 5000)),
     "int-5000-digits.json": json.dumps({"target": "a", "buildings": []})[:-2] + "9" * 5000 + "]}",
+    # Hexadecimal: under the 4096-character limit, past Python's int-to-text limit (4300 digits).
+    "hex-4000-digits.yaml": _scene(_BLOCK.format(fp=_SQUARE, top="0x" + "f" * 4000)),
+    "hex-4000-digits-color.yaml": _scene(_BLOCK.format(fp=_SQUARE, top=5)).replace(
+        "[200, 30, 30]", "[0x" + "f" * 4000 + ", 30, 30]"
+    ),
+    "hex-4000-digits-footprint.yaml": _scene(
+        _BLOCK.format(fp=f"[[0x{'f' * 4000}, 0], [4, 0], [4, 3]]", top=5)
+    ),
+    "hex-4000-digits.toml": 'target = "a"\n[[buildings]]\nname = "a"\ncolor = [1, 2, 3]\n'
+    "[[buildings.blocks]]\nfootprint = [[0, 0], [4, 0], [4, 3]]\ntop_m = 0x" + "f" * 4000 + "\n",
     "duplicate-key.yaml": "target: red\ntarget: blue\nbuildings:\n"
     + _BLOCK.format(fp=_SQUARE, top=5),
     "duplicate-key.json": '{"target": "a", "target": "b", "buildings": []}',

@@ -75,6 +75,26 @@ def test_small_aliases_are_still_allowed() -> None:
         ("int-5000-digits.yaml", r"^int-5000-digits.yaml:7: a value longer than 4096 characters"),
         ("int-5000-digits.json", r"^int-5000-digits.json: invalid JSON: a number too long"),
         (
+            "hex-4000-digits.yaml",
+            r"^hex-4000-digits.yaml:7: buildings\[0\].blocks\[0\].top_m: expected a finite "
+            "number, got a number thousands of digits long$",
+        ),
+        (
+            "hex-4000-digits-color.yaml",
+            r"^hex-4000-digits-color.yaml:4: buildings\[0\].color: expected \[r, g, b\] with "
+            "integers 0-255, got a number thousands of digits long$",
+        ),
+        (
+            "hex-4000-digits-footprint.yaml",
+            r"^hex-4000-digits-footprint.yaml:\d+: buildings\[0\].blocks\[0\].footprint\[0\]"
+            r"\[0\]: expected a finite number, got a number thousands of digits long$",
+        ),
+        (
+            "hex-4000-digits.toml",
+            r"^hex-4000-digits.toml: buildings\[0\].blocks\[0\].top_m: expected a finite "
+            "number, got a number thousands of digits long$",
+        ),
+        (
             "duplicate-key.yaml",
             r"^duplicate-key.yaml:2: duplicate key 'target' \(first on line 1\)",
         ),

@@ -204,7 +204,7 @@ class _Reader:
         except OverflowError:
             out = math.inf
         if not math.isfinite(out):
-            self.fail(path, f"expected a finite number, got {_clip(str(value))}")
+            self.fail(path, f"expected a finite number, got {_shown(value)}")
         return out
 
     def text(self, value: object, path: KeyPath) -> str:
@@ -227,14 +227,16 @@ class _Reader:
             isinstance(c, int) and not isinstance(c, bool) and 0 <= c <= 255 for c in items
         )
         if not ok:
-            self.fail(path, f"expected [r, g, b] with integers 0-255, got {_clip(repr(value))}")
+            self.fail(path, f"expected [r, g, b] with integers 0-255, got {_shown(value)}")
         return (items[0], items[1], items[2])
 
 
 def _plain_key(key: object) -> bool:
     """A key worth naming in an error: a short word such as ``colour`` or ``top-m``, not a line
     of some other file (``root:$6$…`` from /etc/shadow read as YAML)."""
-    text = str(key)
+    if not isinstance(key, str):  # 1: or 0xfff…: (an integer too long to turn into text)
+        return False
+    text = key
     return len(text) <= 32 and text.replace("-", "_").replace(" ", "_").isidentifier()
 
 
@@ -244,6 +246,15 @@ def _kind(value: object) -> str:
 
 def _clip(text: str, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _shown(value: object) -> str:
+    """``value`` as an error shows it, clipped; Python will not turn an integer of thousands
+    of digits (``0xfff…`` in YAML) into text, so that is named instead."""
+    try:
+        return _clip(repr(value))
+    except ValueError:
+        return "a number thousands of digits long"
 
 
 def scene_from_dict(data: object, *, source: str = "<scene>") -> Scene:
@@ -359,7 +370,7 @@ def _block_from(value: object, path: KeyPath, r: _Reader) -> Block:
     for k, p in enumerate(raw):
         xy = r.sequence(p, (*fp_path, k))
         if len(xy) != 2:
-            r.fail((*fp_path, k), f"expected [east_m, north_m], got {_clip(repr(p))}")
+            r.fail((*fp_path, k), f"expected [east_m, north_m], got {_shown(p)}")
         x_m, y_m = r.number(xy[0], (*fp_path, k, 0)), r.number(xy[1], (*fp_path, k, 1))
         if max(abs(x_m), abs(y_m)) > limits.MAX_EXTENT_M:
             r.fail((*fp_path, k), f"more than {limits.MAX_EXTENT_M:g} m from home")
