@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import os
 import shutil
+import subprocess
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -173,3 +175,60 @@ def test_atomic_output_through_a_symlink_keeps_the_link(tmp_path: Path) -> None:
     assert link.is_symlink() and target.read_text() == "new"
     with pytest.raises(SameFileError), atomic_output(link, inputs=[target]):
         pass
+
+
+def test_info_recover_onto_a_full_disk_is_one_line(tmp_path: Path) -> None:
+    if not Path("/dev/full").exists():
+        pytest.skip("no /dev/full")
+    rec = tmp_path / "rec.mcap"
+    write_sample(rec)
+    code, _, err = _run("info", "--recover", str(rec), "-o", "/dev/full")
+    assert code == 2
+    assert err == "uavtool: error: /dev/full: cannot write: No space left on device\n"
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["scene", "show", "paper", "-o", "{fifo}.png"],
+        ["scene", "target", "paper", "-o", "{fifo}.png"],
+        ["scene", "render", "paper", "--pos", "0,0,45", "-o", "{fifo}.png"],
+        ["scene", "random", "--seed", "1", "-o", "{fifo}.yaml"],
+        ["info", "--recover", "{rec}", "-o", "{fifo}.mcap"],
+        ["export", "{rec}", "--tlog", "{fifo}.tlog"],
+        ["view", "{rec}", "--save", "{fifo}.rrd"],
+        ["vision", "vectorize", "{png}", "--overlay", "{fifo}.png"],
+    ],
+)
+def test_an_output_pipe_nobody_reads_is_refused_at_once(tmp_path: Path, args: list[str]) -> None:
+    # Opening a pipe for writing waits for a reader: these hung for ever. Run in a process of
+    # its own, so that a hang fails the test instead of stopping the suite.
+    rec, png = tmp_path / "rec.mcap", tmp_path / "frame.png"
+    write_sample(rec)
+    assert _run("scene", "show", "paper", "-o", str(png))[0] == 0
+    fifo = tmp_path / "out"
+    argv = [a.format(fifo=fifo, rec=rec, png=png) for a in args]
+    os.mkfifo(argv[-1])
+    done = subprocess.run(
+        [sys.executable, "-m", "uavtool", *argv],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 2, done.stderr
+    assert done.stderr == (
+        f"uavtool: error: {argv[-1]}: a named pipe that nobody reads (writing would wait for"
+        " ever): start its reader first, or write to a file\n"
+    )
+
+
+def test_an_output_pipe_with_a_reader_gets_the_whole_file(tmp_path: Path) -> None:
+    fifo, got = tmp_path / "out.png", tmp_path / "got.png"
+    os.mkfifo(fifo)
+    with got.open("wb") as sink, subprocess.Popen(["cat", str(fifo)], stdout=sink) as reader:
+        time.sleep(0.2)  # let it open its end
+        assert _run("scene", "show", "paper", "-o", str(fifo))[0] == 0
+        assert reader.wait(timeout=10) == 0
+    assert _run("scene", "show", "paper", "-o", str(tmp_path / "file.png"))[0] == 0
+    assert got.read_bytes() == (tmp_path / "file.png").read_bytes()

@@ -10,6 +10,7 @@ import click
 from uavtool.checks import Range
 from uavtool.cli.options import SEED, Number, Numbers
 from uavtool.errors import InputError
+from uavtool.fifo import reader_held
 
 if TYPE_CHECKING:
     from uavtool.world.hard import HardSceneInfo
@@ -167,8 +168,10 @@ def target(scene_ref: str, output: Path) -> None:
     config = FlyConfig()
     (width, height), hfov = config.size_px, config.hfov_deg
     intrinsics = Intrinsics.from_hfov(width_px=width, height_px=height, hfov_deg=hfov)
+    picture = target_picture(load_scene(scene_ref), intrinsics)
     try:
-        output.write_bytes(target_picture(load_scene(scene_ref), intrinsics))
+        with reader_held(output):
+            output.write_bytes(picture)
     except OSError as exc:
         raise click.FileError(str(output), exc.strerror) from None
     click.echo(f"wrote {output}: the target building of {scene_ref}")
@@ -299,7 +302,8 @@ def random_scene(
             seed=seed, buildings=8 if buildings is None else buildings, margin_m=margin
         )
     try:
-        output.write_text(dump_scene(s, suffix=suffix), encoding="utf-8")
+        with reader_held(output):
+            output.write_text(dump_scene(s, suffix=suffix), encoding="utf-8")
     except OSError as exc:
         raise InputError(f"{output}: cannot write: {exc.strerror}") from None
     click.echo(f"{output}: {len(s.buildings)} buildings, target {s.target!r}")

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import BinaryIO
 
 from uavtool.errors import InputError
+from uavtool.fifo import reader_held
 
 
 class SameFileError(InputError):
@@ -104,7 +105,8 @@ def atomic_output(
     output = Path(output)
     refuse_same_file(output, inputs)
     if _in_place(output):
-        yield output
+        with reader_held(output):
+            yield output
         return
     final = output.resolve() if output.is_symlink() else output
     tmp = temporary_path(final)

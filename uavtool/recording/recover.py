@@ -40,11 +40,11 @@ def recover(src: str | Path, dst: str | Path) -> RecoverResult:
         record = {"source": Path(src).name, "problem": problem}
         if dropped:
             record["dropped"] = "; ".join(dropped)
-        with atomic_output(dst, inputs=[src]) as tmp, create_file(tmp) as out:
-            try:
+        try:  # the last buffered bytes are written when the file closes: a full disk then
+            with atomic_output(dst, inputs=[src]) as tmp, create_file(tmp) as out:
                 count, channels, metadata = _copy(reader, out, record)
-            except OSError as exc:
-                raise write_failed(dst, exc) from None
+        except OSError as exc:
+            raise write_failed(dst, exc) from None
     lost = sum(d.messages_lost for d in damage)
     return RecoverResult(count, channels, metadata, problem, dropped, lost)
 

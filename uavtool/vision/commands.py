@@ -11,6 +11,7 @@ from pathlib import Path
 import cv2
 
 from uavtool.camera import Intrinsics
+from uavtool.fifo import reader_held
 from uavtool.images import read_image
 from uavtool.vision.errors import ImageError, ModelInputError, ShapeFileError
 from uavtool.vision.io import shapes_to_json, views_from_json
@@ -25,7 +26,8 @@ from uavtool.vision.vectorize import U8Array, vectorize
 def write_image(path: Path, rgb: U8Array) -> None:
     """Write an RGB image (format from the file extension)."""
     try:
-        ok = cv2.imwrite(str(path), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+        with reader_held(path):
+            ok = cv2.imwrite(str(path), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
     except cv2.error:  # no encoder for the extension
         ok = False
     if not ok:
@@ -34,10 +36,11 @@ def write_image(path: Path, rgb: U8Array) -> None:
 
 def _write(path: Path, data: str | bytes) -> None:
     try:
-        if isinstance(data, str):
-            path.write_text(data)
-        else:
-            path.write_bytes(data)
+        with reader_held(path):
+            if isinstance(data, str):
+                path.write_text(data)
+            else:
+                path.write_bytes(data)
     except OSError as exc:
         raise ImageError(f"{path}: cannot write: {exc.strerror or exc}") from None
 

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from uavtool.camera import CameraPose, Intrinsics, project
+from uavtool.fifo import reader_held
 from uavtool.world.errors import SceneError
 from uavtool.world.render import ImageRGB, render
 from uavtool.world.scene import Scene
@@ -27,7 +28,8 @@ def write_png(path: str | Path, rgb: ImageRGB) -> None:
     bgr = np.ascontiguousarray(rgb[:, :, ::-1])
     params = [cv2.IMWRITE_PNG_COMPRESSION, 3, cv2.IMWRITE_PNG_FILTER, cv2.IMWRITE_PNG_FILTER_NONE]
     try:
-        ok = cv2.imwrite(str(target), bgr, params)
+        with reader_held(target):
+            ok = cv2.imwrite(str(target), bgr, params)
     except cv2.error as exc:
         raise SceneError(f"{target}: cannot write PNG: {exc}") from exc
     if not ok:
