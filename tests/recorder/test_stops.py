@@ -210,3 +210,35 @@ def _until(check: Any, what: str, timeout: float = 30.0) -> None:
             return
         time.sleep(0.05)
     raise AssertionError(f"timed out waiting for {what}")
+
+
+def test_until_landed_stops_when_the_vehicle_dies(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from uavtool.recorder import session
+
+    monkeypatch.setattr(session, "LOST_S", 2.0, raising=False)  # 10 s by default
+    out = tmp_path / "lost.mcap"
+    port = free_udp_port()  # over UDP a dead vehicle is only silence
+    sitl = vehicle(load_scene("paper"), endpoints=(f"udpout:127.0.0.1:{port}",)).start()
+    config = RecordConfig(connect=f"udpin:127.0.0.1:{port}", output=out, until_landed=True)
+    summary: list[Any] = []
+    give_up = threading.Event()
+    thread = threading.Thread(
+        target=lambda: summary.append(record(config, stop_requested=give_up.is_set))
+    )
+    thread.start()
+    try:
+        _until(out.with_name(f"{out.name}.{os.getpid()}.partial").exists, "recording")
+        time.sleep(1.0)
+        sitl.stop()  # the vehicle dies in the air or on the ground: it will never land
+        died = time.monotonic()
+        thread.join(timeout=15)
+        took = time.monotonic() - died
+    finally:
+        give_up.set()  # it recorded for ever
+        thread.join()
+        sitl.stop()
+    assert summary[0].stop.value == "vehicle lost"
+    assert 2.0 <= took < 5.0
+    assert summarize(out).record_result["stopped"] == "vehicle lost"  # what info shows

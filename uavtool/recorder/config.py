@@ -15,6 +15,8 @@ class Stop(Enum):
     DURATION = "duration"
     LANDED = "landed"
     """The vehicle flew, then landed and disarmed (``until_landed``)."""
+    VEHICLE_LOST = "vehicle lost"
+    """Waiting for a landing (``until_landed``), nothing was heard for ``LOST_S``."""
 
 
 @dataclass(frozen=True, slots=True)

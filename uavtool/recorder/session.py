@@ -36,6 +36,9 @@ from uavtool.world import Scene, load_scene, scene_to_dict
 
 SILENCE_S = 3.0
 """A link silent this long gets an event (and another when it speaks again)."""
+LOST_S = 10.0
+"""With ``until_landed``: a vehicle silent this long is taken for lost (a dead vehicle never
+lands on the link, and the recording went on for ever); one that reboots speaks sooner."""
 LISTEN_S = 1.5
 """With ``direct``: how long to listen for another ground station before speaking."""
 _IDLE_FLUSH_S = 1.0
@@ -202,6 +205,9 @@ class _Loop:
                     last_flush = now
                 if landed and c.until_landed:
                     return Stop.LANDED
+                if c.until_landed and now - last_rx >= LOST_S:
+                    self._note(LogLevel.WARNING, f"link: nothing heard for {LOST_S:g} s: lost")
+                    return Stop.VEHICLE_LOST
                 if c.duration_s is not None and now - self.start_s >= c.duration_s:
                     return Stop.DURATION
                 if self.stop_now():
