@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import signal
 import socket
 import subprocess
 import sys
@@ -107,3 +108,21 @@ print("landed", m.recv_match(type="GLOBAL_POSITION_INT", blocking=True).relative
     finally:
         proc.terminate()
         proc.communicate(timeout=10)
+
+
+@pytest.mark.parametrize(("sig", "code"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_a_stop_signal_stops_cleanly_with_its_exit_code(sig: signal.Signals, code: int) -> None:
+    """As every other command (and shell): 128 + the signal, after the clean stop."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "uavtool", "sitl", "--endpoint", "tcpin:127.0.0.1:0"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert proc.stdout is not None
+    while "Ctrl-C to stop" not in proc.stdout.readline():
+        pass
+    proc.send_signal(sig)
+    out, err = proc.communicate(timeout=30)
+    assert proc.returncode == code, err
+    assert "uavtool sitl: stopped at sim time" in out and "Traceback" not in err

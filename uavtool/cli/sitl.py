@@ -3,13 +3,18 @@
 from __future__ import annotations
 
 import signal
+import sys
 from pathlib import Path
 
 import click
 
 
+class _Stopped(KeyboardInterrupt):
+    """SIGTERM: stop as cleanly as on Ctrl-C."""
+
+
 def _interrupt(_signum: int, _frame: object) -> None:
-    raise KeyboardInterrupt
+    raise _Stopped
 
 
 @click.command()
@@ -142,19 +147,23 @@ def sitl(
         **kwargs,  # type: ignore[arg-type]
     )
     vehicle = Sitl(config)
+    signal.signal(signal.SIGTERM, _interrupt)  # `kill` stops it as cleanly as Ctrl-C
     click.echo(
         f"uavtool sitl: vehicle sysid {vehicle.sysid}, speedup {vehicle.speedup:g}x{scene_text}"
     )
     for ep in vehicle.describe_endpoints():
         click.echo(f"  serving MAVLink on {ep}")
     click.echo("  Ctrl-C to stop")
-    signal.signal(signal.SIGTERM, _interrupt)  # `kill` stops it as cleanly as Ctrl-C
+    code = 0
     try:
         vehicle.run(duration_s=duration)
-    except KeyboardInterrupt:
-        pass
+    except KeyboardInterrupt as stop:
+        # as every command and shell: 128 + the signal (Ctrl-C 130, `kill` 143)
+        code = 128 + (signal.SIGTERM if isinstance(stop, _Stopped) else signal.SIGINT)
     finally:
         vehicle.close()
     click.echo(f"uavtool sitl: stopped at sim time {vehicle.now_ns / 1e9:.1f} s")
     if vehicle.crashed:
         click.echo(f"  the vehicle crashed: {vehicle.crash_reason}")
+    if code:
+        sys.exit(code)
