@@ -86,21 +86,27 @@ def setting_text(value: Any) -> str:
     return json.dumps(value)
 
 
-def check(key: str, value: Any) -> Any:
-    """``value`` for dimension ``key`` in the type a flight takes; ValueError says what is
-    wrong, KeyError when ``key`` is no dimension at all."""
+def check(key: str, value: Any, params_type: type | None = None) -> Any:
+    """``value`` for dimension ``key`` in the type a flight takes (``set.*`` keys are
+    parameters of ``params_type``, the mission's; default the built-in search's); ValueError
+    says what is wrong, KeyError when ``key`` is no dimension at all."""
     if key in _BUILTIN:
         return _BUILTIN[key](value)
     if key.startswith(SET_PREFIX):
         from uavtool.mission.params import Params, valid_keys, with_overrides  # noqa: PLC0415
 
+        root = params_type or Params
         name = key[len(SET_PREFIX) :]
-        if name not in (known := valid_keys()):
+        if name not in (known := valid_keys(root)):
             close = difflib.get_close_matches(name, known, n=3, cutoff=0.75)
-            hint = f"did you mean {' or '.join(close)}?" if close else "see `uavtool fly --help`"
+            hint = (
+                f"did you mean {' or '.join(close)}?"
+                if close
+                else "see `uavtool missions NAME` for its parameters"
+            )
             raise KeyError(f"unknown mission parameter {name!r}; {hint}")
         try:
-            with_overrides(Params(), {key[len(SET_PREFIX) :]: setting_text(value)}, source="set")
+            with_overrides(root(), {key[len(SET_PREFIX) :]: setting_text(value)}, source="set")
         except InputError as exc:
             raise ValueError(str(exc).removeprefix("set: ")) from None
         return value

@@ -15,6 +15,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
+from uavtool.plugins import resolve
 from uavtool.sweep import dimensions
 from uavtool.sweep.errors import SpecError
 from uavtool.sweep.scenes import scene_label
@@ -40,6 +41,8 @@ class FlightSpec:
     scene: SceneSource
     inputs: tuple[tuple[str, Any], ...]
     """The dimensions the sweep sets for this flight, in spec order."""
+    mission: str = "search"
+    """The mission it flies."""
 
     @property
     def scene_seed(self) -> int | None:
@@ -52,11 +55,10 @@ class FlightSpec:
     @property
     def key(self) -> str:
         """8 hex digits of a hash of everything that shapes the flight (not its index)."""
-        text = json.dumps(
-            [self.label, self.scene.digest, self.scene.options, self.inputs],
-            sort_keys=True,
-            default=list,
-        )
+        shaped = [self.label, self.scene.digest, self.scene.options, self.inputs]
+        if self.mission != "search":  # the built-in mission's flights keep their keys
+            shaped.append(self.mission)
+        text = json.dumps(shaped, sort_keys=True, default=list)
         return hashlib.sha256(text.encode()).hexdigest()[:8]
 
     @property
@@ -154,7 +156,7 @@ def _flights(spec: SweepSpec) -> Iterator[FlightSpec]:
                     if spec.random:
                         rng = random.Random(f"{spec.rng_seed}|{label}|{g}|{d}")
                         inputs += [(k, _draw(k, law, rng, checked, spec)) for k, law in spec.random]
-                    yield FlightSpec(index, one, tuple(inputs))
+                    yield FlightSpec(index, one, tuple(inputs), spec.mission)
                     index += 1
 
 
@@ -171,7 +173,7 @@ def _draw(
     memo = (key, repr(value))
     if memo not in checked:
         try:
-            checked[memo] = dimensions.check(key, value)
+            checked[memo] = dimensions.check(key, value, resolve(spec.mission)[0].params_type)
         except (KeyError, ValueError) as exc:
             raise SpecError(spec.source, f"random.{key}", f"drew {value!r}: {exc}") from None
     return checked[memo]

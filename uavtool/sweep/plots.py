@@ -31,9 +31,8 @@ def write_plots(summary: Summary, folder: Path) -> tuple[Path, ...]:
     written = []
     for key, rates in summary.conditions:
         name = re.sub(r"[^A-Za-z0-9._]+", "-", key)
-        written.append(
-            _save(_success(Figure(figsize=(7, 4)), key, rates), folder / f"success-{name}.png")
-        )
+        fig = _success(Figure(figsize=(7, 4)), key, rates, searched=summary.searched)
+        written.append(_save(fig, folder / f"success-{name}.png"))
     if summary.ious:
         fig = _histogram(Figure(figsize=(6, 4)), summary.ious, "model IoU with the target building")
         written.append(_save(fig, folder / "iou.png"))
@@ -48,13 +47,16 @@ def write_plots(summary: Summary, folder: Path) -> tuple[Path, ...]:
     return tuple(written)
 
 
-def _success(fig: Figure, key: str, rates: tuple[Rate, ...]) -> Figure:
+def _success(fig: Figure, key: str, rates: tuple[Rate, ...], *, searched: bool) -> Figure:
     ax = fig.add_subplot()
     xs = range(len(rates))
     correct = [r.correct / r.flights for r in rates]
     completed = [r.completed / r.flights for r in rates]
-    ax.bar([x - 0.2 for x in xs], correct, width=0.4, label="correct match")
-    ax.bar([x + 0.2 for x in xs], completed, width=0.4, label="completed (model built)")
+    if searched:
+        ax.bar([x - 0.2 for x in xs], correct, width=0.4, label="correct match")
+        ax.bar([x + 0.2 for x in xs], completed, width=0.4, label="completed (model built)")
+    else:  # another mission: whether it completed is all the table knows
+        ax.bar(list(xs), completed, width=0.4, label="completed")
     ax.set_xticks(list(xs), [f"{r.value}\n({r.flights})" for r in rates], fontsize=8)
     ax.set_ylim(0.0, 1.05)
     ax.set_ylabel("fraction of flights")

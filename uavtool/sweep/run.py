@@ -18,6 +18,8 @@ from pathlib import Path
 from typing import Any
 
 from uavtool.errors import InputError
+from uavtool.mission import SearchMission
+from uavtool.plugins import resolve
 from uavtool.sweep.cluster import check_cluster_options, open_client
 from uavtool.sweep.dispatch import run_tasks
 from uavtool.sweep.errors import FlightTimeoutError, OutputExistsError
@@ -180,7 +182,8 @@ def _finish(
     extension = "csv" if spec.table_format is TableFormat.CSV else "parquet"
     table = layout.table(extension)
     write_table(to_table(ordered, input_keys), table)
-    summary = summarise(ordered, input_keys=input_keys, planned=len(flights))
+    searched = issubclass(resolve(spec.mission)[0], SearchMission)
+    summary = summarise(ordered, input_keys=input_keys, planned=len(flights), searched=searched)
     text = format_summary(summary)
     layout.summary.write_text(text + "\n", encoding="utf-8")
     layout.summary_json.write_text(json.dumps(summary.to_json(), indent=1) + "\n")

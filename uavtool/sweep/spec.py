@@ -8,6 +8,7 @@ Example (paths are relative to the spec file)::
     format = "parquet"            # or "csv"
     retries = 2                   # re-runs of a task that raised outside the flight
     timeout_s = 900               # vehicle seconds a flight may last (default: no limit)
+    mission = "search"            # which mission flies (uavtool missions): set.* are its parameters
 
     [scenes]
     builtin = ["paper", "blocked-front"]
@@ -36,16 +37,18 @@ Example (paths are relative to the spec file)::
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import re
 import tomllib
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, fields
 from enum import Enum
 from pathlib import Path
 from typing import Any
 
 from uavtool.errors import UavtoolError
+from uavtool.plugins import resolve
 from uavtool.sweep import dimensions
 from uavtool.sweep.errors import SpecError
 from uavtool.sweep.values import Distribution, distribution, value_list
@@ -53,7 +56,7 @@ from uavtool.sweep.values import Distribution, distribution, value_list
 MAX_SPEC_BYTES = 1 << 20
 """A spec is a few hundred bytes; this bounds what is read and parsed."""
 _TOP = ("sweep", "scenes", "grid", "random", "cases")
-_SWEEP_KEYS = ("out", "format", "retries", "timeout_s")
+_SWEEP_KEYS = ("out", "format", "retries", "timeout_s", "mission")
 _SCENE_KEYS = ("builtin", "files", "hard", "random")
 _RANDOM_SCENE_OPTIONS = ("buildings", "margin_m")
 
@@ -100,6 +103,8 @@ class SweepSpec:
     """Vehicle seconds a flight may last before it is stopped (a row with its error)."""
     cases: tuple[tuple[tuple[str, Any], ...], ...] = ()
     """Sets of inputs that go together; flights take every case (none: one empty case)."""
+    mission: str = "search"
+    """The mission every flight flies (a registered name or ``module:Class``)."""
     text: str = ""
     """The spec file as read, with its overrides appended as comments (kept with the results)."""
 
@@ -145,12 +150,21 @@ def parse_spec(data: Mapping[str, Any], *, source: str, base: Path, default_out:
     retries = sweep.get("retries", 2)
     if isinstance(retries, bool) or not isinstance(retries, int) or not 0 <= retries <= 10:
         raise SpecError(source, "sweep.retries", f"expected 0..10, got {retries!r}")
-    grid = tuple(_grid(_table(data, "grid", source), source))
-    draws, rng_seed, random = _random(_table(data, "random", source), source)
+    mission = sweep.get("mission", "search")
+    if not isinstance(mission, str):
+        raise SpecError(source, "sweep.mission", f"expected a mission's name, got {mission!r}")
+    try:
+        params_type = resolve(mission)[0].params_type
+    except UavtoolError as exc:
+        raise SpecError(source, "sweep.mission", str(exc)) from None
+    check = functools.partial(_checked, params_type=params_type)
+    grid = tuple(_grid(_table(data, "grid", source), source, check))
+    draws, rng_seed, random = _random(_table(data, "random", source), source, check)
     taken = {k for k, _ in grid} & {k for k, _ in random}
     if taken:
         raise SpecError(source, f"random.{min(taken)}", "already a grid dimension")
-    cases = tuple(_cases(data.get("cases", []), {k for k, _ in (*grid, *random)}, source))
+    taken = {k for k, _ in (*grid, *random)}
+    cases = tuple(_cases(data.get("cases", []), taken, source, check))
     return SweepSpec(
         source=source,
         scenes=tuple(_scenes(data.get("scenes", {"builtin": ["paper"]}), base, source)),
@@ -163,6 +177,7 @@ def parse_spec(data: Mapping[str, Any], *, source: str, base: Path, default_out:
         retries=retries,
         timeout_s=_timeout(sweep.get("timeout_s"), source),
         cases=cases,
+        mission=mission,
     )
 
 
@@ -174,7 +189,13 @@ def _timeout(value: Any, source: str) -> float | None:
     return float(value)
 
 
-def _cases(value: Any, taken: set[str], source: str) -> Iterator[tuple[tuple[str, Any], ...]]:
+Check = Callable[[str, Any, str, str], Any]
+"""``_checked`` for the sweep's mission: (key, value, where, source) → the value."""
+
+
+def _cases(
+    value: Any, taken: set[str], source: str, check: Check
+) -> Iterator[tuple[tuple[str, Any], ...]]:
     if not isinstance(value, list) or not all(isinstance(case, dict) for case in value):
         raise SpecError(source, "cases", "expected an array of tables ([[cases]])")
     for i, case in enumerate(value):
@@ -183,7 +204,7 @@ def _cases(value: Any, taken: set[str], source: str) -> Iterator[tuple[tuple[str
             where = f"cases[{i}].{key}"
             if key in taken:
                 raise SpecError(source, where, "already a grid or random dimension")
-            inputs.append((key, _checked(key, raw, where, source)))
+            inputs.append((key, check(key, raw, where, source)))
         yield tuple(inputs)
 
 
@@ -233,9 +254,9 @@ def _flatten(table: Mapping[str, Any], prefix: str = "") -> Iterator[tuple[str, 
             yield path, value
 
 
-def _checked(key: str, value: Any, where: str, source: str) -> Any:
+def _checked(key: str, value: Any, where: str, source: str, *, params_type: type) -> Any:
     try:
-        return dimensions.check(key, value)
+        return dimensions.check(key, value, params_type)
     except KeyError as exc:
         # An unknown key is wrong in all its values: name the key, not one value.
         raise SpecError(source, re.sub(r"\[\d+\]$", "", where), str(exc.args[0])) from None
@@ -243,17 +264,19 @@ def _checked(key: str, value: Any, where: str, source: str) -> Any:
         raise SpecError(source, where, str(exc)) from None
 
 
-def _grid(table: Mapping[str, Any], source: str) -> Iterator[tuple[str, tuple[Any, ...]]]:
+def _grid(
+    table: Mapping[str, Any], source: str, check: Check
+) -> Iterator[tuple[str, tuple[Any, ...]]]:
     for key, raw in _flatten(table):
         try:
             values = value_list(raw, list_valued=key == "link_outages")
         except ValueError as exc:
             raise SpecError(source, f"grid.{key}", str(exc)) from None
-        yield key, tuple(_checked(key, v, f"grid.{key}[{i}]", source) for i, v in enumerate(values))
+        yield key, tuple(check(key, v, f"grid.{key}[{i}]", source) for i, v in enumerate(values))
 
 
 def _random(
-    table: dict[str, Any], source: str
+    table: dict[str, Any], source: str, check: Check
 ) -> tuple[int, int, tuple[tuple[str, Distribution], ...]]:
     table = dict(table)
     draws = table.pop("draws", None)
@@ -269,7 +292,7 @@ def _random(
         # Every choice, or both bounds (a mission parameter valid at both ends of a range
         # is valid between them: draws of it are not checked again one by one).
         for i, value in enumerate(law.support()):
-            _checked(key, value, f"random.{key}[{i}]", source)
+            check(key, value, f"random.{key}[{i}]", source)
         laws.append((key, law))
     if draws is None:
         draws = 1 if laws else 0

@@ -40,6 +40,8 @@ class Summary:
     flight_time_median_s: float | None
     wall_total_s: float
     conditions: tuple[tuple[str, tuple[Rate, ...]], ...]
+    searched: bool = True
+    """The flights flew the built-in search (else matches and models mean nothing)."""
 
     def to_json(self) -> dict[str, Any]:
         data = asdict(self)
@@ -50,7 +52,11 @@ class Summary:
 
 
 def summarise(
-    rows: Sequence[dict[str, Any]], *, input_keys: Sequence[str], planned: int
+    rows: Sequence[dict[str, Any]],
+    *,
+    input_keys: Sequence[str],
+    planned: int,
+    searched: bool = True,
 ) -> Summary:
     counts: dict[str, int] = {}
     for r in rows:
@@ -70,12 +76,15 @@ def summarise(
         flight_time_median_s=statistics.median(times) if times else None,
         wall_total_s=sum(float(r.get("wall_s") or 0.0) for r in rows),
         conditions=tuple(
-            (key, rates) for key in ("scene", *input_keys) if len(rates := _rates(rows, key)) > 1
+            (key, rates)
+            for key in ("scene", *input_keys)
+            if len(rates := _rates(rows, key, searched)) > 1
         ),
+        searched=searched,
     )
 
 
-def _rates(rows: Sequence[dict[str, Any]], key: str) -> tuple[Rate, ...]:
+def _rates(rows: Sequence[dict[str, Any]], key: str, searched: bool) -> tuple[Rate, ...]:
     labels, order = _labels([r.get(key) for r in rows], by_kind=key == "scene")
     groups: dict[str, list[dict[str, Any]]] = {label: [] for label in order}
     for label, row in zip(labels, rows, strict=True):
@@ -85,7 +94,10 @@ def _rates(rows: Sequence[dict[str, Any]], key: str) -> tuple[Rate, ...]:
             label,
             len(group),
             sum(bool(r.get("correct")) for r in group),
-            sum(bool(r.get("correct")) and r.get("status") == "completed" for r in group),
+            sum(
+                (bool(r.get("correct")) or not searched) and r.get("status") == "completed"
+                for r in group
+            ),
         )
         for label, group in groups.items()
         if group
@@ -138,8 +150,9 @@ def format_summary(s: Summary) -> str:
     n = s.flights
     lines = [f"flights        {n} of {s.planned}" + ("" if n == s.planned else " (incomplete)")]
     lines.append("outcomes       " + ", ".join(f"{k} {v}" for k, v in s.statuses))
-    lines.append(f"correct match  {_pct(s.correct, n)}")
-    lines.append(f"model built    {_pct(s.models, n)}")
+    if s.searched:
+        lines.append(f"correct match  {_pct(s.correct, n)}")
+        lines.append(f"model built    {_pct(s.models, n)}")
     iou = _stats(s.ious)
     if iou is not None:
         lines.append(
@@ -162,8 +175,9 @@ def format_summary(s: Summary) -> str:
     for key, rates in s.conditions:
         lines.append(f"by {key}:")
         lines += [
-            f"  {r.value:<22} correct {_pct(r.correct, r.flights):<16} "
-            f"completed {_pct(r.completed, r.flights)}"
+            f"  {r.value:<22} "
+            + (f"correct {_pct(r.correct, r.flights):<16} " if s.searched else "")
+            + f"completed {_pct(r.completed, r.flights)}"
             for r in rates
         ]
     return "\n".join(lines)

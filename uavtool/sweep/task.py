@@ -82,7 +82,8 @@ def _fly(
     exit_codes: Mapping[str, int],
     timeout_s: float | None,
 ) -> dict[str, Any]:
-    from uavtool.mission.params import Params, with_overrides  # noqa: PLC0415
+    from uavtool.mission.params import with_overrides  # noqa: PLC0415
+    from uavtool.plugins import resolve  # noqa: PLC0415
     from uavtool.runner.fly import FlyConfig, fly  # noqa: PLC0415
     from uavtool.sweep.scores import recognition_scores  # noqa: PLC0415
 
@@ -91,10 +92,12 @@ def _fly(
     if heading is not None:
         scene = dataclasses.replace(scene, home_heading_deg=float(heading))
     row["home_heading_deg"] = scene.home_heading_deg
+    mission = resolve(flight.mission)[0]
     config = FlyConfig(
         scene=scene,
         record=record,
-        params=with_overrides(Params(), flight.settings()),
+        mission=flight.mission,
+        params=with_overrides(mission.params_type(), flight.settings()),
         vehicle_params=flight.vehicle_params(),
         seed=int(flight.value("seed")),
         noise=bool(flight.value("noise")),
@@ -103,6 +106,19 @@ def _fly(
     )
     s = fly(config, progress=None if timeout_s is None else VehicleDeadline(timeout_s))
     o, e = s.outcome, s.evaluation
+    if not s.searched:  # another mission: its outcome, not the search's findings
+        return {
+            "status": o.status.value,
+            "exit_code": exit_codes.get(o.status.value),
+            "reason": o.reason,
+            "error": None,
+            "clearance_m": s.clearance_m,
+            "closest_building": s.clearance_building or None,
+            "flight_time_s": s.flight_time_s,
+            "vehicle_time_s": s.vehicle_time_s,
+            "route_length_m": s.route_length_m,
+            "frames": s.frames,
+        }
     scores = recognition_scores(record, scene)
     return {
         "status": o.status.value,
