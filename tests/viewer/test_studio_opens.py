@@ -8,8 +8,10 @@ import os
 from pathlib import Path
 
 import pytest
+from click.testing import CliRunner
 
 from tests.viewer.studio import assets, open_in_studio
+from uavtool.cli import cli
 from uavtool.recording import summarize
 
 GOLDEN = sorted((Path(__file__).parents[2] / "recordings" / "golden").glob("*.mcap"))
@@ -48,3 +50,25 @@ def test_panels_have_data(bundle: Path) -> None:
     assert "photos" in entities
     assert first["/mission/model"]["entities"][0]["models"][0]["data"]["bytes"] > 0
     assert first["/mavlink/raw"]["frame"]["bytes"] > 0
+
+
+def test_detections_and_pictures_open(bundle: Path, tmp_path: Path) -> None:
+    """What users add: a vision function's detections (``replay --vision``) and a mission's
+    pictures and results (the survey's mosaic) open with no problem, every message decoded."""
+    paper = next(p for p in GOLDEN if p.stem == "paper")
+    detected, survey = tmp_path / "detected.mcap", tmp_path / "survey.mcap"
+    runs = [
+        ["replay", str(paper), "--vision", "tests.plugins.detector:red_roofs", "--out",
+         str(detected)],
+        ["fly", "-q", "--mission", "survey", "--record", str(survey)],
+    ]  # fmt: skip
+    for args in runs:
+        result = CliRunner().invoke(cli, args)
+        assert result.exit_code == 0, result.output
+    for recording in (detected, survey):
+        seen = open_in_studio(bundle, recording)
+        assert seen["problems"] == [], recording.name
+        counts = {t.topic: t.count for t in summarize(recording).topics}
+        assert {t: v["decoded"] for t, v in seen["perTopic"].items()} == counts
+    first = open_in_studio(bundle, detected)["perTopic"]["/vision/annotations"]["first"]
+    assert "points" in first and "texts" in first
