@@ -14,6 +14,7 @@ from uavtool.errors import InputError
 from uavtool.flight import scene_data
 from uavtool.geo import GeoPoint
 from uavtool.recording import CompressedImage, JsonDocument, LogEntry, RecordingReader
+from uavtool.recording.annotations import DETECTIONS
 from uavtool.recording.topics import FRAMES, IMAGE, TARGET, TELEMETRY, VEHICLE_EVENTS, VISION
 from uavtool.view.errors import ViewError
 from uavtool.view.logger import MissionLogger
@@ -45,7 +46,7 @@ def log_recorded_flight(path: str | Path, reader: RecordingReader, logger: Missi
                 logger.output(0, out)  # the target's shapes
             else:
                 results[frame].append(out)
-    wanted = [t for t in (TELEMETRY, FRAMES, IMAGE, VEHICLE_EVENTS) if t in present]
+    wanted = [t for t in (TELEMETRY, FRAMES, IMAGE, DETECTIONS, VEHICLE_EVENTS) if t in present]
     images: deque[bytes] = deque()
     for entry in reader.entries(wanted):
         value, t_ns = entry.value, entry.log_time_ns
@@ -53,6 +54,8 @@ def log_recorded_flight(path: str | Path, reader: RecordingReader, logger: Missi
             images.append(value.data)
         elif isinstance(value, JsonDocument) and entry.topic == TELEMETRY:
             logger.observation(0, value.payload, log_time_ns=t_ns)
+        elif isinstance(value, JsonDocument) and entry.topic == DETECTIONS:
+            logger.detections(value.payload, log_time_ns=t_ns)  # replay --vision's
         elif isinstance(value, JsonDocument) and entry.topic == FRAMES:
             record = dict(value.payload)
             logger.observation(0, record, images.popleft() if images else None, log_time_ns=t_ns)
