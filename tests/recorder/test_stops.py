@@ -242,3 +242,35 @@ def test_until_landed_stops_when_the_vehicle_dies(
     assert summary[0].stop.value == "vehicle lost"
     assert 2.0 <= took < 5.0
     assert summarize(out).record_result["stopped"] == "vehicle lost"  # what info shows
+
+
+def test_a_full_disk_names_the_file_that_keeps_the_recording(tmp_path: Path) -> None:
+    """A write the OS refuses (here a file-size limit, as a full disk would) is one line that
+    names the file the user asked for, which keeps what was recorded until then — not the
+    partial file it was written through."""
+    import resource  # noqa: PLC0415 - POSIX only, as the limit is
+
+    out = tmp_path / "full.mcap"
+    scene = load_scene("paper")
+
+    def limit() -> None:  # 200 kB: reached within seconds of camera frames
+        resource.setrlimit(resource.RLIMIT_FSIZE, (200_000, 200_000))
+
+    with vehicle(scene, endpoints=("tcpin:127.0.0.1:0",)) as sitl:
+        args = ["--connect", f"tcp:127.0.0.1:{sitl.ports[0]}", "-o", str(out)]
+        done = subprocess.run(
+            [sys.executable, "-m", "uavtool", "record", *args, "--camera", "sim", "--rate", "5"],
+            cwd=REPO,
+            capture_output=True,
+            text=True,
+            timeout=60,
+            preexec_fn=limit,  # noqa: PLW1509 - a limit of the child alone, set before exec
+            check=False,
+        )
+    assert done.returncode == 2, done.stderr
+    last = done.stderr.strip().splitlines()[-1]
+    assert last.startswith(f"uavtool: error: {out}: cannot write: File too large"), last
+    assert "kept here" in last and ".partial" not in last
+    assert out.exists() and not list(tmp_path.glob("*.partial"))
+    with RecordingReader(out) as reader:
+        assert sum(1 for _ in reader.messages([TELEMETRY])) > 0

@@ -28,7 +28,7 @@ from uavtool.recorder.config import RecordConfig, RecordSummary, Stop
 from uavtool.recorder.frames import FrameTaker, PoseTrack
 from uavtool.recorder.sink import PassiveRecorder
 from uavtool.recorder.watch import Event, VehicleWatch, frame_ids
-from uavtool.recording import Direction, LogLevel, RecordingWriter
+from uavtool.recording import Direction, LogLevel, RecordingError, RecordingWriter
 from uavtool.recording.files import atomic_output
 from uavtool.runner.camera import open_camera
 from uavtool.runner.vehicle import telemetry
@@ -74,7 +74,29 @@ def record(
     """Record until Ctrl-C (or ``stop_requested()``), ``duration_s`` or, with
     ``until_landed``, the vehicle's landing and disarm. Raises LinkError (exit 2) when no
     vehicle is heard within ``timeout_s``, InputError for bad options; the file then is not
-    created. Once recording, the file is always closed whole."""
+    created. Once recording, the file is always closed whole; a write that fails (a full
+    disk) is a RecordingError naming the file that keeps what was recorded before it."""
+    started_ns = time.time_ns()
+    try:
+        return _record(config, status=status, stop_requested=stop_requested)
+    except RecordingError as exc:
+        kept = config.output.exists() and config.output.stat().st_mtime_ns >= started_ns
+        if exc.path == str(config.output) or not kept:
+            raise
+        # The writer named its partial file; what it held is kept under the name asked for.
+        raise RecordingError(
+            config.output,
+            f"{exc.problem}; what was recorded until then is kept here "
+            f"(`uavtool info {config.output}` checks it)",
+        ) from None
+
+
+def _record(
+    config: RecordConfig,
+    *,
+    status: Callable[[str], None] | None,
+    stop_requested: Callable[[], bool] | None,
+) -> RecordSummary:
     say = status or (lambda _text: None)
     stop_now = stop_requested or (lambda: False)
     _check(config)
