@@ -248,7 +248,7 @@ def test_a_full_disk_names_the_file_that_keeps_the_recording(tmp_path: Path) -> 
     """A write the OS refuses (here a file-size limit, as a full disk would) is one line that
     names the file the user asked for, which keeps what was recorded until then — not the
     partial file it was written through."""
-    import resource  # noqa: PLC0415 - POSIX only, as the limit is
+    import resource  # POSIX only, as the limit is
 
     out = tmp_path / "full.mcap"
     scene = load_scene("paper")
@@ -264,7 +264,7 @@ def test_a_full_disk_names_the_file_that_keeps_the_recording(tmp_path: Path) -> 
             capture_output=True,
             text=True,
             timeout=60,
-            preexec_fn=limit,  # noqa: PLW1509 - a limit of the child alone, set before exec
+            preexec_fn=limit,  # the child's limit alone, set before it runs
             check=False,
         )
     assert done.returncode == 2, done.stderr
