@@ -41,7 +41,8 @@ def test_ctrl_c_exits_130_quietly_and_resume_completes(tmp_path: Path, scheduler
             os.killpg(sweep.pid, signal.SIGKILL)
     assert sweep.returncode == 130, stderr
     assert "Traceback" not in stderr and "KeyboardInterrupt" not in stderr, stderr
-    assert "--resume" in stderr
+    # The hint is the whole command that resumes: the spec, the folder, and then --resume.
+    assert f"continue with: uavtool sweep {spec} --out {out} --workers 1 --resume" in stderr
     # No worker process outlives the command.
     _wait_for(lambda: not _live_processes(sweep.pid), timeout_s=30)
 

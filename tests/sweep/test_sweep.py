@@ -18,6 +18,7 @@ from click.testing import CliRunner
 from uavtool.cli import cli
 from uavtool.cli.fly import EXIT_CODES
 from uavtool.sweep import load_spec, run_sweep
+from uavtool.sweep.errors import OutputExistsError
 from uavtool.sweep.table import RUN_DEPENDENT, read_table
 
 # Three short flights of the paper scene, and three whose link is cut from the start: the
@@ -94,6 +95,25 @@ def test_the_table_is_the_same_with_one_worker_and_a_small_window(
     assert reproducible(read_table(result.table)) == reproducible(
         read_table(swept / "results.parquet")
     )
+
+
+def test_resume_refuses_another_sweep_and_changes_nothing(
+    swept: Path, spec_path: Path, tmp_path: Path
+) -> None:
+    """The issue's case: a sweep resumed without its override (or with another spec) was
+    replaced by a different one: the table, spec.toml, and clashing flight numbers."""
+    out = tmp_path / "kept"
+    shutil.copytree(swept, out)
+    before = {p: p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()}
+    other = load_spec(spec_path, ["grid.seed=[7, 8, 9]"])
+    with pytest.raises(OutputExistsError, match="holds another sweep") as exc:
+        run_sweep(other, exit_codes=EXIT_CODES, out=out, resume=True, plots=False)
+    assert "--override values it was started with" in str(exc.value)
+    after = {p: p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()}
+    assert after == before  # not a byte changed
+    (out / "plan.json").unlink()  # a folder from before plans were kept: the spec's text
+    with pytest.raises(OutputExistsError, match=r"its spec.toml differs"):
+        run_sweep(other, exit_codes=EXIT_CODES, out=out, resume=True, plots=False)
 
 
 def test_resume_flies_only_what_is_missing(

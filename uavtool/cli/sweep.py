@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import shlex
 import sys
 import time
 from pathlib import Path
@@ -57,7 +58,12 @@ import click
     "(vehicle seconds, so the same flights stop on any machine).  [default: the spec's "
     "sweep.timeout_s, else none]",
 )
-@click.option("--resume", is_flag=True, help="Keep flights whose recording is whole; fly the rest.")
+@click.option(
+    "--resume",
+    is_flag=True,
+    help="Continue the sweep in the output folder: keep flights whose recording is whole, fly "
+    "the rest. The spec and --override values must plan the same flights as when it started.",
+)
 @click.option("--csv", is_flag=True, help="Write the table as CSV instead of Parquet.")
 @click.option("--no-plots", is_flag=True, help="Write no PNG plots.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar.")
@@ -87,7 +93,7 @@ def sweep(
     \b
     Examples:
       uavtool sweep wind.toml
-      uavtool sweep wind.toml -o random.draws=200 --resume
+      uavtool sweep wind.toml -o random.draws=200 --resume   # as started, interrupted
       uavtool sweep wind.toml --timeout 900 --csv
       uavtool sweep wind.toml --scheduler tcp://head-node:8786 --out /shared/sweeps/wind
     """
@@ -120,9 +126,15 @@ def sweep(
     if result.plots_note:
         click.echo(result.plots_note, err=True)
     if result.interrupted:
+        again = ["uavtool", "sweep", str(spec), *(a for o in overrides for a in ("-o", o))]
+        again += ["--out", str(result.table.parent)]
+        again += ["--timeout", f"{timeout_s:g}"] if timeout_s is not None else []
+        again += ["--scheduler", scheduler] if scheduler is not None else []
+        again += ["--workers", str(workers)] if workers is not None else []
+        again += ["--csv"] if csv else []
         click.echo(
             f"uavtool sweep: interrupted after {len(result.rows)} of {result.summary.planned} "
-            f"flights; continue with: uavtool sweep {spec} --resume",
+            f"flights; continue with: {shlex.join([*again, '--resume'])}",
             err=True,
         )
         sys.exit(130)

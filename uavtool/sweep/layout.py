@@ -2,6 +2,8 @@
 renamed), so an interrupted sweep leaves only whole files::
 
     OUT/spec.toml                       the spec as run (overrides applied)
+    OUT/plan.json                       every flight's file stem, in order: what --resume
+                                        checks a spec against before it flies anything
     OUT/flights/000/000012-paper-1a2b3c4d.mcap   one recording per flight, 1000 per folder
     OUT/flights/000/000012-paper-1a2b3c4d.json   its result row
     OUT/results.parquet | results.csv   the table, one row per flight, in flight order
@@ -44,6 +46,10 @@ class SweepLayout:
     @property
     def spec(self) -> Path:
         return self.root / "spec.toml"
+
+    @property
+    def plan(self) -> Path:
+        return self.root / "plan.json"
 
     @property
     def summary(self) -> Path:

@@ -77,10 +77,14 @@ def run_sweep(
             f"{layout.root} already holds a sweep: add --resume to continue it, or choose "
             "another --out"
         )
+    stems = [f.stem for f in flights]
+    if resume and layout.holds_sweep():
+        _same_sweep(layout, spec, stems)  # before anything in the folder changes
     created = not layout.root.exists()
     layout.root.mkdir(parents=True, exist_ok=True)
     layout.remove_partials()
     layout.spec.write_text(spec.text, encoding="utf-8")
+    layout.plan.write_text(json.dumps(stems) + "\n", encoding="utf-8")
     rows: dict[int, dict[str, Any]] = {}
     if resume:
         rows = {f.index: r for f in flights if (r := _kept(layout, f, spec)) is not None}
@@ -94,6 +98,7 @@ def run_sweep(
         except InputError:  # no cluster to fly on: leave no folder behind that we made
             if created and not rows:
                 layout.spec.unlink(missing_ok=True)
+                layout.plan.unlink(missing_ok=True)
                 with contextlib.suppress(OSError):
                     layout.root.rmdir()
             raise
@@ -105,6 +110,38 @@ def run_sweep(
             rows |= {f.index: r for f in late if (r := _kept(layout, f, spec)) is not None}
         layout.remove_partials()  # the workers are gone: what they left half-written
     return _finish(spec, layout, flights, rows, input_keys, resumed, interrupted, plots)
+
+
+def _same_sweep(layout: SweepLayout, spec: SweepSpec, stems: list[str]) -> None:
+    """OutputExistsError unless ``spec`` (its overrides applied) plans the flights the folder
+    holds: a resume with another spec would mix two sweeps in one table."""
+    try:
+        held = json.loads(layout.plan.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        held = None
+    if isinstance(held, list):
+        if held == stems:
+            return
+        first = next(
+            (i for i, (a, b) in enumerate(zip(held, stems, strict=False)) if a != b),
+            min(len(held), len(stems)),
+        )
+        what = (
+            f"{len(held)} flights planned there, {len(stems)} now; the first to differ is "
+            f"flight {first}"
+        )
+    else:  # a folder from before plans were kept: the spec as run must be the same text
+        try:
+            same = layout.spec.read_text(encoding="utf-8") == spec.text
+        except OSError:
+            same = False
+        if same:
+            return
+        what = f"its {layout.spec.name} differs"
+    raise OutputExistsError(
+        f"{layout.root} holds another sweep ({what}): --resume takes the spec and --override "
+        "values it was started with; or choose another --out"
+    )
 
 
 def _kept(layout: SweepLayout, flight: FlightSpec, spec: SweepSpec) -> dict[str, Any] | None:
