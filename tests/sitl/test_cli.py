@@ -7,6 +7,7 @@ import signal
 import socket
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
@@ -126,3 +127,15 @@ def test_a_stop_signal_stops_cleanly_with_its_exit_code(sig: signal.Signals, cod
     out, err = proc.communicate(timeout=30)
     assert proc.returncode == code, err
     assert "uavtool sitl: stopped at sim time" in out and "Traceback" not in err
+
+
+def test_the_readmes_mount_file_loads_on_the_builtin_vehicle(tmp_path: Path) -> None:
+    """The mount.parm the README gives ArduCopter (and the no-gimbal error names): the same
+    file on our vehicle, SERVOn_FUNCTION included."""
+    parm = tmp_path / "mount.parm"
+    parm.write_text(
+        "MNT1_TYPE 1\nMNT1_PITCH_MIN -90\nMNT1_PITCH_MAX 0\nSERVO9_FUNCTION 7\nSERVO10_FUNCTION 6\n"
+    )
+    result = CliRunner().invoke(cli, ["sitl", "--params", str(parm), "--duration", "0.5"])
+    assert result.exit_code == 0, result.output
+    assert "stopped at sim time" in result.output

@@ -148,14 +148,14 @@ def sitl(
     )
     vehicle = Sitl(config)
     signal.signal(signal.SIGTERM, _interrupt)  # `kill` stops it as cleanly as Ctrl-C
-    click.echo(
-        f"uavtool sitl: vehicle sysid {vehicle.sysid}, speedup {vehicle.speedup:g}x{scene_text}"
-    )
-    for ep in vehicle.describe_endpoints():
-        click.echo(f"  serving MAVLink on {ep}")
-    click.echo("  Ctrl-C to stop")
     code = 0
-    try:
+    try:  # from the first line it prints, a stop signal stops it cleanly
+        click.echo(
+            f"uavtool sitl: vehicle sysid {vehicle.sysid}, speedup {vehicle.speedup:g}x{scene_text}"
+        )
+        for ep in vehicle.describe_endpoints():
+            click.echo(f"  serving MAVLink on {ep}")
+        click.echo("  Ctrl-C to stop")
         vehicle.run(duration_s=duration)
     except KeyboardInterrupt as stop:
         # as every command and shell: 128 + the signal (Ctrl-C 130, `kill` 143)

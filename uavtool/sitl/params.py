@@ -88,6 +88,13 @@ PARAM_SPECS: tuple[ParamSpec, ...] = (
     P("FENCE_TYPE", 7, _INT8, 0, 15, "fence types: 1 max altitude, 2 circle, 4 polygon, 8 min alt"),
     P("FENCE_ACTION", 1, _INT8, 0, 5, "on a breach: 0 report, 1 RTL or LAND, 2 LAND, 3-5 RTL/LAND"),
     P("FENCE_MARGIN", 2.0, _REAL32, 1, 10, "distance inside the fence RTL keeps to, m"),
+    # What each servo output drives (ArduPilot's SERVOn_FUNCTION: 6 mount yaw, 7 mount pitch,
+    # 8 mount roll …). Kept so that an ArduCopter parameter file (the mount.parm of the
+    # README) loads as it is; the built-in vehicle's mount moves without them.
+    *(
+        P(f"SERVO{n}_FUNCTION", 0, _INT16, -1, 188, f"what servo output {n} drives")
+        for n in range(1, 17)
+    ),
 )
 
 _SPECS_BY_NAME = {spec.name: spec for spec in PARAM_SPECS}
