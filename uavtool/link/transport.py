@@ -31,9 +31,17 @@ class Transport(Protocol):
 
 
 class TcpTransport:
-    def __init__(self, host: str, port: int, *, connect_timeout_s: float = 10.0) -> None:
+    def __init__(
+        self,
+        host: str,
+        port: int,
+        *,
+        connect_timeout_s: float = 10.0,
+        waiting: Callable[[str], None] | None = None,
+    ) -> None:
         self.name = f"tcp:{host}:{port}"
         deadline = time.monotonic() + connect_timeout_s
+        told = False
         while True:  # a vehicle that is still starting refuses for a moment
             try:
                 self.sock = socket.create_connection((host, port), timeout=2.0)
@@ -41,6 +49,12 @@ class TcpTransport:
             except OSError as exc:
                 if time.monotonic() > deadline:
                     raise LinkError(f"{self.name}: cannot connect: {_why(exc)}") from None
+                if waiting is not None and not told:  # say so now, not after the timeout
+                    waiting(
+                        f"{self.name}: {_why(exc)}; trying again for up to "
+                        f"{connect_timeout_s:g} s (is the vehicle running? Ctrl-C stops)"
+                    )
+                    told = True
                 time.sleep(0.2)
         self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
 
@@ -136,9 +150,12 @@ class SerialTransport:
         self.port.close()
 
 
-def open_transport(text: str, *, timeout_s: float = 10.0) -> Transport:
+def open_transport(
+    text: str, *, timeout_s: float = 10.0, waiting: Callable[[str], None] | None = None
+) -> Transport:
     """Open a connection string; raises LinkError naming what is wrong. A TCP vehicle that
-    refuses is retried for ``timeout_s`` (it may still be starting)."""
+    refuses is retried for ``timeout_s`` (it may still be starting); ``waiting`` hears that
+    at the first refusal."""
     kind, _, rest = text.partition(":")
     if text.startswith("/dev/") or kind in ("serial", "com") or kind.upper().startswith("COM"):
         device, baud = _serial_parts(text)
@@ -157,7 +174,7 @@ def open_transport(text: str, *, timeout_s: float = 10.0) -> Transport:
     if not host or not 0 < port < 65536:
         raise LinkError(f"connection {text!r}: expected {kind}:HOST:PORT with a port 1-65535")
     if kind == "tcp":
-        return TcpTransport(host, port, connect_timeout_s=timeout_s)
+        return TcpTransport(host, port, connect_timeout_s=timeout_s, waiting=waiting)
     return opener(host, port)
 
 

@@ -120,7 +120,7 @@ def open_backend(
 ) -> Iterator[BuiltinBackend | ExternalBackend]:
     """The built-in vehicle (``config.connect`` None), or a connection to another."""
     if config.connect is not None:
-        transport = open_transport(config.connect, timeout_s=config.connect_timeout_s)
+        transport = open_transport(config.connect, timeout_s=config.connect_timeout_s, waiting=say)
         try:
             yield ExternalBackend(transport, config.scene_origin)
         finally:
