@@ -203,3 +203,15 @@ def test_per_frame_reanalysis_with_the_recorded_parameters_changes_nothing(
     changes = reanalyse_frames(flight, flight.params)
     assert [c.describe() for c in changes if c.changed] == []
     assert any(c.matched_after for c in changes)
+
+
+def test_vision_only_says_which_shape_it_judged_and_the_best_in_the_frame() -> None:
+    """The issue's case: a photo whose aimed-at shape scores 0.194 while another shape in it
+    (what `uavtool vision match` finds) scores 0.876."""
+    from uavtool.replay.frames import FrameChange
+
+    line = FrameChange(4, "poi-3", 2, 2, 0.194, 0.194, False, False, 0.876).describe()
+    assert "match score of the aimed-at shape 0.194 → 0.194" in line
+    assert "best shape in the frame 0.876" in line
+    same = FrameChange(4, "poi-3", 2, 2, 0.9, 0.9, True, True, 0.9).describe()
+    assert "best shape" not in same

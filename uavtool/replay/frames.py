@@ -26,6 +26,9 @@ class FrameChange:
     score_after: float | None
     matched_before: bool | None
     matched_after: bool | None
+    best_after: float | None = None
+    """The best score of any shape in the frame (the mission judges only the one the look
+    was aimed at)."""
 
     @property
     def changed(self) -> bool:
@@ -39,7 +42,9 @@ class FrameChange:
         parts = [f"shapes {self.shapes_before} → {self.shapes_after}"]
         if self.score_after is not None:
             before = "—" if self.score_before is None else f"{self.score_before:.3f}"
-            parts.append(f"match score {before} → {self.score_after:.3f}")
+            parts.append(f"match score of the aimed-at shape {before} → {self.score_after:.3f}")
+            if self.best_after is not None and self.best_after > self.score_after:
+                parts.append(f"best shape in the frame {self.best_after:.3f}")
             if self.matched_before == self.matched_after:
                 parts.append("decision unchanged")
             else:
@@ -72,13 +77,14 @@ def reanalyse_frames(flight: RecordedFlight, params: Params) -> list[FrameChange
             continue
         side = obs.tag.split("-")[0] in _SIDE_TAGS  # "front", or "front-2" for a retake
         shapes = side_shapes(params, obs.image_rgb) if side else nadir_shapes(params, obs.image_rgb)
-        score_after = matched_after = score_before = matched_before = None
+        score_after = matched_after = score_before = matched_before = best_after = None
         # The looks ("poi-3", "poi-3-2") are judged; "poi-3-roof" only measures a height.
         kind, *numbers = obs.tag.split("-")
         if kind == "poi" and numbers and all(n.isdigit() for n in numbers):
             aimed = poi_colours.get(int(numbers[0]))
             j = judge(params, target, shapes, obs.intrinsics, aimed)
             score_after, matched_after = j.score, j.matched
+            best_after = max(j.scores, default=None)
             before = recorded_judgement.get(obs.frame_index)
             if before is not None:
                 score_before, matched_before = float(before["score"]), bool(before["matched"])
@@ -92,6 +98,7 @@ def reanalyse_frames(flight: RecordedFlight, params: Params) -> list[FrameChange
                 score_after,
                 matched_before,
                 matched_after,
+                best_after,
             )
         )
     return changes
