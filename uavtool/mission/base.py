@@ -111,7 +111,7 @@ class FlightMission:
     """
 
     name: ClassVar[str] = ""
-    """The mission's name (``uavtool fly --mission NAME``); set by the registry if empty."""
+    """The name a recording gives the mission when it is not registered under one."""
     params_type: ClassVar[type[Any]] = type(None)
     """The parameters type: a frozen dataclass whose fields are groups of values."""
     needs_target: ClassVar[bool] = False
@@ -167,7 +167,7 @@ class FlightMission:
     # --- the outside: observations in, outputs out --------------------------------------------
 
     def start(self) -> list[Output]:
-        """The outputs before the first observation (the target's shapes)."""
+        """The outputs before the first observation (:meth:`first_outputs`)."""
         if self._started:
             raise MissionStateError("the mission was already started")
         self._started = True
@@ -209,7 +209,7 @@ class FlightMission:
     def _run(self) -> Wait[None]:
         try:
             done = yield from self.fly()
-            end = MissionEnd(Status.COMPLETED, done)
+            end = MissionEnd(Status.COMPLETED, done if isinstance(done, str) and done else "done")
         except MissionEnd as exc:
             end = exc
         self.event(
