@@ -55,10 +55,13 @@ def served(recording: Path) -> Iterator[str]:
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         url = _read_url(proc, timeout_s=60.0)
-        assert url.startswith(f"http://localhost:{web}/?url=rerun%2Bhttp")
-        with urllib.request.urlopen(f"http://localhost:{web}/", timeout=10) as page:
+        assert url.startswith(f"http://127.0.0.1:{web}/?url=rerun%2Bhttp")
+        with urllib.request.urlopen(f"http://127.0.0.1:{web}/", timeout=10) as page:
             assert page.status == 200
             assert b"Rerun" in page.read()
+        # Both servers on 127.0.0.1 only (issue 30: they listened on every interface)
+        listening = _listening_addresses({web, grpc})
+        assert listening == {("127.0.0.1", web), ("127.0.0.1", grpc)}, listening
         yield url
     finally:
         proc.terminate()
@@ -67,6 +70,24 @@ def served(recording: Path) -> Iterator[str]:
         except subprocess.TimeoutExpired:
             proc.kill()
             proc.communicate()
+
+
+def _listening_addresses(ports: set[int]) -> set[tuple[str, int]]:
+    """(address, port) of every listening TCP socket on ``ports``, from /proc/net/tcp{,6}."""
+    found = set()
+    for name in ("/proc/net/tcp", "/proc/net/tcp6"):
+        with Path(name).open(encoding="ascii") as table:
+            for line in list(table)[1:]:
+                local, state = line.split()[1], line.split()[3]
+                address, port = local.split(":")
+                if state == "0A" and int(port, 16) in ports:  # LISTEN
+                    ip = (
+                        ".".join(str(b) for b in reversed(bytes.fromhex(address)))
+                        if len(address) == 8
+                        else address
+                    )
+                    found.add((ip, int(port, 16)))
+    return found
 
 
 def _read_url(proc: subprocess.Popen[str], *, timeout_s: float) -> str:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import signal
 import sys
 import time
 from pathlib import Path
@@ -25,8 +26,8 @@ from uavtool.terminal import counted
 @click.option(
     "--web",
     is_flag=True,
-    help="Serve the web viewer and print its localhost URL. Rerun listens on every network "
-    "interface (it has no option to bind one): firewall the ports on a shared network.",
+    help="Serve the web viewer (Rerun's own server, on 127.0.0.1 unless --bind says "
+    "otherwise) and print its URL.",
 )
 @click.option(
     "--compare",
@@ -37,6 +38,14 @@ from uavtool.terminal import counted
 )
 @click.option("--port", default=9090, show_default=True, type=int, help="Web viewer port (--web).")
 @click.option(
+    "--bind",
+    default="127.0.0.1",
+    show_default=True,
+    metavar="ADDRESS",
+    help="Where the web viewer and its data server listen (--web); 0.0.0.0 serves other "
+    "machines too (anyone who can connect sees the flight).",
+)
+@click.option(
     "--grpc-port", default=9876, show_default=True, type=int, help="Data server port (--web)."
 )
 def view(
@@ -45,6 +54,7 @@ def view(
     web: bool,
     compare: Path | None,
     port: int,
+    bind: str,
     grpc_port: int,
 ) -> None:
     """Show RECORDING (an MCAP file from `uavtool fly`) in Rerun: the scene, the route with
@@ -66,7 +76,13 @@ def view(
         if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
             raise InputError("no display for the native viewer: use --web or --save OUT.rrd")
     result = show(
-        recording, save=save, web=web, compare=compare, web_port=port, grpc_port=grpc_port
+        recording,
+        save=save,
+        web=web,
+        compare=compare,
+        web_port=port,
+        grpc_port=grpc_port,
+        bind=bind,
     )
     c = result.counts
     summary = (
@@ -85,8 +101,13 @@ def view(
         return
     click.echo(f"web viewer: {result.url}")
     click.echo(f"({summary}; Ctrl-C to stop)")
+    signal.signal(signal.SIGTERM, _stop)  # `kill` stops the servers too
     try:
         while True:
             time.sleep(3600)
     finally:
         result.viewer.close()
+
+
+def _stop(_signum: int, _frame: object) -> None:
+    raise KeyboardInterrupt

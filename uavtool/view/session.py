@@ -7,6 +7,14 @@ and a `MissionLogger` on it; `view` feeds it a recording (and a second one to co
 
 from __future__ import annotations
 
+import contextlib
+import importlib.util
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import time
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,14 +32,26 @@ from uavtool.view.source import log_recording
 APPLICATION_ID = "uavtool"
 
 
+LOCALHOST = "127.0.0.1"
+"""Where the web viewer's servers listen unless the user asks for another address."""
+
+
 class Viewer:
     """An open Rerun stream: ``logger`` logs into it; ``url`` is the web viewer's address
     when serving one. ``close`` flushes and finishes the file or stops the servers."""
 
-    def __init__(self, rec: rr.RecordingStream, *, batch: int, url: str | None) -> None:
+    def __init__(
+        self,
+        rec: rr.RecordingStream,
+        *,
+        batch: int,
+        url: str | None,
+        server: subprocess.Popen[bytes] | None = None,
+    ) -> None:
         self.rec = rec
         self.url = url
         self.logger = MissionLogger(rec, batch=batch)
+        self._server = server
 
     def compare_logger(self) -> MissionLogger:
         """A logger for a second mission shown beside the first (entities under ``compare/``)."""
@@ -44,6 +64,13 @@ class Viewer:
     def close(self) -> None:
         self.flush()
         self.rec.disconnect()
+        if self._server is not None:  # the web viewer's servers go with us
+            self._server.terminate()
+            try:
+                self._server.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self._server.kill()
+                self._server.wait()
 
 
 def open_viewer(
@@ -52,6 +79,7 @@ def open_viewer(
     web: bool = False,
     web_port: int | None = None,
     grpc_port: int | None = None,
+    bind: str = LOCALHOST,
     compare: bool = False,
     batch: int = 10,
 ) -> Viewer:
@@ -63,21 +91,87 @@ def open_viewer(
     rec.set_log_time_enabled(False)
     blueprint = default_blueprint(compare=compare)
     url = None
+    server = None
     try:
         if save is not None:
             Path(save).parent.mkdir(parents=True, exist_ok=True)
             rec.save(save, default_blueprint=blueprint)
         elif web:
-            grpc_url = rec.serve_grpc(grpc_port=grpc_port, default_blueprint=blueprint)
             port = 9090 if web_port is None else web_port
-            rr.serve_web_viewer(web_port=port, open_browser=False, connect_to=grpc_url)
-            url = f"http://localhost:{port}/?url={quote(grpc_url, safe='')}"
+            grpc = grpc_port or _free_port(bind)
+            server = _serve_web(bind, grpc, port)
+            grpc_url = f"rerun+http://{_host(bind)}:{grpc}/proxy"
+            rec.connect_grpc(grpc_url, default_blueprint=blueprint)
+            url = f"http://{_host(bind)}:{port}/?url={quote(grpc_url, safe='')}"
         else:
             rec.spawn(default_blueprint=blueprint)
     except (OSError, RuntimeError, ValueError) as exc:
+        if server is not None:
+            server.kill()
         where = save if save is not None else ("the web viewer" if web else "the native viewer")
         raise ViewError(f"{where}: cannot open: {exc}") from None
-    return Viewer(rec, batch=batch, url=url)
+    return Viewer(rec, batch=batch, url=url, server=server)
+
+
+def _serve_web(bind: str, grpc_port: int, web_port: int) -> subprocess.Popen[bytes]:
+    """Rerun's own server, as a child process: its gRPC proxy and web viewer bound to
+    ``bind`` (the SDK's in-process servers listen on every interface and take no address)."""
+    cmd = [*_die_with_us(), _rerun_binary(), "--serve-web", "--bind", bind]
+    cmd += ["--port", str(grpc_port), "--web-viewer-port", str(web_port)]
+    env = dict(os.environ, RERUN_ANALYTICS="0")
+    proc = subprocess.Popen(
+        cmd,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        env=env,
+        start_new_session=True,  # Ctrl-C is ours to handle: we stop it, whole
+    )
+    deadline = time.monotonic() + _SERVER_START_S
+    while time.monotonic() < deadline:
+        if proc.poll() is not None:
+            why = (proc.stderr.read() if proc.stderr else b"").decode(errors="replace").strip()
+            last = why.splitlines()[-1] if why else f"exit {proc.returncode}"
+            raise OSError(f"Rerun's server stopped: {last[-200:]}")
+        with contextlib.suppress(OSError), socket.create_connection((_host(bind), grpc_port), 0.2):
+            return proc
+        time.sleep(0.1)
+    proc.kill()
+    raise OSError(f"Rerun's server did not listen on port {grpc_port} in {_SERVER_START_S:g} s")
+
+
+_SERVER_START_S = 30.0
+
+
+def _rerun_binary() -> str:
+    """The rerun-sdk's own ``rerun`` executable (``python -m rerun`` would run it as a second
+    process, which stopping the first would leave behind)."""
+    spec = importlib.util.find_spec("rerun_cli")  # installed with rerun-sdk
+    if spec is None or spec.origin is None:
+        raise OSError("rerun-sdk's rerun_cli is not installed")
+    folder = Path(spec.origin).parent
+    found = next((p for p in (folder / "rerun", folder / "rerun.exe") if p.is_file()), None)
+    if found is None:
+        raise OSError(f"rerun-sdk's rerun executable is not in {folder}")
+    return str(found)
+
+
+def _die_with_us() -> list[str]:
+    """A prefix that stops the server when uavtool stops, however it stops (a kill must not
+    leave a server listening): util-linux's ``setpriv --pdeathsig`` where there is one."""
+    setpriv = shutil.which("setpriv") if sys.platform.startswith("linux") else None
+    return [setpriv, "--pdeathsig", "TERM"] if setpriv else []
+
+
+def _host(bind: str) -> str:
+    """The address to reach a server bound to ``bind`` at (every interface: this machine)."""
+    return LOCALHOST if bind in ("0.0.0.0", "::", "") else bind
+
+
+def _free_port(bind: str) -> int:
+    with socket.socket() as s:
+        s.bind((_host(bind), 0))
+        port: int = s.getsockname()[1]
+        return port
 
 
 @dataclass(frozen=True, slots=True)
@@ -102,6 +196,7 @@ def view(
     compare: str | Path | None = None,
     web_port: int | None = None,
     grpc_port: int | None = None,
+    bind: str = LOCALHOST,
 ) -> ViewResult:
     """Show the recording at ``path`` (and ``compare`` beside it) in Rerun; see
     `open_viewer` for the sinks. With ``save`` the file is complete on return; with ``web``
@@ -112,7 +207,15 @@ def view(
     if save is not None:
         with atomic_output(save, inputs=[path, compare]) as tmp:
             return _view(path, save=tmp, web=False, compare=compare)
-    return _view(path, save=None, web=web, compare=compare, web_port=web_port, grpc_port=grpc_port)
+    return _view(
+        path,
+        save=None,
+        web=web,
+        compare=compare,
+        web_port=web_port,
+        grpc_port=grpc_port,
+        bind=bind,
+    )
 
 
 def _view(
@@ -123,12 +226,14 @@ def _view(
     compare: str | Path | None,
     web_port: int | None = None,
     grpc_port: int | None = None,
+    bind: str = LOCALHOST,
 ) -> ViewResult:
     viewer = open_viewer(
         save=save,
         web=web,
         web_port=web_port,
         grpc_port=grpc_port,
+        bind=bind,
         compare=compare is not None,
         batch=1 << 30,
     )
