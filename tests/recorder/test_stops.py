@@ -240,7 +240,8 @@ def test_until_landed_stops_when_the_vehicle_dies(
         thread.join()
         sitl.stop()
     assert summary[0].stop.value == "vehicle lost"
-    assert 2.0 <= took < 5.0
+    # from the last message heard (just before it died) to the stop: about the 2 s limit
+    assert 1.8 <= took < 5.0
     assert summarize(out).record_result["stopped"] == "vehicle lost"  # what info shows
 
 

@@ -145,7 +145,7 @@ def parse_spec(data: Mapping[str, Any], *, source: str, base: Path, default_out:
     if out is not None and not isinstance(out, str):
         raise SpecError(source, "sweep.out", f"expected a folder path, got {out!r}")
     fmt = sweep.get("format", "parquet")
-    if fmt not in {f.value for f in TableFormat}:
+    if not isinstance(fmt, str) or fmt not in {f.value for f in TableFormat}:
         raise SpecError(source, "sweep.format", f"expected 'parquet' or 'csv', got {fmt!r}")
     retries = sweep.get("retries", 2)
     if isinstance(retries, bool) or not isinstance(retries, int) or not 0 <= retries <= 10:
