@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from uavtool.errors import UavtoolError
@@ -83,6 +83,7 @@ def _read(call: Any) -> Any:
 
 @_SETTINGS
 @given(data=_SPEC)
+@example(data={"sweep": {"format": []}})  # found in CI: a TypeError before
 def test_any_spec_data_is_a_spec_or_one_line(tmp_path: Path, data: dict[str, Any]) -> None:
     spec = _read(lambda: parse_spec(data, source="fuzz.toml", base=tmp_path, default_out=tmp_path))
     if spec is not None and flight_count(spec) <= 2_000:
