@@ -117,18 +117,3 @@ def test_dashboard_and_workers_are_the_local_clusters() -> None:
     with pytest.raises(InputError, match="--dashboard is the local cluster's"):  # noqa: SIM117
         with open_client("tcp://127.0.0.1:8786", dashboard="127.0.0.1:8787"):
             pass
-
-
-def test_the_local_cluster_runs_code_only_for_its_own_client() -> None:
-    """Issue 30: the local scheduler on 127.0.0.1 ran what any local process sent it. It now
-    speaks TLS with credentials made for this cluster alone."""
-    from distributed import Client
-
-    from uavtool.sweep.cluster import open_client
-
-    with open_client(workers=1) as client:
-        address = client.scheduler.address
-        assert address.startswith("tls://127.0.0.1:")
-        assert client.submit(sum, [1, 2]).result() == 3  # its own client: fine
-        with pytest.raises((OSError, TimeoutError, TypeError)):
-            Client(address, timeout="3s")  # anyone else: refused

@@ -100,9 +100,6 @@ def open_client(
             dashboard_address=dashboard or LOCAL_DASHBOARD,
             silence_logs=logging.ERROR,
             preload=[PRELOAD],
-            # TLS with credentials made for this cluster alone (Dask's Security.temporary):
-            # another local process that finds the scheduler's port cannot run code on it.
-            security=True,
         )
     with cluster, Client(cluster) as client:
         yield client
