@@ -5,10 +5,16 @@ when its argument is a folder or a glob."""
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
+
+if TYPE_CHECKING:
+    from uavtool.sweep.progress import Progress
 
 _GLOB = set("*?[")
 
@@ -37,7 +43,6 @@ def replay_batch(
     ``target`` (required for them; a row says so when it is missing)."""
     from uavtool.cli.replay import _params_file
     from uavtool.mission.params import parse_settings
-    from uavtool.sweep.progress import format_progress
     from uavtool.sweep.replay import (
         IDENTICAL,
         find_recordings,
@@ -59,21 +64,16 @@ def replay_batch(
             param_hint="--out",
         )
 
-    def draw(text: str) -> None:
-        if not quiet and sys.stderr.isatty():
-            click.echo(f"\r\x1b[2K{text}", nl=False, err=True)
-
-    batch = replay_many(
-        paths,
-        overrides=overrides,
-        vision_only=vision_only,
-        target_png=target_png,
-        scheduler=scheduler,
-        workers=workers,
-        progress=lambda p: draw(format_progress(p, noun="recordings")),
-    )
-    if not quiet and sys.stderr.isatty():
-        click.echo(err=True)
+    with _progress_line(quiet) as progress:
+        batch = replay_many(
+            paths,
+            overrides=overrides,
+            vision_only=vision_only,
+            target_png=target_png,
+            scheduler=scheduler,
+            workers=workers,
+            progress=progress,
+        )
     write_replay_table(batch, table)
     text = format_replay_summary(batch, total=len(paths), changed_params=bool(overrides))
     table.with_suffix(".txt").write_text(text + "\n", encoding="utf-8")
@@ -116,7 +116,6 @@ def vision_batch(
     default ``vision-<UTC time>``) as ``<name>.vision.mcap``, with a table of them there."""
     from uavtool.plugins import code_dir
     from uavtool.replay.vision import load_function
-    from uavtool.sweep.progress import format_progress
     from uavtool.sweep.replay import find_recordings
     from uavtool.sweep.vision import format_vision_summary, vision_many, write_vision_table
 
@@ -129,23 +128,35 @@ def vision_batch(
         )
     folder.mkdir(parents=True, exist_ok=True)
 
-    def draw(text: str) -> None:
-        if not quiet and sys.stderr.isatty():
-            click.echo(f"\r\x1b[2K{text}", nl=False, err=True)
-
-    batch = vision_many(
-        paths,
-        spec=spec,
-        out_dir=folder,
-        code_dir=code_dir(),
-        scheduler=scheduler,
-        workers=workers,
-        progress=lambda p: draw(format_progress(p, noun="recordings")),
-    )
-    if not quiet and sys.stderr.isatty():
-        click.echo(err=True)
+    with _progress_line(quiet) as progress:
+        batch = vision_many(
+            paths,
+            spec=spec,
+            out_dir=folder,
+            code_dir=code_dir(),
+            scheduler=scheduler,
+            workers=workers,
+            progress=progress,
+        )
     table = folder / "vision.parquet"
     write_vision_table(batch, table)
     click.echo(format_vision_summary(batch, total=len(paths), spec=spec, table=table))
     if batch.interrupted or any(r.get("error") for r in batch.rows):
         sys.exit(1)
+
+
+@contextmanager
+def _progress_line(quiet: bool) -> Iterator[Callable[[Progress], None]]:
+    """A progress callback that redraws one line on a terminal's stderr (nothing elsewhere,
+    or with ``quiet``), ended with a newline."""
+    from uavtool.sweep.progress import format_progress
+
+    shown = not quiet and sys.stderr.isatty()
+
+    def draw(p: Progress) -> None:
+        if shown:
+            click.echo(f"\r\x1b[2K{format_progress(p, noun='recordings')}", nl=False, err=True)
+
+    yield draw
+    if shown:
+        click.echo(err=True)

@@ -106,25 +106,22 @@ def _fly(
     )
     s = fly(config, progress=None if timeout_s is None else VehicleDeadline(timeout_s))
     o, e = s.outcome, s.evaluation
-    if not s.searched:  # another mission: its outcome, not the search's findings
-        return {
-            "status": o.status.value,
-            "exit_code": exit_codes.get(o.status.value),
-            "reason": o.reason,
-            "error": None,
-            "clearance_m": s.clearance_m,
-            "closest_building": s.clearance_building or None,
-            "flight_time_s": s.flight_time_s,
-            "vehicle_time_s": s.vehicle_time_s,
-            "route_length_m": s.route_length_m,
-            "frames": s.frames,
-        }
-    scores = recognition_scores(record, scene)
-    return {
+    columns: dict[str, Any] = {
         "status": o.status.value,
         "exit_code": exit_codes.get(o.status.value),
         "reason": o.reason,
         "error": None,
+        "clearance_m": s.clearance_m,
+        "closest_building": s.clearance_building or None,
+        "flight_time_s": s.flight_time_s,
+        "vehicle_time_s": s.vehicle_time_s,
+        "route_length_m": s.route_length_m,
+        "frames": s.frames,
+    }
+    if not s.searched:  # another mission: its outcome, not the search's findings
+        return columns
+    scores = recognition_scores(record, scene)
+    return columns | {
         "target_building": scene.target,
         "matched_building": e.matched_building or None,
         "correct": bool(e.matched_building) and e.matched_building == scene.target,
@@ -136,12 +133,6 @@ def _fly(
         "model_built": o.model_built,
         "iou": e.model_iou,
         "tunnel_kept": e.tunnel_kept,
-        "clearance_m": s.clearance_m,
-        "closest_building": s.clearance_building or None,
-        "flight_time_s": s.flight_time_s,
-        "vehicle_time_s": s.vehicle_time_s,
-        "route_length_m": s.route_length_m,
-        "frames": s.frames,
     }
 
 
