@@ -144,6 +144,7 @@ def plan_flights(spec: SweepSpec) -> list[FlightSpec]:
 def _flights(spec: SweepSpec) -> Iterator[FlightSpec]:
     keys = [k for k, _ in spec.grid]
     checked: dict[tuple[str, str], Any] = {}
+    params_type = resolve(spec.mission)[0].params_type  # once: the draws check against it
     index = 0
     for source in spec.scenes:
         for seed in source.seeds or (None,):
@@ -155,7 +156,10 @@ def _flights(spec: SweepSpec) -> Iterator[FlightSpec]:
                     inputs = [*case, *zip(keys, combo, strict=True)]
                     if spec.random:
                         rng = random.Random(f"{spec.rng_seed}|{label}|{g}|{d}")
-                        inputs += [(k, _draw(k, law, rng, checked, spec)) for k, law in spec.random]
+                        inputs += [
+                            (k, _draw(k, law, rng, checked, spec, params_type))
+                            for k, law in spec.random
+                        ]
                     yield FlightSpec(index, one, tuple(inputs), spec.mission)
                     index += 1
 
@@ -166,6 +170,7 @@ def _draw(
     rng: random.Random,
     checked: dict[tuple[str, str], Any],
     spec: SweepSpec,
+    params_type: type,
 ) -> Any:
     value = law.draw(rng)
     if law.law is Law.UNIFORM and key.startswith(dimensions.SET_PREFIX):
@@ -173,7 +178,7 @@ def _draw(
     memo = (key, repr(value))
     if memo not in checked:
         try:
-            checked[memo] = dimensions.check(key, value, resolve(spec.mission)[0].params_type)
+            checked[memo] = dimensions.check(key, value, params_type)
         except (KeyError, ValueError) as exc:
             raise SpecError(spec.source, f"random.{key}", f"drew {value!r}: {exc}") from None
     return checked[memo]
