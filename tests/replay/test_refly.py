@@ -20,7 +20,7 @@ GOLDEN = Path(__file__).parents[2] / "recordings" / "golden" / "paper.mcap"
 
 def test_refly_cli_reports_identical(tmp_path: Path) -> None:
     out = tmp_path / "again.mcap"
-    result = CliRunner().invoke(cli, ["replay", "--refly", str(GOLDEN), "--out", str(out)])
+    result = CliRunner().invoke(cli, ["replay", "--refly", str(GOLDEN), "--output", str(out)])
     assert result.exit_code == 0, result.output
     assert "identical: the new recording equals the old one" in result.output
     assert out.exists()
@@ -31,9 +31,9 @@ def test_a_no_gimbal_flight_re_flies_the_same(tmp_path: Path) -> None:
     in the recording, so the flight flown again is the same one (before, re-flown with a
     gimbal: 140.9 s instead of 172.9 s)."""
     flown, again = tmp_path / "fixed.mcap", tmp_path / "again.mcap"
-    first = CliRunner().invoke(cli, ["fly", "-q", "--no-gimbal", "--record", str(flown)])
+    first = CliRunner().invoke(cli, ["fly", "-q", "--no-gimbal", "--output", str(flown)])
     assert first.exit_code == 3, first.output  # partial: no model without a gimbal
-    result = CliRunner().invoke(cli, ["replay", "--refly", str(flown), "--out", str(again)])
+    result = CliRunner().invoke(cli, ["replay", "--refly", str(flown), "--output", str(again)])
     assert result.exit_code == 0, result.output
     assert "identical: the new recording equals the old one" in result.output
 

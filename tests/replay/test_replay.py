@@ -63,14 +63,14 @@ def test_unknown_parameter_lists_the_valid_ones() -> None:
 def test_params_file(tmp_path: Path) -> None:
     params = tmp_path / "p.json"
     params.write_text(json.dumps({"recognize": {"threshold": 0.995}}))
-    code, out = run("replay", "-q", str(PAPER), "--params", str(params))
+    code, out = run("replay", "-q", str(PAPER), "--set-file", str(params))
     assert code == 0
     assert "diverged" in out
 
 
 def test_out_writes_a_recording_that_replays_identically(tmp_path: Path) -> None:
     out = tmp_path / "replayed.mcap"
-    code, text = run("replay", "-q", str(PAPER), "--out", str(out))
+    code, text = run("replay", "-q", str(PAPER), "--output", str(out))
     assert code == 0, text
     original = load_flight(PAPER)
     copy = load_flight(out)

@@ -26,7 +26,7 @@ def _sweep(tmp_path: Path, spec: str | bytes, *args: str) -> tuple[str, Path]:
     else:
         path.write_text(spec)
     out = tmp_path / "out"
-    result = CliRunner().invoke(cli, ["sweep", str(path), "--out", str(out), "-q", *args])
+    result = CliRunner().invoke(cli, ["sweep", str(path), "--output", str(out), "-q", *args])
     assert result.exit_code == 2, result.output
     assert "Traceback" not in result.output
     assert len(result.output.strip().splitlines()) == 1, result.output

@@ -24,7 +24,7 @@ def test_ctrl_c_exits_130_quietly_and_resume_completes(tmp_path: Path, scheduler
     spec = tmp_path / "three.toml"
     spec.write_text(SPEC)
     out = tmp_path / "out"
-    command = [sys.executable, "-m", "uavtool", "sweep", str(spec), "--out", str(out)]
+    command = [sys.executable, "-m", "uavtool", "sweep", str(spec), "--output", str(out)]
     sweep = subprocess.Popen(
         [*command, "--workers", "1", "-q"],
         stdout=subprocess.PIPE,
@@ -42,7 +42,7 @@ def test_ctrl_c_exits_130_quietly_and_resume_completes(tmp_path: Path, scheduler
     assert sweep.returncode == 130, stderr
     assert "Traceback" not in stderr and "KeyboardInterrupt" not in stderr, stderr
     # The hint is the whole command that resumes: the spec, the folder, and then --resume.
-    assert f"continue with: uavtool sweep {spec} --out {out} --workers 1 --resume" in stderr
+    assert f"continue with: uavtool sweep {spec} --output {out} --workers 1 --resume" in stderr
     # No worker process outlives the command.
     _wait_for(lambda: not _live_processes(sweep.pid), timeout_s=30)
 
@@ -59,7 +59,7 @@ def test_ctrl_c_exits_130_quietly_and_resume_completes(tmp_path: Path, scheduler
     assert f"flights        {len(rows)} of 3 (incomplete)" in stdout
 
     resumed = CliRunner().invoke(
-        cli, ["sweep", str(spec), "--out", str(out), "--resume", "--scheduler", scheduler, "-q"]
+        cli, ["sweep", str(spec), "--output", str(out), "--resume", "--scheduler", scheduler, "-q"]
     )
     assert resumed.exit_code == 0, resumed.output
     assert "flights        3 of 3\n" in resumed.output

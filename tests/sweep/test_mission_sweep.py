@@ -25,7 +25,7 @@ def test_a_sweep_flies_the_mission_it_names(tmp_path: Path, scheduler: str) -> N
     spec = tmp_path / "orbit.toml"
     spec.write_text(SPEC)
     out = tmp_path / "out"
-    args = ["sweep", str(spec), "--out", str(out), "--scheduler", scheduler, "-q"]
+    args = ["sweep", str(spec), "--output", str(out), "--scheduler", scheduler, "-q"]
     result = CliRunner().invoke(cli, args)
     assert result.exit_code == 0, result.output
     assert "correct match" not in result.output  # the search's findings: not this mission's
@@ -44,10 +44,10 @@ def test_a_sweep_flies_the_mission_it_names(tmp_path: Path, scheduler: str) -> N
 def test_a_parameter_of_another_mission_is_refused_by_name(tmp_path: Path) -> None:
     spec = tmp_path / "bad.toml"
     spec.write_text(SPEC.replace("set.orbit.step_deg", "set.mission.look_fill"))
-    result = CliRunner().invoke(cli, ["sweep", str(spec), "--out", str(tmp_path / "o")])
+    result = CliRunner().invoke(cli, ["sweep", str(spec), "--output", str(tmp_path / "o")])
     assert result.exit_code == 2
     assert "unknown mission parameter 'mission.look_fill'" in result.output, result.output
     spec.write_text(SPEC.replace('"orbit"', '"nosuch"'))
-    result = CliRunner().invoke(cli, ["sweep", str(spec), "--out", str(tmp_path / "o")])
+    result = CliRunner().invoke(cli, ["sweep", str(spec), "--output", str(tmp_path / "o")])
     assert result.exit_code == 2 and "sweep.mission" in result.output, result.output
     assert "no such mission" in result.output and "Traceback" not in result.output

@@ -16,7 +16,7 @@ GOLDEN = Path(__file__).resolve().parents[2] / "recordings" / "golden"
 def test_check_over_the_golden_folder_reports_all_identical(tmp_path: Path, scheduler: str) -> None:
     table = tmp_path / "check.parquet"
     result = CliRunner().invoke(
-        cli, ["replay", "--check", str(GOLDEN), "--out", str(table), "--scheduler", scheduler]
+        cli, ["replay", "--check", str(GOLDEN), "--output", str(table), "--scheduler", scheduler]
     )
     assert result.exit_code == 0, result.output
     rows = read_table(table)
@@ -45,7 +45,7 @@ def test_a_changed_parameter_reports_the_flights_that_differ(
             pattern,
             "--set",
             f"recognize.threshold={threshold}",
-            "--out",
+            "--output",
             str(table),
             "--scheduler",
             scheduler,

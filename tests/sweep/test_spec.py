@@ -122,9 +122,9 @@ def test_a_bad_spec_exits_2_naming_the_key_path(
     tmp_path: Path, text: str, overrides: list[str], where: str
 ) -> None:
     path = write(tmp_path, text)
-    args = ["sweep", str(path), "--out", str(tmp_path / "out")]
+    args = ["sweep", str(path), "--output", str(tmp_path / "out")]
     for o in overrides:
-        args += ["-o", o]
+        args += ["--set", o]
     result = CliRunner().invoke(cli, args)
     assert result.exit_code == 2, result.output
     assert f"{path}: {where}" in result.output or where in result.output

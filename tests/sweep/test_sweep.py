@@ -49,7 +49,7 @@ def swept(spec_path: Path, scheduler: str) -> Path:
     """The six flights, swept once through the command line on the 2-worker cluster."""
     out = spec_path.parent / "out"
     result = CliRunner().invoke(
-        cli, ["sweep", str(spec_path), "--out", str(out), "--scheduler", scheduler, "-q"]
+        cli, ["sweep", str(spec_path), "--output", str(out), "--scheduler", scheduler, "-q"]
     )
     assert result.exit_code == 1, result.output  # three flights raised: rows with errors
     assert "flights        6 of 6" in result.output
@@ -108,7 +108,7 @@ def test_resume_refuses_another_sweep_and_changes_nothing(
     other = load_spec(spec_path, ["grid.seed=[7, 8, 9]"])
     with pytest.raises(OutputExistsError, match="holds another sweep") as exc:
         run_sweep(other, exit_codes=EXIT_CODES, out=out, resume=True, plots=False)
-    assert "--override values it was started with" in str(exc.value)
+    assert "--set values it was started with" in str(exc.value)
     after = {p: p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()}
     assert after == before  # not a byte changed
     (out / "plan.json").unlink()  # a folder from before plans were kept: the spec's text
@@ -212,7 +212,7 @@ def test_a_timeout_a_csv_table_and_no_matplotlib(
     path = tmp_path / "one.toml"
     path.write_text('[scenes]\nbuiltin = ["paper"]\n')
     out = tmp_path / "out"
-    args = ["sweep", str(path), "--out", str(out), "--scheduler", scheduler, "--csv", "-q"]
+    args = ["sweep", str(path), "--output", str(out), "--scheduler", scheduler, "--csv", "-q"]
     result = CliRunner().invoke(cli, [*args, "--timeout", "30"])
     assert result.exit_code == 1, result.output
     assert "plots skipped: matplotlib is not installed" in result.output

@@ -41,7 +41,7 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
         return GOLDEN
     out = tmp_path_factory.mktemp("fly") / "paper.mcap"
     proc = subprocess.run(
-        [sys.executable, "-m", "uavtool", "fly", "--scene", "paper", "--record", str(out), "-q"],
+        [sys.executable, "-m", "uavtool", "fly", "--scene", "paper", "--output", str(out), "-q"],
         capture_output=True,
         text=True,
         timeout=300,

@@ -10,6 +10,7 @@ import click
 
 from uavtool.checks import NON_NEGATIVE, POSITIVE, Range, coerce
 from uavtool.cli.options import SEED, Number, Numbers
+from uavtool.cli.spelling import Command, OldSpelling
 from uavtool.errors import InputError
 
 EXIT_CODES: dict[str, int] = {
@@ -28,7 +29,7 @@ _WIND = Numbers(",", (("SPEED", Range(0.0, 50.0)), ("DIR", Range(-360.0, 360.0))
 _OUTAGE = Numbers(":", (("START", NON_NEGATIVE), ("DURATION", POSITIVE)), example="60:10")
 
 
-@click.command()
+@click.command(cls=Command, old_spellings=(OldSpelling("--record", "--output", "-o/--output"),))
 @click.option(
     "--connect",
     default=None,
@@ -56,10 +57,12 @@ _OUTAGE = Numbers(":", (("START", NON_NEGATIVE), ("DURATION", POSITIVE)), exampl
     "the flight (lockstep). Default: max (as fast as the CPU allows); 1 with --rerun spawn|web.",
 )
 @click.option(
-    "--record",
+    "-o",
+    "--output",
+    "record",
     type=click.Path(path_type=Path),
     default=None,
-    help="Recording path. Default: recordings/<UTC time>.mcap.",
+    help="The recording to write (MCAP).  [default: recordings/<UTC time>.mcap]",
 )
 @click.option("--no-record", is_flag=True, help="Do not write a recording.")
 @click.option(
@@ -116,7 +119,8 @@ _OUTAGE = Numbers(":", (("START", NON_NEGATIVE), ("DURATION", POSITIVE)), exampl
     default=30.0,
     show_default=True,
     type=Number(_SECONDS),
-    help="Seconds to wait for the vehicle to connect and report its home (vehicle seconds for "
+    metavar="SECONDS",
+    help="How long to wait for the vehicle to connect and report its home (vehicle seconds for "
     "the built-in one).",
 )
 @click.option(
@@ -189,7 +193,7 @@ def fly(
     from uavtool.runner.summary import format_progress, format_summary
 
     if record is not None and no_record:
-        raise click.UsageError("--record and --no-record exclude each other")
+        raise InputError("-o/--output and --no-record exclude each other")
     mission_cls, _ = resolve(mission)
     overrides = parse_settings(settings)
     if visit_all:

@@ -57,8 +57,8 @@ from uavtool.terminal import counted
     type=float,
     default=0.0,
     show_default=True,
-    metavar="S",
-    help="Also take a photo every S seconds (0: only on the camera commands seen on the link).",
+    metavar="SECONDS",
+    help="Also take a photo this often (0: only on the camera commands seen on the link).",
 )
 @click.option(
     "--hfov",
@@ -77,7 +77,12 @@ from uavtool.terminal import counted
     help="The camera's pitch when the vehicle reports no gimbal attitude (−90: straight down).",
 )
 @click.option(
-    "--duration", "duration_s", type=float, default=None, metavar="S", help="Stop after S seconds."
+    "--duration",
+    "duration_s",
+    type=float,
+    default=None,
+    metavar="SECONDS",
+    help="Stop after this many seconds.",
 )
 @click.option(
     "--until-landed", is_flag=True, help="Stop once the vehicle has flown, landed and disarmed."
@@ -88,8 +93,8 @@ from uavtool.terminal import counted
     type=float,
     default=30.0,
     show_default=True,
-    metavar="S",
-    help="Give up (exit 2) when no vehicle is heard in S seconds.",
+    metavar="SECONDS",
+    help="Give up (exit 2) when no vehicle is heard in this many seconds.",
 )
 def record(
     connect: str,
@@ -119,7 +124,7 @@ def record(
       mavproxy.py --master tcp:127.0.0.1:5760 --out udp:127.0.0.1:14551
       uavtool record --connect udpin:127.0.0.1:14551 -o flight.mcap --camera opencv:0
       uavtool record --connect tcp:127.0.0.1:5760 -o sim.mcap --camera sim --until-landed
-      uavtool replay --vision-only sim.mcap --target target.png --out analysed.mcap
+      uavtool replay --vision-only sim.mcap --target target.png -o analysed.mcap
     """
     from uavtool.recorder import RecordConfig
     from uavtool.recorder import record as run

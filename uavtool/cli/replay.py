@@ -8,11 +8,17 @@ from pathlib import Path
 
 import click
 
+from uavtool.cli.spelling import Command, OldSpelling
 from uavtool.errors import FailureError, InputError
 from uavtool.terminal import counted
 
+_OLD_SPELLINGS = (
+    OldSpelling("--out", "--output", "-o/--output"),
+    OldSpelling("--params", "--set-file", "--set-file"),
+)
 
-@click.command()
+
+@click.command(cls=Command, old_spellings=_OLD_SPELLINGS)
 @click.argument("recording", type=click.Path(path_type=Path))
 @click.option(
     "--check",
@@ -27,14 +33,17 @@ from uavtool.terminal import counted
     help="Override a mission parameter (repeatable), e.g. vectorize.rdp_epsilon_px=3.",
 )
 @click.option(
-    "--params",
+    "--set-file",
     "params_file",
     type=click.Path(path_type=Path),
     default=None,
-    help="JSON file of parameters (nested or dotted keys) to override.",
+    metavar="FILE.json",
+    help="Override mission parameters from a JSON file (nested or dotted keys); --set wins.",
 )
 @click.option(
-    "--out",
+    "-o",
+    "--output",
+    "out",
     type=click.Path(path_type=Path),
     default=None,
     help="Write the replay as a new recording.",
@@ -46,7 +55,7 @@ from uavtool.terminal import counted
     default=None,
     metavar="module:function",
     help="Run your function on every recorded photo and write its detections to a new "
-    "recording (--out, default RECORDING.vision.mcap) beside the original's channels.",
+    "recording (-o/--output, default RECORDING.vision.mcap) beside the original's channels.",
 )
 @click.option(
     "--target",
@@ -66,7 +75,7 @@ from uavtool.terminal import counted
     is_flag=True,
     help="Fly RECORDING's configuration again on the built-in vehicle, in lockstep, from its "
     "metadata alone, and compare the new recording with it message by message (exit 1 at the "
-    "first difference). --out keeps the new recording.",
+    "first difference). -o/--output keeps the new recording.",
 )
 @click.option(
     "--mission",
@@ -105,19 +114,19 @@ def replay(
     Examples:
       uavtool replay --check recordings/golden/paper.mcap
       uavtool replay recordings/golden/paper.mcap --set recognize.threshold=0.9
-      uavtool replay flight.mcap --set vectorize.rdp_epsilon_px=3 --out replayed.mcap
+      uavtool replay flight.mcap --set vectorize.rdp_epsilon_px=3 -o replayed.mcap
       uavtool replay --refly recordings/golden/paper.mcap   # vehicle, renderer and mission
-      uavtool replay --check recordings/golden --out check.parquet  # a folder or a glob, on Dask
-      uavtool replay --vision-only recorded.mcap --target red.png --out analysed.mcap
-      uavtool replay --vision-only 'flights/*.mcap' --target red.png --out photos.csv
-      uavtool replay flight.mcap --vision my_detector:detect --out detected.mcap
+      uavtool replay --check recordings/golden -o check.parquet  # a folder or a glob, on Dask
+      uavtool replay --vision-only recorded.mcap --target red.png -o analysed.mcap
+      uavtool replay --vision-only 'flights/*.mcap' --target red.png -o photos.csv
+      uavtool replay flight.mcap --vision my_detector:detect -o detected.mcap
     """
     from uavtool.cli.replay_batch import is_batch, replay_batch
 
     if vision is not None:
         others = check or settings or params_file or vision_only or target or refly
         if others or update_golden or mission:
-            raise click.UsageError("--vision takes only --out")
+            raise InputError("--vision takes only -o/--output")
         if is_batch(recording):
             from uavtool.cli.replay_batch import vision_batch
 
@@ -162,8 +171,8 @@ def replay(
         raise click.UsageError("--target is for --vision-only of a recording from uavtool record")
     if refly:
         if settings or params_file or vision_only or update_golden or check:
-            raise click.UsageError(
-                "--refly flies the recorded configuration as it is: it takes only --out "
+            raise InputError(
+                "--refly flies the recorded configuration as it is: it takes only -o/--output "
                 "(and --mission)"
             )
         _refly(recording, out, mission)
@@ -288,9 +297,9 @@ def _params_file(path: Path) -> dict[str, object]:
     try:
         data = json.loads(path.read_text())
     except OSError as exc:
-        raise InputError(f"--params {path}: cannot read: {exc.strerror}") from None
+        raise InputError(f"--set-file {path}: cannot read: {exc.strerror}") from None
     except ValueError as exc:
-        raise InputError(f"--params {path}: not JSON: {exc}") from None
+        raise InputError(f"--set-file {path}: not JSON: {exc}") from None
     if not isinstance(data, dict):
-        raise InputError(f"--params {path}: expected a JSON object")
+        raise InputError(f"--set-file {path}: expected a JSON object")
     return data

@@ -37,7 +37,7 @@ def replay_batch(
     workers: int | None,
     quiet: bool,
 ) -> None:
-    """Replay every recording; write the table (``--out``, ``.parquet`` or ``.csv``) and its
+    """Replay every recording; write the table (``-o/--output``, ``.parquet`` or ``.csv``) and its
     summary beside it; exit 1 under ``--check`` unless every one is identical. Under
     ``--vision-only``, the photos of recordings from ``uavtool record`` are matched against
     ``target`` (required for them; a row says so when it is missing)."""
@@ -60,8 +60,8 @@ def replay_batch(
     table = out if out is not None else _default_table()
     if table.suffix not in (".parquet", ".csv"):
         raise click.BadParameter(
-            f"{table}: with many recordings, --out names the table: .parquet or .csv",
-            param_hint="--out",
+            f"{table}: with many recordings, -o/--output names the table: .parquet or .csv",
+            param_hint="-o/--output",
         )
 
     with _progress_line(quiet) as progress:
@@ -124,7 +124,7 @@ def vision_batch(
     folder = out if out is not None else Path(f"vision-{datetime.now(UTC):%Y%m%dT%H%M%SZ}")
     if folder.suffix:
         raise click.BadParameter(
-            f"{folder}: with many recordings, --out names a folder", param_hint="--out"
+            f"{folder}: with many recordings, -o/--output names a folder", param_hint="-o/--output"
         )
     folder.mkdir(parents=True, exist_ok=True)
 

@@ -1,5 +1,5 @@
 """``uavtool replay --vision-only REC --target PNG`` for a recording of ``uavtool record``:
-every photo against the target, and ``--out`` a copy with the results."""
+every photo against the target, and ``-o/--output`` a copy with the results."""
 
 from __future__ import annotations
 

@@ -65,7 +65,11 @@ def _interrupt(_signum: int, _frame: object) -> None:
     help="Set a vehicle parameter at start (repeatable; after --params), e.g. RTL_ALT=3000.",
 )
 @click.option(
-    "--duration", default=None, type=float, help="Stop after this many simulated seconds."
+    "--duration",
+    default=None,
+    type=float,
+    metavar="SECONDS",
+    help="Stop after this many simulated seconds.",
 )
 @click.option(
     "--link-outage",

@@ -11,21 +11,37 @@ from pathlib import Path
 
 import click
 
+from uavtool.cli.spelling import Command, OldSpelling, looks_like_setting
 
-@click.command()
+_OLD_SPELLINGS = (
+    OldSpelling(
+        "-o",
+        "--set",
+        "--set KEY.PATH=VALUE (-o now names the output folder)",
+        applies=looks_like_setting,
+        described="-o KEY.PATH=VALUE",
+    ),
+    OldSpelling("--override", "--set", "--set KEY.PATH=VALUE"),
+    OldSpelling("--out", "--output", "-o/--output"),
+)
+
+
+@click.command(cls=Command, old_spellings=_OLD_SPELLINGS)
 @click.argument("spec", type=click.Path(path_type=Path))
 @click.option(
-    "-o",
-    "--override",
+    "--set",
     "overrides",
     multiple=True,
     metavar="KEY.PATH=VALUE",
-    help="Change one spec value (TOML syntax), e.g. -o random.draws=50 -o 'grid.seed=[1,2]'.",
+    help="Change one spec value (TOML syntax), e.g. --set random.draws=50 --set 'grid.seed=[1,2]'.",
 )
 @click.option(
-    "--out",
+    "-o",
+    "--output",
+    "out",
     type=click.Path(path_type=Path),
     default=None,
+    metavar="DIR",
     help="Output folder.  [default: the spec's sweep.out, else sweeps/<spec name>]",
 )
 @click.option(
@@ -62,7 +78,7 @@ import click
     "--resume",
     is_flag=True,
     help="Continue the sweep in the output folder: keep flights whose recording is whole, fly "
-    "the rest. The spec and --override values must plan the same flights as when it started.",
+    "the rest. The spec and --set values must plan the same flights as when it started.",
 )
 @click.option("--csv", is_flag=True, help="Write the table as CSV instead of Parquet.")
 @click.option("--no-plots", is_flag=True, help="Write no PNG plots.")
@@ -93,9 +109,9 @@ def sweep(
     \b
     Examples:
       uavtool sweep wind.toml
-      uavtool sweep wind.toml -o random.draws=200 --resume   # as started, interrupted
+      uavtool sweep wind.toml --set random.draws=200 --resume   # as started, interrupted
       uavtool sweep wind.toml --timeout 900 --csv
-      uavtool sweep wind.toml --scheduler tcp://head-node:8786 --out /shared/sweeps/wind
+      uavtool sweep wind.toml --scheduler tcp://head-node:8786 -o /shared/sweeps/wind
     """
     from uavtool.cli.fly import EXIT_CODES
     from uavtool.sweep import format_progress, load_spec, run_sweep
@@ -126,8 +142,8 @@ def sweep(
     if result.plots_note:
         click.echo(result.plots_note, err=True)
     if result.interrupted:
-        again = ["uavtool", "sweep", str(spec), *(a for o in overrides for a in ("-o", o))]
-        again += ["--out", str(result.table.parent)]
+        again = ["uavtool", "sweep", str(spec), *(a for o in overrides for a in ("--set", o))]
+        again += ["--output", str(result.table.parent)]
         again += ["--timeout", f"{timeout_s:g}"] if timeout_s is not None else []
         again += ["--scheduler", scheduler] if scheduler is not None else []
         again += ["--workers", str(workers)] if workers is not None else []

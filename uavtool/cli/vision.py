@@ -7,10 +7,12 @@ from pathlib import Path
 import click
 
 from uavtool.cli.options import Number
+from uavtool.cli.spelling import Command, OldSpelling
 from uavtool.errors import FailureError
 
 _IMAGE = click.Path(path_type=Path)  # read (and checked) by uavtool.images
 _OUT = click.Path(dir_okay=False, writable=True, path_type=Path)
+_OLD_SPELLINGS = (OldSpelling("--out", "--output", "-o/--output"),)
 
 
 @click.group()
@@ -23,9 +25,9 @@ def vision() -> None:
     """
 
 
-@vision.command("vectorize")
+@vision.command("vectorize", cls=Command, old_spellings=_OLD_SPELLINGS)
 @click.argument("frame", type=_IMAGE)
-@click.option("-o", "--out", type=_OUT, help="Write the shapes as JSON here.")
+@click.option("-o", "--output", "out", type=_OUT, help="Write the shapes as JSON here.")
 @click.option("--overlay", type=_OUT, help="Write the frame with the vectors drawn over it (PNG).")
 @click.option(
     "--epsilon",
@@ -124,7 +126,7 @@ def match_cmd(target: Path, frame: Path, threshold: float | None, allow_mirror: 
     click.echo(report.summary())
 
 
-@vision.command("model")
+@vision.command("model", cls=Command, old_spellings=_OLD_SPELLINGS)
 @click.argument("top", type=_IMAGE)
 @click.argument("front", type=_IMAGE)
 @click.argument("right", type=_IMAGE)
@@ -134,7 +136,7 @@ def match_cmd(target: Path, frame: Path, threshold: float | None, allow_mirror: 
     required=True,
     help="JSON file with each photo's camera pose and intrinsics (see below).",
 )
-@click.option("-o", "--out", type=_OUT, required=True, help="Write the model here (GLB).")
+@click.option("-o", "--output", "out", type=_OUT, required=True, help="Write the model here (GLB).")
 def model_cmd(top: Path, front: Path, right: Path, poses: Path, out: Path) -> None:
     """Build the 3D model of the building in TOP, FRONT and RIGHT photos; write a GLB.
 

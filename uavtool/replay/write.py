@@ -1,4 +1,4 @@
-"""``replay --out``: a new recording with the original's inputs and the replayed outputs, which
+"""``replay -o``: a new recording with the original's inputs and the replayed outputs, which
 ``uavtool view`` can show beside the original."""
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ from uavtool.errors import FailureError, InputError
 
 
 class SpecError(InputError):
-    """A sweep spec (or a ``--override`` of it) is invalid: ``spec.toml: grid.seed[2]: …``."""
+    """A sweep spec (or a ``--set`` of it) is invalid: ``spec.toml: grid.seed[2]: …``."""
 
     def __init__(self, source: str, key_path: str, problem: str) -> None:
         where = f"{source}: {key_path}" if key_path else source

@@ -75,7 +75,7 @@ def run_sweep(
     if layout.holds_sweep() and not resume:
         raise OutputExistsError(
             f"{layout.root} already holds a sweep: add --resume to continue it, or choose "
-            "another --out"
+            "another -o/--output"
         )
     stems = [f.stem for f in flights]
     if resume and layout.holds_sweep():
@@ -132,15 +132,16 @@ def _same_sweep(layout: SweepLayout, spec: SweepSpec, stems: list[str]) -> None:
         )
     else:  # a folder from before plans were kept: the spec as run must be the same text
         try:
-            same = layout.spec.read_text(encoding="utf-8") == spec.text
+            held_text = layout.spec.read_text(encoding="utf-8")  # before --set: --override
+            same = held_text.replace("\n# --override ", "\n# --set ") == spec.text
         except OSError:
             same = False
         if same:
             return
         what = f"its {layout.spec.name} differs"
     raise OutputExistsError(
-        f"{layout.root} holds another sweep ({what}): --resume takes the spec and --override "
-        "values it was started with; or choose another --out"
+        f"{layout.root} holds another sweep ({what}): --resume takes the spec and --set "
+        "values it was started with; or choose another -o/--output"
     )
 
 

@@ -1,4 +1,4 @@
-"""The sweep spec: a small TOML file (plus ``--override KEY=VALUE``) read into a checked
+"""The sweep spec: a small TOML file (plus ``--set KEY=VALUE``) read into a checked
 :class:`SweepSpec`. Every problem is a :class:`SpecError` naming the key path.
 
 Example (paths are relative to the spec file)::
@@ -132,7 +132,7 @@ def load_spec(path: Path, overrides: Sequence[str] = ()) -> SweepSpec:
     for override in overrides:
         _apply_override(data, override, source)
     spec = parse_spec(data, source=source, base=path.parent, default_out=Path("sweeps") / path.stem)
-    notes = "".join(f"# --override {o}\n" for o in overrides)
+    notes = "".join(f"# --set {o}\n" for o in overrides)
     return dataclasses.replace(spec, text=text + ("\n" + notes if notes else ""))
 
 
@@ -211,7 +211,7 @@ def _cases(
 def _apply_override(data: dict[str, Any], text: str, source: str) -> None:
     key, sep, raw = text.partition("=")
     if not sep or not key.strip():
-        raise SpecError(source, "", f"--override {text!r}: expected KEY.PATH=VALUE")
+        raise SpecError(source, "", f"--set {text!r}: expected KEY.PATH=VALUE")
     try:
         value = tomllib.loads(f"v = {raw}")["v"]
     except (tomllib.TOMLDecodeError, RecursionError):
@@ -221,7 +221,7 @@ def _apply_override(data: dict[str, Any], text: str, source: str) -> None:
     for part in parts[:-1]:
         child = node.setdefault(part, {})
         if not isinstance(child, dict):
-            raise SpecError(source, key, f"--override: {part!r} is not a table")
+            raise SpecError(source, key, f"--set: {part!r} is not a table")
         node = child
     node[parts[-1]] = value
 

@@ -1,6 +1,6 @@
 """Feed a recording of ``uavtool record`` (no mission) into a `MissionLogger`: the route and
 telemetry from ``/vehicle/telemetry``, each camera frame from ``/camera/frames`` with its
-image, the events, and — after ``replay --vision-only --out`` — each photo's shapes and match
+image, the events, and — after ``replay --vision-only -o`` — each photo's shapes and match
 from ``/vision/results`` drawn over it, with the target picture."""
 
 from __future__ import annotations
