@@ -1,12 +1,13 @@
 """One name per meaning across commands (issue 31): what a command writes is -o/--output,
 mission and spec values are --set (--set-file for a JSON file of them), durations are
-SECONDS. The old spellings work for one release and say so in one line on stderr, once
-however often they are used."""
+SECONDS, the web viewer's ports --web-port and --grpc-port. The old spellings work for one
+release and say so in one line on stderr, once however often they are used."""
 
 from __future__ import annotations
 
 import json
 import shlex
+import socket
 from collections.abc import Iterator
 from pathlib import Path
 from types import SimpleNamespace
@@ -67,7 +68,7 @@ def test_help_shows_one_name_per_meaning(path: tuple[str, ...]) -> None:
     text = _help(path)
     lines = [line.strip() for line in text.split("Options:", 1)[1].splitlines()]
     listed = " ".join(line.split("  ")[0] for line in lines if line.startswith("-"))
-    for old in ("--out ", "--override", "--params-file"):
+    for old in ("--out ", "--override", "--port "):
         assert old not in listed, f"uavtool {' '.join(path)}: {old.strip()}"
     if "--timeout" in listed:
         assert "--timeout SECONDS" in listed
@@ -331,3 +332,57 @@ def test_fly_output_and_no_record_exclude_each_other(tmp_path: Path) -> None:
     result = _invoke("fly", "-o", str(tmp_path / "a.mcap"), "--no-record")
     assert result.exit_code == 2
     assert result.stderr == "uavtool: error: -o/--output and --no-record exclude each other\n"
+
+
+# --- the web viewer's ports ---------------------------------------------------------------------
+
+_WEB = {"view": ["view", str(PAPER), "--web"], "fly": ["fly", "--no-record", "--rerun", "web"]}
+
+
+@pytest.mark.parametrize("command", _WEB)
+@pytest.mark.parametrize("option", ["--web-port", "--grpc-port"])
+@pytest.mark.parametrize("port", ["0", "65536", "-1", "http", "80.5"])
+def test_a_port_is_1_to_65535(command: str, option: str, port: str) -> None:
+    message = _one_error(_invoke(*_WEB[command], option, port))
+    assert message == f"{option}={port}: expected an integer in [1, 65535]"
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["view", "x.mcap", "--web-port", "8080"], "--web-port goes with --web"),
+        (["view", "x.mcap", "--grpc-port", "8081", "--save", "x.rrd"], "--grpc-port goes with"),
+        (["fly", "--web-port", "8080"], "--web-port goes with --rerun web"),
+        (["fly", "--rerun", "x.rrd", "--grpc-port", "8081"], "--grpc-port goes with --rerun web"),
+        (["view", str(PAPER), "--web", "--web-port", "8080", "--grpc-port", "8080"], "both"),
+        (["fly", "--rerun", "web", "--grpc-port", "9090"], "both"),  # the default web port
+    ],
+)
+def test_port_options_that_cannot_work(argv: list[str], message: str) -> None:
+    assert message in _one_error(_invoke(*argv))
+
+
+@pytest.fixture
+def busy_port() -> Iterator[int]:
+    with socket.socket() as listener:
+        listener.bind(("127.0.0.1", 0))
+        listener.listen()
+        yield listener.getsockname()[1]
+
+
+@pytest.mark.parametrize("command", _WEB)
+@pytest.mark.parametrize("option", ["--web-port", "--grpc-port"])
+def test_a_busy_port_is_one_line(command: str, option: str, busy_port: int) -> None:
+    message = _one_error(_invoke(*_WEB[command], option, str(busy_port)))
+    assert message == (
+        f"{option} {busy_port}: already in use on 127.0.0.1 (another viewer?); choose another "
+        "port, or stop what holds it"
+    )
+
+
+def test_view_old_port_option(busy_port: int) -> None:
+    result = _invoke("view", str(PAPER), "--web", "--port", str(busy_port))
+    assert _one_error(result).startswith(f"--web-port {busy_port}: already in use")
+    assert _warnings(result) == [
+        "uavtool: warning: --port is deprecated and goes in the next release; use --web-port"
+    ]

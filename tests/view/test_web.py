@@ -51,7 +51,7 @@ def served(recording: Path) -> Iterator[str]:
     """``uavtool view REC --web`` running; yields the URL it printed."""
     web, grpc = _free_port(), _free_port()
     cmd = [sys.executable, "-m", "uavtool", "view", str(recording), "--web"]
-    cmd += ["--port", str(web), "--grpc-port", str(grpc)]
+    cmd += ["--web-port", str(web), "--grpc-port", str(grpc)]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         url = _read_url(proc, timeout_s=60.0)

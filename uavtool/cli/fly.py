@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 from uavtool.checks import NON_NEGATIVE, POSITIVE, Range, coerce
-from uavtool.cli.options import SEED, Number, Numbers
+from uavtool.cli.options import PORT, SEED, Number, Numbers, check_web_ports
 from uavtool.cli.spelling import Command, OldSpelling
 from uavtool.errors import InputError
 
@@ -132,6 +132,21 @@ _OUTAGE = Numbers(":", (("START", NON_NEGATIVE), ("DURATION", POSITIVE)), exampl
     "pace), or to a .rrd file (at full speed).",
 )
 @click.option(
+    "--web-port",
+    type=PORT,
+    default=None,
+    metavar="PORT",
+    help="With --rerun web: the web viewer's port.  [default: 9090]",
+)
+@click.option(
+    "--grpc-port",
+    type=PORT,
+    default=None,
+    metavar="PORT",
+    help="With --rerun web: the port of the server the viewer reads the flight from.  "
+    "[default: 9876]",
+)
+@click.option(
     "--no-gimbal",
     is_flag=True,
     help="The camera is fixed straight down: fly the search only (no gimbal check, no model).",
@@ -163,6 +178,8 @@ def fly(
     outages: tuple[tuple[float, float], ...],
     timeout: float,
     rerun_target: str | None,
+    web_port: int | None,
+    grpc_port: int | None,
     no_gimbal: bool,
     scene_origin: str,
     quiet: bool,
@@ -194,6 +211,9 @@ def fly(
 
     if record is not None and no_record:
         raise InputError("-o/--output and --no-record exclude each other")
+    rerun_target = _rerun_target(rerun_target)
+    ports = {"--web-port": web_port, "--grpc-port": grpc_port}
+    check_web_ports(ports, web=rerun_target == "web", needs="--rerun web")
     mission_cls, _ = resolve(mission)
     overrides = parse_settings(settings)
     if visit_all:
@@ -207,7 +227,7 @@ def fly(
         scene=scene,
         target=target,
         camera=camera,
-        speedup=_speedup(speedup, live=_rerun_target(rerun_target) in _LIVE_VIEWERS),
+        speedup=_speedup(speedup, live=rerun_target in _LIVE_VIEWERS),
         record=record,
         no_record=no_record,
         params=params,
@@ -218,6 +238,8 @@ def fly(
         link_outages_s=outages,
         connect_timeout_s=timeout,
         rerun=rerun_target,
+        rerun_web_port=web_port,
+        rerun_grpc_port=grpc_port,
         no_gimbal=no_gimbal,
         scene_origin=scene_origin,
     )

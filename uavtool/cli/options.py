@@ -7,6 +7,7 @@ on one line, exit code 2.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 import click
@@ -59,6 +60,17 @@ class Numbers(click.ParamType[Any]):
 
 
 SEED = Number(SEED_RANGE, integer=True)
+
+PORT = Number(Range(1, 65_535), integer=True)
+"""A TCP port for one of our servers to listen on."""
+
+
+def check_web_ports(ports: Mapping[str, int | None], *, web: bool, needs: str) -> None:
+    """The web viewer's port options (option name → port, None when not given) go only with
+    ``web``, the option ``needs`` that serves it."""
+    given = [name for name, port in ports.items() if port is not None]
+    if given and not web:
+        raise InputError(f"{given[0]} goes with {needs}")
 
 
 def _option(param: click.Parameter | None) -> str:

@@ -10,11 +10,13 @@ from pathlib import Path
 
 import click
 
+from uavtool.cli.options import PORT, check_web_ports
+from uavtool.cli.spelling import Command, OldSpelling
 from uavtool.errors import InputError
 from uavtool.terminal import counted
 
 
-@click.command()
+@click.command(cls=Command, old_spellings=(OldSpelling("--port", "--web-port", "--web-port"),))
 @click.argument("recording", type=click.Path(path_type=Path))
 @click.option(
     "--save",
@@ -36,7 +38,13 @@ from uavtool.terminal import counted
     metavar="OTHER.mcap",
     help="A second recording (e.g. a replay) to show beside the first.",
 )
-@click.option("--port", default=9090, show_default=True, type=int, help="Web viewer port (--web).")
+@click.option(
+    "--web-port",
+    type=PORT,
+    default=None,
+    metavar="PORT",
+    help="With --web: the web viewer's port.  [default: 9090]",
+)
 @click.option(
     "--bind",
     default="127.0.0.1",
@@ -46,16 +54,20 @@ from uavtool.terminal import counted
     "machines too (anyone who can connect sees the flight).",
 )
 @click.option(
-    "--grpc-port", default=9876, show_default=True, type=int, help="Data server port (--web)."
+    "--grpc-port",
+    type=PORT,
+    default=None,
+    metavar="PORT",
+    help="With --web: the port of the server the viewer reads the recording from.  [default: 9876]",
 )
 def view(
     recording: Path,
     save: Path | None,
     web: bool,
     compare: Path | None,
-    port: int,
+    web_port: int | None,
     bind: str,
-    grpc_port: int,
+    grpc_port: int | None,
 ) -> None:
     """Show RECORDING (an MCAP file from `uavtool fly`) in Rerun: the scene, the route with
     the photo positions, each frame with its vectors, points of interest, scores,
@@ -65,6 +77,7 @@ def view(
     Examples:
       uavtool view recordings/golden/paper.mcap          # native viewer
       uavtool view recordings/golden/paper.mcap --web    # open the printed URL
+      uavtool view paper.mcap --web --web-port 8080 --grpc-port 8081
       uavtool view recordings/golden/paper.mcap --save paper.rrd
       uavtool view paper.mcap --compare paper-replay.mcap
     """
@@ -72,6 +85,7 @@ def view(
 
     if save is not None and web:
         raise click.UsageError("--save and --web exclude each other")
+    check_web_ports({"--web-port": web_port, "--grpc-port": grpc_port}, web=web, needs="--web")
     if save is None and not web and sys.platform.startswith("linux"):
         if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
             raise InputError("no display for the native viewer: use --web or --save OUT.rrd")
@@ -80,7 +94,7 @@ def view(
         save=save,
         web=web,
         compare=compare,
-        web_port=port,
+        web_port=web_port,
         grpc_port=grpc_port,
         bind=bind,
     )

@@ -79,6 +79,10 @@ class FlyConfig:
     connect_timeout_s: float = 30.0
     rerun: str | None = None
     """Stream live to Rerun: ``"spawn"`` (native viewer), ``"web"`` or a ``.rrd`` path."""
+    rerun_web_port: int | None = None
+    """With ``rerun="web"``: the web viewer's port; None: Rerun's default (9090)."""
+    rerun_grpc_port: int | None = None
+    """With ``rerun="web"``: the port the viewer reads the flight from; None: 9876."""
     no_gimbal: bool = False
     """The camera is fixed straight down: no gimbal check, the search only (see
     ``MissionParams.gimbal``). The built-in vehicle then boots without a mount."""
@@ -207,6 +211,8 @@ def fly(
         if config.rerun is not None:
             live = LiveView(
                 config.rerun,
+                web_port=config.rerun_web_port,
+                grpc_port=config.rerun_grpc_port,
                 scene=scene if config.camera == "sim" else None,
                 params=to_dict(config.params),
                 target_png=target_png,

@@ -16,12 +16,15 @@ from uavtool.world import Scene
 
 class LiveView:
     """Sends each observation and output to a Rerun viewer (``rerun`` = ``"spawn"``,
-    ``"web"`` or a ``.rrd`` path), stamped by the recording's clock ``clock_ns``."""
+    ``"web"`` — on ``web_port``, reading from ``grpc_port`` — or a ``.rrd`` path), stamped by
+    the recording's clock ``clock_ns``."""
 
     def __init__(
         self,
         target: str,
         *,
+        web_port: int | None = None,
+        grpc_port: int | None = None,
         scene: Scene | None,
         params: dict[str, Any],
         target_png: bytes | None,
@@ -30,7 +33,7 @@ class LiveView:
         from uavtool.view import open_viewer  # noqa: PLC0415 - rerun is heavy; only with --rerun
 
         if target == "web":
-            self.viewer = open_viewer(web=True)
+            self.viewer = open_viewer(web=True, web_port=web_port, grpc_port=grpc_port)
         elif target == "spawn":
             self.viewer = open_viewer()
         else:

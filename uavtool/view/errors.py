@@ -7,3 +7,7 @@ from uavtool.errors import InputError
 
 class ViewError(InputError):
     """A recording holds no mission to show, or the viewer cannot be served as asked."""
+
+
+class PortInUseError(ViewError):
+    """A port the web viewer's servers are to listen on is taken."""

@@ -8,6 +8,7 @@ and a `MissionLogger` on it; `view` feeds it a recording (and a second one to co
 from __future__ import annotations
 
 import contextlib
+import errno
 import importlib.util
 import os
 import shutil
@@ -24,7 +25,7 @@ import rerun as rr
 
 from uavtool.recording.files import atomic_output
 from uavtool.view.blueprint import default_blueprint
-from uavtool.view.errors import ViewError
+from uavtool.view.errors import PortInUseError, ViewError
 from uavtool.view.logger import LogCounts, MissionLogger
 from uavtool.view.paths import COMPARE_PREFIX
 from uavtool.view.source import log_recording
@@ -34,6 +35,12 @@ APPLICATION_ID = "uavtool"
 
 LOCALHOST = "127.0.0.1"
 """Where the web viewer's servers listen unless the user asks for another address."""
+
+WEB_PORT = 9090
+"""The web viewer's port unless the user asks for another (Rerun's own default)."""
+
+GRPC_PORT = 9876
+"""The port of the server the web viewer reads from (Rerun's own default)."""
 
 
 class Viewer:
@@ -83,9 +90,12 @@ def open_viewer(
     compare: bool = False,
     batch: int = 10,
 ) -> Viewer:
-    """A stream to ``save`` (a ``.rrd`` file), to a web viewer on ``web_port`` (``web``), or
-    to a newly spawned native viewer (neither). ``batch``: telemetry samples per send.
-    Raises `ViewError` if the file cannot be written or the servers cannot start."""
+    """A stream to ``save`` (a ``.rrd`` file), to a web viewer on ``web_port`` reading from
+    ``grpc_port`` (``web``; None: `WEB_PORT`, `GRPC_PORT`), or to a newly spawned native
+    viewer (neither). ``batch``: telemetry samples per send. Raises `ViewError` if the file
+    cannot be written or the servers cannot start (`PortInUseError`: a port is taken)."""
+    if web and save is None:
+        port, grpc = _web_ports(bind, web_port, grpc_port)
     rec = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4())
     # Our log_time is the recording's receive time, not the time of this conversion.
     rec.set_log_time_enabled(False)
@@ -97,8 +107,6 @@ def open_viewer(
             Path(save).parent.mkdir(parents=True, exist_ok=True)
             rec.save(save, default_blueprint=blueprint)
         elif web:
-            port = 9090 if web_port is None else web_port
-            grpc = grpc_port or _free_port(bind)
             server = _serve_web(bind, grpc, port)
             grpc_url = f"rerun+http://{_host(bind)}:{grpc}/proxy"
             rec.connect_grpc(grpc_url, default_blueprint=blueprint)
@@ -167,11 +175,40 @@ def _host(bind: str) -> str:
     return LOCALHOST if bind in ("0.0.0.0", "::", "") else bind
 
 
-def _free_port(bind: str) -> int:
-    with socket.socket() as s:
-        s.bind((_host(bind), 0))
-        port: int = s.getsockname()[1]
-        return port
+def _web_ports(bind: str, web_port: int | None, grpc_port: int | None) -> tuple[int, int]:
+    """The web viewer's port and its data server's (None: the defaults), both free."""
+    port = WEB_PORT if web_port is None else web_port
+    grpc = GRPC_PORT if grpc_port is None else grpc_port
+    if port == grpc:
+        raise ViewError(
+            f"--web-port and --grpc-port are both {port}: the web viewer and its data server "
+            "need a port each"
+        )
+    _check_free(bind, port, "--web-port")
+    _check_free(bind, grpc, "--grpc-port")
+    return port, grpc
+
+
+def _check_free(bind: str, port: int, option: str) -> None:
+    """`PortInUseError` when something already listens on ``port`` at ``bind``. Bound as
+    Rerun's server binds (SO_REUSEADDR), so a port left in TIME_WAIT counts as free."""
+    try:
+        family, kind, proto, _, address = socket.getaddrinfo(
+            bind or None, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE
+        )[0]
+    except (OSError, UnicodeError) as exc:
+        raise ViewError(f"--bind {bind}: not an address to listen on: {exc}") from None
+    with socket.socket(family, kind, proto) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            probe.bind(address)
+        except OSError as exc:
+            if exc.errno != errno.EADDRINUSE:
+                raise ViewError(f"--bind {bind}: cannot listen there: {exc.strerror}") from None
+            raise PortInUseError(
+                f"{option} {port}: already in use on {bind} (another viewer?); choose another "
+                "port, or stop what holds it"
+            ) from None
 
 
 @dataclass(frozen=True, slots=True)
