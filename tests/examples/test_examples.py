@@ -18,7 +18,7 @@ from uavtool.world import load_scene
 
 def _fly(tmp_path: Path, *args: str) -> tuple[Path, str]:
     rec = tmp_path / "flight.mcap"
-    result = CliRunner().invoke(cli, ["fly", "-q", "--record", str(rec), *args])
+    result = CliRunner().invoke(cli, ["fly", "-q", "--output", str(rec), *args])
     assert result.exit_code == 0, result.output
     return rec, result.output
 

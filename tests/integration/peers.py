@@ -136,7 +136,7 @@ def px4(tmp_path: Path, *, params: dict[str, str] | None = None) -> Iterator[int
 def fly(connect: str, tmp_path: Path, *extra: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
         [sys.executable, "-m", "uavtool", "fly", "--connect", connect, "--timeout", "120",
-         "--record", str(tmp_path / "f.mcap"), *extra],
+         "--output", str(tmp_path / "f.mcap"), *extra],
         capture_output=True, text=True, timeout=1800, check=False,
     )  # fmt: skip
 

@@ -36,7 +36,7 @@ def _metadata(path: Path) -> dict[str, dict[str, str]]:
 
 def test_a_plugin_flies_records_replays_and_re_flies(tmp_path: Path) -> None:
     rec = tmp_path / "hop.mcap"
-    code, out = _run("fly", "-q", "--mission", HOP, "--set", "hop.photos=3", "--record", str(rec))
+    code, out = _run("fly", "-q", "--mission", HOP, "--set", "hop.photos=3", "--output", str(rec))
     assert code == 0, out
     assert "completed: 3 photos" in out and 'result         hop: {"frames": [0, 1, 2]}' in out
     mission = _metadata(rec)["mission"]
@@ -57,7 +57,7 @@ def test_a_plugin_flies_records_replays_and_re_flies(tmp_path: Path) -> None:
 
 def test_the_pytest_helpers_take_a_plugin_mission(tmp_path: Path) -> None:
     rec = tmp_path / "hop.mcap"
-    assert _run("fly", "-q", "--mission", HOP, "--record", str(rec))[0] == 0
+    assert _run("fly", "-q", "--mission", HOP, "--output", str(rec))[0] == 0
     assert_replays_identically(rec, mission=HOP)
     assert_reflies_identically(rec, mission=HOP)
     with pytest.raises(PluginError, match="not registered here"):
@@ -73,7 +73,7 @@ def test_the_api_example_flies(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) 
     rec = tmp_path / "doc.mcap"
     exit_code, out = _run(
         "fly", "-q", "--mission", "my_hop:HopMission", "--set", "hop.altitude_m=15",
-        "--record", str(rec),
+        "--output", str(rec),
     )  # fmt: skip
     assert exit_code == 0, out
     assert "completed: one photo, frame 0" in out
@@ -99,7 +99,7 @@ def test_a_missing_or_broken_plugin_is_one_line(spec: str, words: str) -> None:
 def test_a_bug_in_the_mission_stops_the_run_and_sends_the_vehicle_home(tmp_path: Path) -> None:
     rec = tmp_path / "bug.mcap"
     code, out = _run(
-        "fly", "-q", "--mission", HOP, "--set", "hop.fail_at_photo=1", "--record", str(rec)
+        "fly", "-q", "--mission", HOP, "--set", "hop.fail_at_photo=1", "--output", str(rec)
     )
     assert code == 1, out
     assert "the mission raised ZeroDivisionError: integer division or modulo by zero" in out
@@ -161,7 +161,7 @@ def test_an_installed_package_registers_a_mission_by_name(tmp_path: Path) -> Non
 
     listed = uavtool_cli("missions")
     assert "hop" in listed.stdout and "[hop-pkg: hop_pkg:HopMission]" in listed.stdout, listed
-    flown = uavtool_cli("fly", "-q", "--mission", "hop", "--record", str(rec))
+    flown = uavtool_cli("fly", "-q", "--mission", "hop", "--output", str(rec))
     assert flown.returncode == 0, flown.stderr
     mission = _metadata(rec)["mission"]
     assert (mission["name"], mission["class"], mission["version"]) == (

@@ -30,7 +30,7 @@ def _messages(path: Path) -> list[tuple[str, int, bytes]]:
 def test_detections_are_written_beside_the_original(tmp_path: Path) -> None:
     out = tmp_path / "detected.mcap"
     code, text = _run("replay", str(GOLDEN), "--vision", "tests.plugins.detector:red_roofs",
-                      "--out", str(out))  # fmt: skip
+                      "--output", str(out))  # fmt: skip
     assert code == 0, text
     assert "on 10 photos: 7 detections" in text
     before, after = _messages(GOLDEN), _messages(out)
@@ -80,7 +80,7 @@ def test_a_broken_function_writes_nothing(
     tmp_path: Path, function: str, code: int, words: str
 ) -> None:
     out = tmp_path / "out.mcap"
-    exit_code, text = _run("replay", str(GOLDEN), "--vision", function, "--out", str(out))
+    exit_code, text = _run("replay", str(GOLDEN), "--vision", function, "--output", str(out))
     assert exit_code == code, text
     assert words in text and "Traceback" not in text and len(text.strip().splitlines()) == 1
     assert not out.exists() and list(tmp_path.iterdir()) == []
@@ -98,7 +98,7 @@ def test_a_folder_on_dask_with_a_function_from_the_current_folder(
     golden = GOLDEN.parent
     out = tmp_path / "out"
     code, text = _run(
-        "replay", str(golden), "--vision", "my_vision:red_roofs", "--out", str(out),
+        "replay", str(golden), "--vision", "my_vision:red_roofs", "--output", str(out),
         "--workers", "1", "-q",
     )  # fmt: skip
     assert code == 0, text

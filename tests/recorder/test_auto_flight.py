@@ -80,7 +80,7 @@ def test_vision_only_finds_the_red_building_and_view_shows_it(
     analysed = tmp_path / "analysed.mcap"
     runner = CliRunner()
     args = ["replay", "--vision-only", str(recorded.path), "--target", str(target)]
-    result = runner.invoke(cli, [*args, "--out", str(analysed)])
+    result = runner.invoke(cli, [*args, "--output", str(analysed)])
     assert result.exit_code == 0, result.output
     _, frames, _, _ = _read(recorded.path)
     red = [f["frame_index"] for f, _ in frames if f["photo"] == list(STOPS).index("red")]

@@ -64,7 +64,7 @@ def test_vision_only_matches_the_photos_of_a_record_file_on_dask(
     target.write_bytes(target_picture(load_scene("paper"), Intrinsics.from_hfov()))
     table = tmp_path / "photos.csv"
     args = ["replay", "--vision-only", str(folder), "--target", str(target)]
-    result = CliRunner().invoke(cli, [*args, "--out", str(table), "--scheduler", scheduler])
+    result = CliRunner().invoke(cli, [*args, "--output", str(table), "--scheduler", scheduler])
     assert result.exit_code == 0, result.output
     rows = {Path(r["recording"]).name: r for r in read_table(table)}
     rec = rows["recorded.mcap"]
@@ -85,7 +85,7 @@ def test_a_record_file_without_target_is_an_error_row_that_says_what_to_give(
 ) -> None:
     (folder / "mission.mcap").unlink()
     table = tmp_path / "photos.parquet"
-    args = ["replay", "--vision-only", str(folder), "--out", str(table)]
+    args = ["replay", "--vision-only", str(folder), "--output", str(table)]
     result = CliRunner().invoke(cli, [*args, "--scheduler", scheduler])
     assert result.exit_code == 0, result.output
     [row] = read_table(table)
@@ -106,7 +106,7 @@ def test_vision_runs_on_the_photos_of_a_record_file(recorded: Recorded, tmp_path
     result = CliRunner().invoke(
         cli,
         ["replay", str(recorded.path), "--vision", "tests.plugins.detector:red_roofs",
-         "--out", str(out)],
+         "--output", str(out)],
     )  # fmt: skip
     assert result.exit_code == 0, result.output
     with RecordingReader(out) as reader:

@@ -296,7 +296,7 @@ def test_a_flipped_metadata_byte_is_found_and_refused(tmp_path: Path) -> None:
     does. A recorded max_looks 3 -> 2 changed nothing in a replay (the flight needed 2 looks),
     so `replay --check` said identical on a file whose parameters were not the ones flown."""
     path = tmp_path / "flight.mcap"
-    flown = CliRunner().invoke(cli, ["fly", "-q", "--record", str(path)])
+    flown = CliRunner().invoke(cli, ["fly", "-q", "--output", str(path)])
     assert flown.exit_code == 0, flown.output
     code, out, _ = _run("info", str(path))
     assert code == 0 and "health:    whole, indexed, CRCs checked" in out

@@ -42,7 +42,7 @@ def small_flight(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A short real flight (take-off, one photo, landing): every topic a flight has."""
     path = tmp_path_factory.mktemp("fuzz") / "hop.mcap"
     args = ["fly", "-q", "--mission", "tests.plugins.hop:HopMission", "--set", "hop.photos=1"]
-    result = CliRunner().invoke(cli, [*args, "--record", str(path)])
+    result = CliRunner().invoke(cli, [*args, "--output", str(path)])
     assert result.exit_code == 0, result.output
     return path
 

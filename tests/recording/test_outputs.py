@@ -44,9 +44,9 @@ def _same(path: Path, how: str) -> Path:
 _WRITERS = {
     "export": ["export", "{rec}", "--tlog", "{out}"],
     "view": ["view", "{rec}", "--save", "{out}"],
-    "replay": ["replay", "-q", "{rec}", "--out", "{out}"],
+    "replay": ["replay", "-q", "{rec}", "--output", "{out}"],
     "recover": ["info", "--recover", "{rec}", "-o", "{out}"],
-    "refly": ["replay", "--refly", "{rec}", "--out", "{out}"],
+    "refly": ["replay", "--refly", "{rec}", "--output", "{out}"],
 }
 
 
@@ -85,7 +85,7 @@ def test_import_over_its_tlog_is_refused(tmp_path: Path) -> None:
         (["export", "{bad}", "--tlog", "{tmp}/out.tlog"], b"not mcap"),
         (["view", "{bad}", "--save", "{tmp}/out.rrd"], b"not mcap"),
         (["view", "{bad}", "--save", "{tmp}/out.rrd"], None),  # a recording without a mission
-        (["replay", "{bad}", "--out", "{tmp}/out.mcap"], None),
+        (["replay", "{bad}", "--output", "{tmp}/out.mcap"], None),
         (["info", "--recover", "{bad}", "-o", "{tmp}/out.mcap"], b""),
         (["import", "{bad}", "-o", "{tmp}/out.mcap"], b"\x00" * 100),
     ],

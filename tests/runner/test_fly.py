@@ -55,7 +55,7 @@ def test_recording_is_whole_and_replays_identically(paper_flight: tuple[object, 
 
 def test_fly_cli_prints_progress_and_summary(tmp_path: Path) -> None:
     rec = tmp_path / "r.mcap"
-    result = CliRunner().invoke(cli, ["fly", "--scene", "blocked-front", "--record", str(rec)])
+    result = CliRunner().invoke(cli, ["fly", "--scene", "blocked-front", "--output", str(rec)])
     assert result.exit_code == 0, result.output
     out = result.output
     assert "points of interest; visiting order" in out
@@ -94,7 +94,7 @@ def test_link_lost_for_good_ends_the_mission(tmp_path: Path) -> None:
     ],
 )
 def test_bad_input_is_one_line_exit_2(tmp_path: Path, args: list[str], message: str) -> None:
-    result = CliRunner().invoke(cli, ["fly", "--record", str(tmp_path / "x.mcap"), *args])
+    result = CliRunner().invoke(cli, ["fly", "--output", str(tmp_path / "x.mcap"), *args])
     assert result.exit_code == 2, result.output
     assert message in result.output
     assert "Traceback" not in result.output
@@ -155,7 +155,7 @@ def test_a_collision_crashes_the_vehicle_and_ends_the_mission(tmp_path: Path) ->
     scene = tmp_path / "mast.json"
     scene.write_text(json.dumps(data))
     rec = tmp_path / "crash.mcap"
-    result = CliRunner().invoke(cli, ["fly", "-q", "--scene", str(scene), "--record", str(rec)])
+    result = CliRunner().invoke(cli, ["fly", "-q", "--scene", str(scene), "--output", str(rec)])
     assert result.exit_code == 5, result.output
     assert "outcome        crashed: the vehicle disarmed in the air" in result.output
     assert "from building 'mast'" in result.output
@@ -189,7 +189,7 @@ def test_a_crash_on_the_way_home_is_a_crash_whatever_came_before(tmp_path: Path)
         tmp_path, "mast", [{"footprint": _square(20, -18.3, 0.25), "top_m": 14}], True
     )
     rec = tmp_path / "home-crash.mcap"
-    result = CliRunner().invoke(cli, ["fly", "-q", "--scene", str(scene), "--record", str(rec)])
+    result = CliRunner().invoke(cli, ["fly", "-q", "--scene", str(scene), "--output", str(rec)])
     assert result.exit_code == 5, result.output
     assert "outcome        crashed: the vehicle disarmed in the air" in result.output
     assert "after 'completed: model built'" in result.output

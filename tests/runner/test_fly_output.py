@@ -34,7 +34,7 @@ def test_no_heartbeat_leaves_no_recording(tmp_path: Path) -> None:
     rec = tmp_path / "flight.mcap"
     result = CliRunner().invoke(
         cli,
-        ["fly", "--connect", f"tcp:127.0.0.1:{port}", "--timeout", "1", "--record", str(rec)],
+        ["fly", "--connect", f"tcp:127.0.0.1:{port}", "--timeout", "1", "--output", str(rec)],
     )
     server.close()
     assert result.exit_code == 2, result.output
@@ -64,7 +64,7 @@ def test_recording_over_the_target_picture_is_refused(tmp_path: Path) -> None:
     target = tmp_path / "target.png"
     target.write_bytes(png_encode(np.full((48, 64, 3), (200, 30, 30), np.uint8)))
     before = target.read_bytes()
-    result = CliRunner().invoke(cli, ["fly", "--target", str(target), "--record", str(target)])
+    result = CliRunner().invoke(cli, ["fly", "--target", str(target), "--output", str(target)])
     assert result.exit_code == 2
     assert "writing it would destroy it" in result.output
     assert target.read_bytes() == before

@@ -58,9 +58,9 @@ def test_detections_and_pictures_open(bundle: Path, tmp_path: Path) -> None:
     paper = next(p for p in GOLDEN if p.stem == "paper")
     detected, survey = tmp_path / "detected.mcap", tmp_path / "survey.mcap"
     runs = [
-        ["replay", str(paper), "--vision", "tests.plugins.detector:red_roofs", "--out",
+        ["replay", str(paper), "--vision", "tests.plugins.detector:red_roofs", "--output",
          str(detected)],
-        ["fly", "-q", "--mission", "survey", "--record", str(survey)],
+        ["fly", "-q", "--mission", "survey", "--output", str(survey)],
     ]  # fmt: skip
     for args in runs:
         result = CliRunner().invoke(cli, args)
