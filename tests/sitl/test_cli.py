@@ -130,7 +130,7 @@ def test_a_stop_signal_stops_cleanly_with_its_exit_code(sig: signal.Signals, cod
 
 
 def test_the_readmes_mount_file_loads_on_the_builtin_vehicle(tmp_path: Path) -> None:
-    """The mount.parm the README gives ArduCopter (and the no-gimbal error names): the same
+    """The mount.parm docs/vehicles.md gives ArduCopter (and the no-gimbal error names): the same
     file on our vehicle, SERVOn_FUNCTION included."""
     parm = tmp_path / "mount.parm"
     parm.write_text(

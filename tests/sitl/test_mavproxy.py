@@ -161,7 +161,7 @@ class MavProxy:
 
 @pytest.fixture
 def session(tmp_path: Path) -> Iterator[MavProxy]:
-    """``uavtool sitl --speedup 5`` and MAVProxy connected to it, as the README shows."""
+    """``uavtool sitl --speedup 5`` and MAVProxy connected to it, as docs/sitl.md shows."""
     command = mavproxy_command()  # MAVProxy's own environment (see mavproxy_env)
     port = _free_port()
     with sitl_process(f"tcpin:127.0.0.1:{port}", "--speedup", str(SPEEDUP)):

@@ -12,7 +12,7 @@ def missions(name: str | None) -> None:
 
     \b
     Built-in missions come with uavtool; installed packages add theirs through the
-    "uavtool.missions" entry-point group (see the README, "Write your own mission").
+    "uavtool.missions" entry-point group (see docs/missions.md).
 
     \b
     Examples:

@@ -1,6 +1,6 @@
 """Where a passive recording's messages go: the same `RecordingWriter`, topics and Foxglove
 values as a mission's, with the vehicle's telemetry and the camera's frames in place of the
-mission's observations (README, "Recording flights you don't fly")."""
+mission's observations (docs/record.md)."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """Recordings: one MCAP file per mission — write, read (even when cut), inspect, recover,
-and bridge to MAVProxy's ``.tlog``. The topic list is in README.md, "Recording format"."""
+and bridge to MAVProxy's ``.tlog``. The topic list is in docs/recording-format.md."""
 
 from uavtool.recording.errors import (
     CorruptRecordingError,

@@ -1,5 +1,6 @@
-"""Topic names of a mission recording (README, "Recording format"): shared by the runner that
-writes them and by replay and the viewer that read them."""
+"""Topic names of a recording: shared by the runner and the recorder that write them and by
+replay and the viewer that read them. docs/recording-format.md lists every topic, with its
+encoding and schema; tests/test_docs.py checks that table against this module."""
 
 from __future__ import annotations
 

@@ -57,7 +57,7 @@ def _check_metadata(name: str, record: Mapping[str, str]) -> None:
 class RecordingWriter:
     """Writes one recording. Use as a context manager; safe to share between threads.
 
-    ``metadata`` maps record names (``mission``, ``scene``, ``seeds``, ``command_line`` …) to
+    ``metadata`` maps record names (``mission``, ``scene``, ``seeds``, ``flight`` …) to
     string key/value pairs, written first after a ``uavtool`` record (tool version, dialect).
     Every ``write_*`` takes ``log_time_ns`` (receive time, > 0, one epoch per file) and
     optionally ``publish_time_ns`` (defaults to the log time). Raises

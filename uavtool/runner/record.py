@@ -1,4 +1,4 @@
-"""What a flight writes into its recording, on which topics (README, "Recording format").
+"""What a flight writes into its recording, on which topics (docs/recording-format.md).
 
 The authoritative streams are ``/mission/observations`` (every observation, in the order the
 mission consumed it, numbered by ``step``) and ``/mission/outputs`` (every output, numbered by

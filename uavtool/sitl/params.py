@@ -89,8 +89,8 @@ PARAM_SPECS: tuple[ParamSpec, ...] = (
     P("FENCE_ACTION", 1, _INT8, 0, 5, "on a breach: 0 report, 1 RTL or LAND, 2 LAND, 3-5 RTL/LAND"),
     P("FENCE_MARGIN", 2.0, _REAL32, 1, 10, "distance inside the fence RTL keeps to, m"),
     # What each servo output drives (ArduPilot's SERVOn_FUNCTION: 6 mount yaw, 7 mount pitch,
-    # 8 mount roll …). Kept so that an ArduCopter parameter file (the mount.parm of the
-    # README) loads as it is; the built-in vehicle's mount moves without them.
+    # 8 mount roll …). Kept so that an ArduCopter parameter file (the mount.parm of
+    # docs/vehicles.md) loads as it is; the built-in vehicle's mount moves without them.
     *(
         P(f"SERVO{n}_FUNCTION", 0, _INT16, -1, 188, f"what servo output {n} drives")
         for n in range(1, 17)
