@@ -255,7 +255,7 @@ def test_the_mission_example_in_docs_missions_flies_and_replays(
     rec = tmp_path / "hop.mcap"
     mission = "my_missions.hop:HopMission"
     result = CliRunner().invoke(
-        cli, ["fly", "-q", "--mission", mission, "--set", "hop.photos=2", "--record", str(rec)]
+        cli, ["fly", "-q", "--mission", mission, "--set", "hop.photos=2", "-o", str(rec)]
     )
     assert result.exit_code == 0, result.output
     assert "completed: 2 photos" in result.output
