@@ -1,22 +1,24 @@
 """Where tasks run: a Dask ``LocalCluster`` of worker processes sized to the machine (one
 single-threaded worker per core: flights are CPU-bound Python), or any running Dask
 scheduler given by address (``dask scheduler`` plus ``dask worker`` elsewhere, or any Dask
-deployment). Nothing else about a sweep changes with the cluster. The local cluster's workers
-ignore Ctrl-C (:mod:`~uavtool.sweep.interrupt`): the driver stops the sweep and closes them."""
+deployment). Nothing else about a sweep changes with the cluster. The local cluster speaks TLS
+with credentials made for it alone, so no other local process can run code on it. Its workers
+do not die of Ctrl-C (:mod:`~uavtool.sweep.interrupt`): the driver stops the sweep and closes
+the client, then the cluster, without Dask's logs of the interrupted work."""
 
 from __future__ import annotations
 
 import logging
 import os
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from typing import TYPE_CHECKING
 
 from uavtool.errors import InputError
-from uavtool.sweep.interrupt import PRELOAD, sigint_ignored
+from uavtool.sweep.interrupt import PRELOAD, QuietLogs, quiet_on_sigint, sigint_ignored
 
 if TYPE_CHECKING:
-    from distributed import Client
+    from distributed import Client, LocalCluster
 
 
 def default_workers() -> int:
@@ -82,11 +84,18 @@ def open_client(
     check_cluster_options(scheduler, workers=workers, dashboard=dashboard)
     _quiet_dask()
     if scheduler is not None:
+        # The user's scheduler: its address and Dask's own configuration say how to reach it
+        # (a tls:// one takes its credentials from distributed.comm.tls.*).
         try:
             client = Client(scheduler, timeout="10s")
         except (OSError, TimeoutError, ValueError) as exc:
             raise InputError(f"--scheduler {scheduler}: cannot connect: {exc}") from None
-        with client:
+        except TypeError:  # distributed's word for a tls:// address without credentials
+            raise InputError(
+                f"--scheduler {scheduler}: cannot connect: a tls:// scheduler needs TLS "
+                "credentials in Dask's configuration (distributed.comm.tls.*)"
+            ) from None
+        with _closing(client):
             yield client
         return
     n = workers if workers is not None else default_workers()
@@ -100,9 +109,57 @@ def open_client(
             dashboard_address=dashboard or LOCAL_DASHBOARD,
             silence_logs=logging.ERROR,
             preload=[PRELOAD],
+            # TLS with credentials made for this cluster alone (Dask's Security.temporary, in
+            # memory, passed to the workers it starts): another local process that finds the
+            # scheduler's port cannot run code on it.
+            security=True,
         )
-    with cluster, Client(cluster) as client:
+    try:
+        client = Client(cluster)
+    except BaseException:
+        cluster.close()
+        raise
+    with _closing(client, cluster):
         yield client
+
+
+CLOSE_TIMEOUT_S = 10.0
+"""How long closing the client, then the local cluster, may take after Ctrl-C: a worker busy
+with a flight is stopped rather than waited for."""
+
+
+@contextmanager
+def _closing(client: Client, cluster: LocalCluster | None = None) -> Iterator[None]:
+    """Close ``client``, then ``cluster``, when the block ends. After Ctrl-C that happens with
+    Dask's logs quiet (its errors about the interrupted tasks and closed connections are
+    expected then) and a short timeout, and the logs' levels are put back after."""
+    logs = QuietLogs()
+    try:
+        with quiet_on_sigint(logs):
+            yield
+    except KeyboardInterrupt:
+        logs.quiet()
+        try:
+            with suppress(Exception):
+                client.close(timeout=CLOSE_TIMEOUT_S)
+            if cluster is not None:
+                with suppress(Exception):
+                    cluster.close(timeout=CLOSE_TIMEOUT_S)
+        finally:
+            logs.restore()
+        raise
+    except BaseException:
+        _close(client, cluster)
+        raise
+    _close(client, cluster)
+
+
+def _close(client: Client, cluster: LocalCluster | None) -> None:
+    try:
+        client.close()
+    finally:
+        if cluster is not None:
+            cluster.close()
 
 
 def _quiet_dask() -> None:
