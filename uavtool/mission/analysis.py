@@ -10,10 +10,11 @@ from uavtool.mission.errors import MissionInputError
 from uavtool.mission.observations import Photo, U8Array
 from uavtool.mission.params import Params
 from uavtool.nav.heights import outline_residual_px, roof_from_photos
+from uavtool.nav.parallax import highest_inner_edge_m
 from uavtool.vision import Shape, best_match, mirror_score, vectorize
 from uavtool.vision.merge import merge_touching
 from uavtool.vision.model3d import central_shape
-from uavtool.vision.vectorize import hue_distance_deg
+from uavtool.vision.vectorize import hue_distance_deg, roof_inside
 
 
 def nadir_shapes(params: Params, image_rgb: U8Array) -> tuple[Shape, ...]:
@@ -137,7 +138,45 @@ def roof_between(a: Shape, photo_a: Photo, b: Shape, photo_b: Photo) -> float | 
         intrinsics=coarse[1].intrinsics,
         plane_z_m=roof,
     )
-    return roof if residual <= ONE_ROOF_PX else None
+    if residual > ONE_ROOF_PX:
+        return None
+    # ... and nothing inside the outline may stand higher: tiers of one colour show from
+    # above only as edges inside the lowest tier's outline.
+    top = inner_top_m(a, photo_a, b, photo_b)
+    return roof if top is None or top <= roof + NOT_FLAT_M else None
+
+
+def inner_top_m(a: Shape, photo_a: Photo, b: Shape, photo_b: Photo) -> float | None:
+    """How high the edges inside one roof's outlines (``a`` in ``photo_a``, ``b`` in
+    ``photo_b``) stand, from their parallax between the two photos: the higher of the two
+    plane sweeps (each photo's inner edges against the other; a wall between tiers often
+    shows in only one of them). None when neither outline holds edges the photos agree on."""
+    ceiling_m = min(photo_a.pose.pos_enu_m[2], photo_b.pose.pos_enu_m[2]) - 1.0
+    tops = [
+        highest_inner_edge_m(
+            p.image_rgb,
+            p.pose,
+            roof_inside(p.image_rgb, s, inset_px=INSET_PX),
+            o.image_rgb,
+            o.pose,
+            p.intrinsics,
+            lo_m=0.0,
+            hi_m=ceiling_m,
+        )
+        for s, p, o in ((a, photo_a, photo_b), (b, photo_b, photo_a))
+    ]
+    return max((t for t in tops if t is not None), default=None)
+
+
+INSET_PX = 3
+"""How far inside a roof's outline (and from the ground showing through it) an edge must lie
+to be the roof's inside: its outline's own edge is a few pixels wide."""
+
+NOT_FLAT_M = 3.0
+"""How much higher than its outline's height a roof's inner edges may stand for the roof to
+count as flat: half of ``mission.min_above_roof_m``'s default, so a step the sweep missed
+still leaves half the clearance over the outline's height. A stepped tower's tiers are
+5-25 m apart; the sweep's error on the overviews is a few metres."""
 
 
 ONE_ROOF_PX = 1.0

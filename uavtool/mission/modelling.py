@@ -15,8 +15,10 @@ from uavtool.mission.sides import SidePlan, side_view
 from uavtool.mission.survey import (
     Survey,
     beyond_the_frame,
+    building_top_m,
     obstacles_around,
     remeasured_obstacles,
+    same_building,
 )
 from uavtool.nav import (
     Viewpoint,
@@ -49,7 +51,9 @@ def photograph_and_model(
     """Top, front and right photos from planned viewpoints, then the model. The side photos
     are taken only once the top photo shows the whole building."""
     p = m.params.mission
-    roof = found.roof_m
+    # The building's highest part: one tier of a stepped tower may have been found apart
+    # from the others, each measured on its own.
+    roof = max(found.roof_m, building_top_m(seen, same_building(m, seen, found.poi.shape_index)))
     k = found.photo.intrinsics
     # Side photos: a horizontal camera halfway up, its view holding the whole height.
     vp_params = dataclasses.replace(
@@ -58,7 +62,10 @@ def photograph_and_model(
         assumed_height_m=max(m.params.viewpoints.assumed_height_m, roof),
     )
     footprint = ground_polygon(
-        found.shape.polygon_px, found.photo.pose, k, plane_z_m=min(roof, _below(found.photo))
+        found.shape.polygon_px,
+        found.photo.pose,
+        k,
+        plane_z_m=min(found.roof_m, _below(found.photo)),
     )
     rect = min_area_rect(footprint)
     others = obstacles_around(m, seen, found.poi.shape_index)
@@ -73,6 +80,11 @@ def photograph_and_model(
     )
     for attempt in range(1, p.max_looks + 1):
         top = top_viewpoint(rect, front_heading, alt_m=alt)
+        # never below a known roof within the margin, nor near one of unknown height
+        floor_m = m.floor_at(top.pos_enu_m[0], top.pos_enu_m[1])
+        if floor_m > alt:
+            alt = floor_m
+            top = top_viewpoint(rect, front_heading, alt_m=alt)
         yield from m.travel(top.pos_enu_m, top.heading_deg, transit_m, "top viewpoint")
         top_photo = yield from m.photo("top" if attempt == 1 else f"top-{attempt}", -90.0)
         top_shapes = photo_shapes(m, top_photo)
@@ -94,7 +106,9 @@ def photograph_and_model(
     # The top photo, low over the target, measures the neighbours the overview could not.
     obstacles = remeasured_obstacles(m, seen, found.poi.shape_index, top_photo, top_shapes)
     # The top photo is centred on the building: plan the side photos from its footprint.
-    footprint = ground_polygon(obj.polygon_px, top_photo.pose, top_photo.intrinsics, plane_z_m=roof)
+    footprint = ground_polygon(
+        obj.polygon_px, top_photo.pose, top_photo.intrinsics, plane_z_m=found.roof_m
+    )
     rect = min_area_rect(footprint)
     front, right = plan_viewpoints(rect, obstacles, top_photo.intrinsics, vp_params)
     m.viewpoints = Viewpoints(footprint, top, front, right)

@@ -209,6 +209,12 @@ def same_building(m: SearchMission, seen: Survey, target: int) -> frozenset[int]
     return frozenset(parts)
 
 
+def building_top_m(seen: Survey, parts: frozenset[int]) -> float:
+    """The highest measured roof among a building's ``parts`` (survey shape indices), 0
+    when none is measured."""
+    return max((seen.roofs_m[i] for i in parts if seen.measured[i]), default=0.0)
+
+
 def obstacles_around(
     m: SearchMission, seen: Survey, target: int
 ) -> list[tuple[tuple[float, float], ...]]:

@@ -135,6 +135,27 @@ def non_ground(
     return tuple(s for *_, s in shapes)
 
 
+def roof_inside(
+    frame_rgb: U8Array, shape: Shape, *, inset_px: int, tolerance_dn: int = 15
+) -> CvArray:
+    """A mask of ``shape``'s roof proper: inside its outline, not in its holes, and at least
+    ``inset_px`` from its outline and from any pixel of the ground's colour (a courtyard or
+    an opening shows the ground; a wall between two tiers of one building does not)."""
+    frame = _check_frame(frame_rgb)
+    inside = np.zeros(frame.shape[:2], np.uint8)
+    cv2.fillPoly(inside, [_ring(shape.polygon_px)], 255)
+    for hole in shape.holes_px:
+        cv2.fillPoly(inside, [_ring(hole)], 0)
+    ground = _near(frame, _mode_rgb(frame), tolerance_dn)
+    inside = cv2.bitwise_and(inside, cv2.bitwise_not(ground))
+    side = 2 * inset_px + 1
+    return cv2.erode(inside, np.ones((side, side), np.uint8))
+
+
+def _ring(points: FloatArray) -> CvArray:
+    return np.round(np.asarray(points)).astype(np.int32).reshape(-1, 1, 2)
+
+
 def _near(frame: U8Array, rgb: tuple[int, int, int], tolerance_dn: int) -> CvArray:
     lo = np.array([max(c - tolerance_dn, 0) for c in rgb], np.uint8)
     hi = np.array([min(c + tolerance_dn, 255) for c in rgb], np.uint8)
