@@ -12,6 +12,7 @@ them bounds the building's top from below — evidence that the roof is not flat
 from __future__ import annotations
 
 import math
+
 import cv2
 import numpy as np
 
@@ -66,7 +67,7 @@ def highest_inner_edge_m(
     roi_b = grey_b[y0:y1, x0:x1]
     corners = [(x0, y0), (x1 - 1, y0), (x1 - 1, y1 - 1), (x0, y1 - 1)]
     local = np.array([(u - x0, v - y0) for u, v in corners], np.float32)
-    heights = [lo_m + i * step_m for i in range(int(math.floor((hi_m - lo_m) / step_m)) + 1)]
+    heights = [lo_m + i * step_m for i in range(math.floor((hi_m - lo_m) / step_m) + 1)]
     costs = np.full((len(heights), y1 - y0, x1 - x0), np.inf, np.float32)
     for i, h in enumerate(heights):
         try:

@@ -142,7 +142,7 @@ def roof_inside(
     ``inset_px`` from its outline and from any pixel of the ground's colour (a courtyard or
     an opening shows the ground; a wall between two tiers of one building does not)."""
     frame = _check_frame(frame_rgb)
-    inside = np.zeros(frame.shape[:2], np.uint8)
+    inside: CvArray = np.zeros(frame.shape[:2], np.uint8)
     cv2.fillPoly(inside, [_ring(shape.polygon_px)], 255)
     for hole in shape.holes_px:
         cv2.fillPoly(inside, [_ring(hole)], 0)
