@@ -117,7 +117,9 @@ def test_line_of_sight_blocked_but_camera_clear() -> None:
     assert isinstance(front, ViewpointFailure)
     assert front.reason == (
         "front: long-a at 17.3 m: no line of sight (obstacle 0); "
-        "long-b at 17.3 m: no line of sight (obstacle 1) (tried up to 20 m)"
+        "long-b at 17.3 m: no line of sight (obstacle 1); "
+        "long-a looking down: no line of sight; long-b looking down: no line of sight "
+        "(tried up to 20 m)"
     )
     assert_view(right, pos=(5.0 + D0, 0.0, 6.0), heading=270.0, side="short-a", distance=D0)
 
@@ -187,10 +189,40 @@ def test_camera_inside_an_obstacle_is_named() -> None:
 
 
 def test_base_distance_beyond_the_limit() -> None:
-    front, _ = plan([], ViewpointParams(max_distance_m=10.0))
+    front, _ = plan([], ViewpointParams(max_distance_m=10.0, max_pitch_down_deg=0.0))
     assert front == ViewpointFailure(
-        "front", "front: the base distance 17.3 m exceeds nav.max_distance_m 10 m"
+        "front",
+        "front: the base distance 17.3 m exceeds nav.max_distance_m 10 m (tried up to 10 m)",
     )
+    front, _ = plan([], ViewpointParams(max_distance_m=10.0))
+    assert isinstance(front, ViewpointFailure)
+    assert front.reason == (
+        "front: the base distance 17.3 m exceeds nav.max_distance_m 10 m; "
+        "long-a looking down: too close to look down at steeply enough; "
+        "long-b looking down: too close to look down at steeply enough (tried up to 10 m)"
+    )
+
+
+@pytest.mark.parametrize("tall_m", [45.0, 55.0, 70.0])
+def test_a_tower_too_tall_for_a_level_camera_is_photographed_looking_down(tall_m: float) -> None:
+    """A level camera needs 65-101 m to hold a 45-70 m tower, more than ``max_distance_m``
+    (60 m): the camera rises and looks down, no steeper than ``max_pitch_down_deg``, and
+    its view holds the building's every corner from the ground to its top."""
+    params = ViewpointParams(assumed_height_m=tall_m, camera_alt_m=tall_m / 2.0)
+    assert base_distance_m(BOX.length_m, K, params) > params.max_distance_m
+    front, right = plan([], params)
+    for vp in (front, right):
+        assert isinstance(vp, Viewpoint), vp
+        assert -params.max_pitch_down_deg <= vp.pitch_deg < 0.0
+        assert "looking down" in vp.fallback and vp.distance_m <= params.max_distance_m
+        assert vp.pos_enu_m[2] > params.camera_alt_m
+        pose = CameraPose(vp.pos_enu_m, vp.heading_deg, vp.pitch_deg)
+        corners = BOX.corners()
+        points = [(x, y, z) for x, y in corners for z in (0.0, tall_m)]
+        uvz = project(np.array(points), pose, K)
+        assert (uvz[:, 2] > 0.0).all()
+        assert (uvz[:, 0] >= 0.0).all() and (uvz[:, 0] <= K.width_px - 1).all()
+        assert (uvz[:, 1] >= 0.0).all() and (uvz[:, 1] <= K.height_px - 1).all()
 
 
 def test_top_viewpoint() -> None:

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from uavtool.camera import Intrinsics, project
+from uavtool.camera import CameraPose, Intrinsics, project
 from uavtool.mission.analysis import cut_edges
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level
@@ -137,7 +137,9 @@ def side_view(
     )
     for attempt in range(1, p.max_looks + 1):
         yield from m.move((x, y, z), vp.heading_deg, f"{vp.name} viewpoint")
-        photo = yield from m.photo(vp.name if attempt == 1 else f"{vp.name}-{attempt}", 0.0)
+        photo = yield from m.photo(
+            vp.name if attempt == 1 else f"{vp.name}-{attempt}", vp.pitch_deg
+        )
         shapes = photo_shapes(m, photo, nadir=False)
         silhouette = _in_line(
             same_colour(shapes, colour_rgb, hue_tolerance_deg=SIDE_HUE_TOLERANCE_DEG),
@@ -147,7 +149,7 @@ def side_view(
         edges = cut_edges(silhouette, photo.intrinsics)
         if not edges or attempt == p.max_looks:
             break
-        taller = _taller_view(m, plan, vp, photo.pose.pos_enu_m[2]) if edges == {"top"} else None
+        taller = _taller_view(m, plan, vp, photo.pose) if edges == {"top"} else None
         moved = taller if taller is not None else _backed_away(m, plan, vp, step_m)
         if moved is None:
             break
@@ -181,12 +183,14 @@ def _in_line(shapes: tuple[Shape, ...], rect: Rect, photo: Photo) -> tuple[Shape
 
 
 def _taller_view(
-    m: SearchMission, plan: SidePlan, vp: Viewpoint, camera_z_m: float
+    m: SearchMission, plan: SidePlan, vp: Viewpoint, pose: CameraPose
 ) -> Viewpoint | None:
     """The viewpoint planned again, from the same direction, for a building taller than the
-    top of the view over its near wall; None when no viewpoint fits."""
+    top of the view over its near wall (the camera level or looking down); None when no
+    viewpoint fits."""
     half_vfov = math.radians(plan.intrinsics.vfov_deg) / 2.0
-    at_least_m = camera_z_m + vp.distance_m * math.tan(half_vfov)
+    up = half_vfov + math.radians(pose.pitch_deg)  # the top of the view above the horizon
+    at_least_m = pose.pos_enu_m[2] + vp.distance_m * math.tan(up)
     height_m = _TALLER * max(at_least_m, plan.params.assumed_height_m)
     found = _towards(plan, vp, _for_height(m, plan.params, height_m))
     if not isinstance(found, Viewpoint):

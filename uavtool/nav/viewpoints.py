@@ -16,6 +16,7 @@ from the front camera. Side photos assume a horizontal camera (gimbal pitch 0).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -46,6 +47,12 @@ class ViewpointParams:
     """Farthest a camera may stand from the side it photographs."""
     distance_step: float = 1.25
     """Factor by which the distance grows on each fallback round."""
+    max_pitch_down_deg: float = 40.0
+    """How far below the horizon a side camera may look. When no level camera within
+    ``max_distance_m`` sees the whole height (a tower), or none has room, the camera rises
+    and looks down at the building instead (the model takes side photos up to
+    ``model.max_side_tilt_deg``, 45°, off the horizon; 5° are kept for the gimbal's error).
+    0: level cameras only."""
     oblique_deg: tuple[float, ...] = (25.0, -25.0, 45.0, -45.0)
     """Last fallbacks, tried in order when no side can be seen square on: the camera turned
     this far around the building from a side's normal (it then sees two walls; the model
@@ -59,8 +66,14 @@ class ViewpointParams:
             ("safety_margin_m", self.safety_margin_m >= 0.0),
             ("max_distance_m", self.max_distance_m > 0.0),
             ("distance_step", self.distance_step > 1.0),
+            ("max_pitch_down_deg", 0.0 <= self.max_pitch_down_deg < 90.0),
         )
-        bounds = {"margin": "≥ 0", "safety_margin_m": "≥ 0", "distance_step": "> 1"}
+        bounds = {
+            "margin": "≥ 0",
+            "safety_margin_m": "≥ 0",
+            "distance_step": "> 1",
+            "max_pitch_down_deg": "in [0, 90)",
+        }
         for name, ok in checks:
             value = getattr(self, name)
             if not ok or not math.isfinite(value):
@@ -130,6 +143,31 @@ def base_distance_m(side_length_m: float, intrinsics: Intrinsics, params: Viewpo
     return max(d_h, d_v, params.safety_margin_m)
 
 
+def tilted_camera(
+    distance_m: float, depth_m: float, intrinsics: Intrinsics, params: ViewpointParams
+) -> tuple[float, float] | None:
+    """``(altitude, pitch)`` of a camera ``distance_m`` out from a building's near wall that
+    looks down at it (pitch ≤ 0) and sees it whole, with the margin, from the ground at the
+    near wall up to the top of its far side ``depth_m`` further (``assumed_height_m``
+    tall): the lowest such altitude from ``camera_alt_m`` up, in half-metre steps. None when
+    no pitch within ``max_pitch_down_deg`` does it."""
+    limit = math.radians(params.max_pitch_down_deg)
+    half = math.atan((intrinsics.height_px / 2.0) / intrinsics.fy_px / (1.0 + params.margin))
+    tall = params.assumed_height_m
+    z = params.camera_alt_m
+    while True:
+        below_base = math.atan2(z, distance_m)  # the near wall's foot, below the horizon
+        top = math.atan2(z - tall, distance_m + depth_m if z > tall else distance_m)
+        low = below_base - half  # the least pitch down that holds the foot
+        if low > limit:
+            return None  # higher only looks steeper
+        least, most = max(low, 0.0), min(top + half, limit)  # pitches down that hold both
+        if least <= most:
+            pitch = min(max((below_base + top) / 2.0, least), most)
+            return z, -math.degrees(pitch)
+        z += 0.5
+
+
 def _ids(indices: list[int]) -> str:
     return ("obstacle " if len(indices) == 1 else "obstacles ") + ", ".join(map(str, indices))
 
@@ -188,14 +226,76 @@ def _plan_one(
                 return found
             tried.append(found)
     if not tried:
-        return ViewpointFailure(
-            name,
-            f"{name}: the base distance {d0:.1f} m exceeds nav.max_distance_m "
-            f"{params.max_distance_m:g} m",
+        tried.append(
+            f"the base distance {d0:.1f} m exceeds nav.max_distance_m {params.max_distance_m:g} m"
         )
+    if params.max_pitch_down_deg > 0.0:
+        for side in (first_side, _OPPOSITE[first_side]):
+            end1, end2, normal = _side_geometry(rect, side)
+            depth = rect.width_m if side.startswith("long") else rect.length_m
+            mid = ((end1[0] + end2[0]) / 2.0, (end1[1] + end2[1]) / 2.0)
+            ends = (end1, end2)
+            found = _looking_down(
+                name, side, mid, ends, normal, depth, side_len, obstacles, intrinsics, params
+            )
+            if isinstance(found, Viewpoint):
+                return found
+            tried.append(found)
     return ViewpointFailure(
         name, f"{name}: " + "; ".join(tried) + f" (tried up to {params.max_distance_m:g} m)"
     )
+
+
+def _looking_down(
+    name: str,
+    side: str,
+    mid: Point,
+    seen: Sequence[Point],
+    normal: Point,
+    depth_m: float,
+    across_m: float,
+    obstacles: list[list[Point]],
+    intrinsics: Intrinsics,
+    params: ViewpointParams,
+) -> Viewpoint | str:
+    """A camera out along ``normal`` from ``mid`` (the middle of the near wall) that rises
+    and looks down (:func:`tilted_camera`), at the first distance from the horizontal need
+    (``across_m`` wide) or the safety margin, growing, where it keeps the margin and sees
+    the points ``seen`` (the wall's ends, or every corner) past the obstacles (as tall as
+    any: a level camera's rule); else what stopped it."""
+    tan_h = (intrinsics.width_px / 2.0) / intrinsics.fx_px
+    distance = max((1.0 + params.margin) * (across_m / 2.0) / tan_h, params.safety_margin_m)
+    why = "too close to look down at steeply enough"
+    distances = []
+    while distance < params.max_distance_m:
+        distances.append(distance)
+        distance *= params.distance_step
+    for distance in (*distances, params.max_distance_m):  # the farthest allowed last
+        found = tilted_camera(distance, depth_m, intrinsics, params)
+        cam = (mid[0] + distance * normal[0], mid[1] + distance * normal[1])
+        if found is not None:
+            near = any(
+                point_polygon_distance(cam, poly) < params.safety_margin_m for poly in obstacles
+            )
+            hidden = any(
+                triangle_hits_polygon((cam, a, b), poly)
+                for poly in obstacles
+                for i, a in enumerate(seen)
+                for b in seen[i + 1 :]
+            )
+            if not near and not hidden:
+                z, pitch = found
+                return Viewpoint(
+                    name=name,
+                    pos_enu_m=(cam[0], cam[1], z),
+                    heading_deg=_heading(-normal[0], -normal[1]),
+                    side=side,
+                    distance_m=distance,
+                    fallback=f"{side} side, looking down {-pitch:.0f}° from {z:.1f} m",
+                    pitch_deg=pitch,
+                )
+            why = "no line of sight" if hidden else "no room"
+    return f"{side} looking down: {why}"
 
 
 def _oblique(
@@ -279,6 +379,24 @@ def _from_direction(
             )
         blocked = "no line of sight" if hidden else "no room"
         factor *= params.distance_step
+    if not params.max_pitch_down_deg > 0.0:
+        return blocked or "beyond nav.max_distance_m"
+    # No level camera: one that rises and looks down, facing the corners' span.
+    mid = (cx + depth * u[0], cy + depth * u[1])  # the middle of the near side's span
+    down = _looking_down(
+        name,
+        side,
+        mid,
+        corners,
+        u,
+        2.0 * depth,
+        max(across) - min(across),
+        obstacles,
+        intrinsics,
+        params,
+    )
+    if isinstance(down, Viewpoint):
+        return dataclasses.replace(down, fallback=f"{label}, {down.fallback}")
     return blocked or "beyond nav.max_distance_m"
 
 
