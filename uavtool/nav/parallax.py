@@ -45,7 +45,7 @@ def highest_inner_edge_m(
     *,
     lo_m: float,
     hi_m: float,
-    step_m: float = 0.25,
+    step_m: float = 0.5,
 ) -> float | None:
     """The height (above home) that the edges in ``roof_b`` (a mask of one roof's inside in
     photo B) reach, found by a plane sweep against photo A from ``lo_m`` to ``hi_m``; None
