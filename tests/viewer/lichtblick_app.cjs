@@ -8,7 +8,7 @@
 // same way), and opens RECORDING through its "remote file" data source (HTTP range requests),
 // seeking to TIME (RFC 3339). Written to OUT_DIR: page.png and one PNG per panel, named by its
 // id. Printed: one JSON object with the Problems tab's text, its count badge, the text of each
-// panel and the console's errors.
+// panel, the box of each panel's canvas in its PNG and the console's errors.
 "use strict";
 const fs = require("fs");
 const http = require("http");
@@ -74,10 +74,18 @@ async function main() {
     fs.mkdirSync(outDir, { recursive: true });
     await page.screenshot({ path: path.join(outDir, "page.png") });
     const panels = {};
+    const canvases = {};
     for (const panel of await page.locator("[data-testid^='panel-mouseenter-container']").all()) {
       const id = (await panel.getAttribute("data-testid")).split(" ").slice(1).join(" ");
       await panel.screenshot({ path: path.join(outDir, `${id.replace(/[^\w.-]/g, "_")}.png`) });
       panels[id] = await panel.innerText();
+      // Where the panel draws (an image panel: its picture, fitted): x, y, width, height in
+      // the panel's screenshot.
+      const canvas = panel.locator("canvas").first();
+      if ((await canvas.count()) > 0) {
+        const [outer, inner] = [await panel.boundingBox(), await canvas.boundingBox()];
+        canvases[id] = [inner.x - outer.x, inner.y - outer.y, inner.width, inner.height];
+      }
     }
     const tab = page.getByTestId("problems-left");
     const badge = (await tab.innerText()).replace("Problems", "").trim();
@@ -85,7 +93,7 @@ async function main() {
     await page.waitForTimeout(500);
     const sidebar = await page.getByTestId("sidebar-left").innerText();
     const problems = sidebar.slice(sidebar.indexOf("Layouts") + "Layouts".length).trim();
-    process.stdout.write(JSON.stringify({ idle, badge, problems, panels, errors }) + "\n");
+    process.stdout.write(JSON.stringify({ idle, badge, problems, panels, canvases, errors }) + "\n");
   } finally {
     await browser.close();
     server.close();

@@ -50,7 +50,8 @@ class LichtblickApp:
 
     def open(self, recording: Path, layout: Path, time: str, out: Path) -> dict[str, Any]:
         """What the app shows of ``recording`` with ``layout``, seeked to ``time``: the Problems
-        tab (``badge``, ``problems``), each panel's text (``panels``) and console errors;
+        tab (``badge``, ``problems``), each panel's text (``panels``), the box (x, y, width,
+        height) of each panel's canvas in the panel's PNG (``canvases``) and console errors;
         ``out`` gets ``page.png`` and a PNG per panel."""
         done = subprocess.run(
             ["node", str(DRIVER), str(self.web), str(self.node_modules), str(recording),
