@@ -116,6 +116,7 @@ class Result:
     wall_s: float
     classes: tuple[str, ...] = ()  # the town classes the scene holds
     wrong_kind: str = ""  # what the building wrongly matched is (see _kind)
+    flew: bool = True  # False: the vehicle never left the ground (a take-off refused)
 
 
 def _kind(info: HardSceneInfo, name: str) -> str:
@@ -226,6 +227,7 @@ def judge(seed: int, scene: Scene, info: HardSceneInfo, row: dict[str, Any]) -> 
         tunnel = tunnel_kept(model["vertices_m"], model["faces"], scene)
     clearance, _ = closest_clearance(route, scene, body_radius_m=SitlConfig().body_radius_m)
     crashed = status == "crashed" or clearance < 0.0
+    flew = bool(times)
     flight_s = (times[-1] - times[0]) / 1000.0 if len(times) > 1 else 0.0
     return Result(
         seed,
@@ -242,6 +244,7 @@ def judge(seed: int, scene: Scene, info: HardSceneInfo, row: dict[str, Any]) -> 
         float(row["wall_s"]),
         info.classes,
         _kind(info, matched) if matched and matched != scene.target else "",
+        flew,
     )
 
 
@@ -256,6 +259,7 @@ def summarise(name: str, results: list[Result]) -> dict[str, Any]:
     clear = [r.clearance_m for r in results if math.isfinite(r.clearance_m)]
     crashes = [r for r in results if r.crashed]
     errors = [r for r in results if r.status.startswith("error")]
+    flew = [r for r in results if r.flew]
     return {
         "name": name,
         "n": n,
@@ -270,6 +274,10 @@ def summarise(name: str, results: list[Result]) -> dict[str, Any]:
         "clearance_min": min(clear, default=math.inf),
         "below_margin": sum(c < SAFETY_MARGIN_M for c in clear),
         "crashes": len(crashes),
+        "crashes_hidden": sum(r.status != "crashed" for r in crashes),
+        "below_2m": sum(c < 2.0 for c in clear),
+        "flew": len(flew),
+        "correct_flew": sum(r.matched == r.target for r in flew if r.matched),
         "errors": len(errors),
         "flight_s": statistics.median([r.flight_s for r in results if r.flight_s > 0] or [0.0]),
         "wall_s": sum(r.wall_s for r in results),
@@ -347,6 +355,8 @@ def report(rows: list[dict[str, Any]]) -> None:
     line("wrong match", [_pct(r["wrong"], r["n"]) for r in rows])
     line("  of which the mirror decoy", [_pct(r["mirror"], r["n"]) for r in rows])
     line("no match", [_pct(r["none"], r["n"]) for r in rows])
+    line("  of which never took off", [_pct(r["n"] - r["flew"], r["n"]) for r in rows])
+    line("correct, of flights that took off", [_pct(r["correct_flew"], r["flew"]) for r in rows])
     line("model built (of correct matches)", [_pct(r["models"], r["correct"]) for r in rows])
     line("IoU median / worst", [f"{r['iou_median']:.3f} / {r['iou_worst']:.3f}" for r in rows])
     line("tunnels kept", [_pct(*r["tunnels"]) for r in rows])
@@ -355,7 +365,9 @@ def report(rows: list[dict[str, Any]]) -> None:
         f"flights below {SAFETY_MARGIN_M:g} m clearance",
         [_pct(r["below_margin"], r["n"]) for r in rows],
     )
+    line("flights below 2 m clearance", [_pct(r["below_2m"], r["n"]) for r in rows])
     line("crashes", [_pct(r["crashes"], r["n"]) for r in rows])
+    line("  of which not reported as a crash", [_pct(r["crashes_hidden"], r["n"]) for r in rows])
     line("errors (exceptions)", [_pct(r["errors"], r["n"]) for r in rows])
     line("median flight time (s)", [f"{r['flight_s']:.1f}" for r in rows])
     line("wall time, all flights (s)", [f"{r['wall_s']:.0f}" for r in rows])
@@ -388,12 +400,15 @@ def report(rows: list[dict[str, Any]]) -> None:
     n = max(new["n"], 1)
     goals = [
         ("correct >= 98 %", new["correct"] / n >= 0.98),
+        ("correct >= 98 % of flights that took off", new["correct_flew"] >= 0.98 * new["flew"]),
         ("no mirror match", new["mirror"] == 0),
         ("wrong <= 0.5 %", new["wrong"] / n <= 0.005),
         ("model in >= 95 % of matches", new["models"] >= 0.95 * max(new["correct"], 1)),
         ("median IoU >= 0.85", new["iou_median"] >= 0.85),
-        ("tunnels kept >= 90 %", new["tunnels"][0] >= 0.9 * max(new["tunnels"][1], 1)),
+        ("tunnels kept >= 90 %", new["tunnels"][0] >= 0.9 * new["tunnels"][1]),
         ("no crash", new["crashes"] == 0),
+        ("every crash reported as one", new["crashes_hidden"] == 0),
+        ("no pass under 2 m", new["below_2m"] == 0),
         ("clearance >= margin", new["below_margin"] == 0),
     ]
     print(
