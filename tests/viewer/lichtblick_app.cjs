@@ -7,8 +7,10 @@
 // its default layout (the placeholder in index.html that Lichtblick's Docker image fills the
 // same way), and opens RECORDING through its "remote file" data source (HTTP range requests),
 // seeking to TIME (RFC 3339). Written to OUT_DIR: page.png and one PNG per panel, named by its
-// id. Printed: one JSON object with the Problems tab's text, its count badge, the text of each
-// panel, the box of each panel's canvas in its PNG and the console's errors.
+// id. Printed: one JSON object with the Alerts (formerly Problems) tab's text, its count badge
+// and the badge's colour (its most severe alert's: "Error", "Warning", "Info"; null without
+// alerts), the text of each panel, the box of each panel's canvas in its PNG and the console's
+// errors.
 "use strict";
 const fs = require("fs");
 const http = require("http");
@@ -87,13 +89,21 @@ async function main() {
         canvases[id] = [inner.x - outer.x, inner.y - outer.y, inner.width, inner.height];
       }
     }
-    const tab = page.getByTestId("problems-left");
-    const badge = (await tab.innerText()).replace("Problems", "").trim();
+    // The tab is "Alerts" in today's Lichtblick, "Problems" in older ones. Its badge counts
+    // them, coloured by the most severe (MuiBadge-colorError, -colorWarning or -colorInfo).
+    const tab = page.getByTestId("alerts-left").or(page.getByTestId("problems-left"));
+    const badge = (await tab.innerText()).replace(/Alerts|Problems/, "").trim();
+    const shown = tab.locator(".MuiBadge-badge:not(.MuiBadge-invisible)");
+    const severity =
+      (await shown.count()) > 0
+        ? (/MuiBadge-color(\w+)/.exec(await shown.getAttribute("class"))?.[1] ?? "default")
+        : null;
     await tab.click();
     await page.waitForTimeout(500);
     const sidebar = await page.getByTestId("sidebar-left").innerText();
     const problems = sidebar.slice(sidebar.indexOf("Layouts") + "Layouts".length).trim();
-    process.stdout.write(JSON.stringify({ idle, badge, problems, panels, canvases, errors }) + "\n");
+    const seen = { idle, badge, severity, problems, panels, canvases, errors };
+    process.stdout.write(JSON.stringify(seen) + "\n");
   } finally {
     await browser.close();
     server.close();

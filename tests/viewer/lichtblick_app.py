@@ -49,10 +49,11 @@ class LichtblickApp:
     node_modules: Path
 
     def open(self, recording: Path, layout: Path, time: str, out: Path) -> dict[str, Any]:
-        """What the app shows of ``recording`` with ``layout``, seeked to ``time``: the Problems
-        tab (``badge``, ``problems``), each panel's text (``panels``), the box (x, y, width,
-        height) of each panel's canvas in the panel's PNG (``canvases``) and console errors;
-        ``out`` gets ``page.png`` and a PNG per panel."""
+        """What the app shows of ``recording`` with ``layout``, seeked to ``time``: the Alerts
+        (formerly Problems) tab (``badge``, its most severe alert's ``severity`` as the badge's
+        colour, ``problems``), each panel's text (``panels``), the box (x, y, width, height) of
+        each panel's canvas in the panel's PNG (``canvases``) and console errors; ``out`` gets
+        ``page.png`` and a PNG per panel."""
         done = subprocess.run(
             ["node", str(DRIVER), str(self.web), str(self.node_modules), str(recording),
              str(layout), time, str(out)],
