@@ -89,3 +89,27 @@ def test_no_traceback_or_warning_from_any_command(tmp_path: Path) -> None:
         out = _run(*args, cwd=ROOT)
         for bad in ("Traceback", "WARNING", "Warning:"):
             assert bad not in out, f"uavtool {' '.join(args)}:\n{out}"
+
+
+@pytest.mark.parametrize(
+    ("args", "says"),
+    [
+        (["fly", "--nosuch"], "No such option '--nosuch'"),
+        (["fly", "--rerun", "nosuch"], "Invalid value for --rerun: 'nosuch'"),
+        (["replay"], "Missing argument 'RECORDING'"),
+        (["nosuchcommand"], "No such command 'nosuchcommand'"),
+    ],
+)
+def test_a_command_line_click_cannot_parse_is_one_line(args: list[str], says: str) -> None:
+    """Not click's usage block (three lines and a blank one): one line naming the problem
+    and where the help is, exit 2, as every other error."""
+    done = subprocess.run(
+        [sys.executable, "-m", "uavtool", *args], capture_output=True, text=True, check=False
+    )
+    assert done.returncode == 2
+    assert done.stdout == ""
+    lines = done.stderr.splitlines()
+    assert len(lines) == 1, done.stderr
+    assert lines[0].startswith("uavtool: error: ") and says in lines[0]
+    command = "uavtool" if args[0] == "nosuchcommand" else f"uavtool {args[0]}"
+    assert lines[0].endswith(f"(see '{command} --help')")

@@ -12,6 +12,7 @@ import sys
 from typing import Any
 
 import click
+from click.exceptions import NoArgsIsHelpError
 
 from uavtool import __version__
 from uavtool.errors import UavtoolError
@@ -83,5 +84,21 @@ _whole_help_lines(cli)
 
 
 def main() -> None:
-    """Console-script entry point."""
-    sys.exit(cli.main(prog_name="uavtool", standalone_mode=True))
+    """Console-script entry point. A command line click cannot parse (an unknown option, a
+    bad value, a missing argument) is one line on stderr, exit 2, like every other error."""
+    try:
+        code = cli.main(prog_name="uavtool", standalone_mode=False)
+    except NoArgsIsHelpError as exc:  # a bare group: its help, as click shows it
+        click.echo(exc.format_message(), err=True)
+        sys.exit(exc.exit_code)
+    except click.UsageError as exc:
+        where = exc.ctx.command_path if exc.ctx is not None else "uavtool"
+        click.echo(f"uavtool: error: {exc.format_message()} (see '{where} --help')", err=True)
+        sys.exit(exc.exit_code)
+    except click.ClickException as exc:
+        exc.show()
+        sys.exit(exc.exit_code)
+    except click.Abort:
+        click.echo("Aborted!", err=True)
+        sys.exit(1)
+    sys.exit(code if isinstance(code, int) else 0)  # an exit code from ctx.exit, --help
