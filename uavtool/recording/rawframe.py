@@ -57,11 +57,26 @@ def _varint(n: int) -> bytes:
     return bytes(out)
 
 
-def encode(direction: Direction, frame: bytes) -> bytes:
-    """The Protobuf bytes of one frame (proto3: the default direction ``IN`` is not written)."""
+def _head(direction: Direction, length: int) -> bytes:
     code = _DIRECTION_CODE[direction]
     head = bytes((_TAG_DIRECTION, code)) if code else b""
-    return head + bytes((_TAG_FRAME,)) + _varint(len(frame)) + frame
+    return head + bytes((_TAG_FRAME,)) + _varint(length)
+
+
+# what comes before a frame of each length up to the longest MAVLink frame (280 bytes)
+_HEAD_IN = [_head(Direction.IN, n) for n in range(281)]
+_HEAD_OUT = [_head(Direction.OUT, n) for n in range(281)]
+
+
+def encode(direction: Direction, frame: bytes) -> bytes:
+    """The Protobuf bytes of one frame (proto3: the default direction ``IN`` is not written)."""
+    n = len(frame)
+    if n <= 280:
+        if direction is Direction.IN:
+            return _HEAD_IN[n] + frame
+        if direction is Direction.OUT:
+            return _HEAD_OUT[n] + frame
+    return _head(direction, n) + frame
 
 
 def decode(data: bytes) -> tuple[Direction, bytes]:

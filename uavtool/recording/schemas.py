@@ -18,7 +18,9 @@ from __future__ import annotations
 import importlib
 import json
 import math
+from collections.abc import Callable
 from functools import cache
+from operator import attrgetter
 from types import ModuleType
 from typing import Any
 
@@ -170,6 +172,83 @@ def _fields(cls: Any) -> list[tuple[str, str, int]]:
     ]
 
 
+_encode_str: Callable[[str], str] = json.encoder.encode_basestring
+
+
+def _json_text(value: Any) -> str:
+    """A char field as `view` and `dumps` write it (a JSON string)."""
+    if isinstance(value, bytes):  # pymavlink's format_attr
+        value = value.decode(errors="backslashreplace").rstrip("\x00")
+    return _encode_str(value) if isinstance(value, str) else _JSON.encode(value)
+
+
+def _json_floats(values: Any) -> str:
+    return "[" + ",".join(map(repr, values)) + "]"
+
+
+@cache
+def _json_writer(dialect: str, msgid: int) -> Callable[[Any], bytes]:
+    """A function giving ``dumps(payload)`` of `MavlinkDecoder.view`'s payload of a message
+    of this type, byte for byte, without building the dict: one ``%`` template of the whole
+    object, filled from one `attrgetter` call. A float is written by ``repr``, as `json`
+    writes it, an integer by ``str``; when any float is not finite (their sum is not), each
+    field is written or left out on its own (`NULL_RULE`). Generated source, as pymavlink's
+    own: it names only local variables (``v0``, ``v1`` …) and helpers; field names reach it
+    as data, never as code."""
+    cls = dialect_module(dialect).mavlink_map[msgid]
+    fields = _fields(cls)
+    keys = ["," + _encode_str(name) + ":" for name, _, _ in fields]
+    head = '{"header":{"sysid":%s,"compid":%s,"seq":%s}'
+    template = [head]
+    values = []  # what fills each field's place in the template
+    finite = []  # terms whose sum is finite only when every float is finite
+    each = []  # the field-by-field path, when some float is not
+    for i, (_, ftype, length) in enumerate(fields):
+        v = f"v{i}"
+        if ftype in _FLOAT_TYPES and not length:
+            template.append(keys[i].replace("%", "%%") + "%r")
+            values.append(v)
+            finite.append(v)
+            each.append(f"    if fin({v}): out.append(K[{i}] + repr({v}))")
+        elif ftype in _FLOAT_TYPES:
+            template.append(keys[i].replace("%", "%%") + "%s")
+            values.append(f"floats({v})")
+            finite.append(f"sum({v})")
+            each.append(f"    if all(map(fin, {v})): out.append(K[{i}] + floats({v}))")
+        else:
+            one_int = ftype in _INT_TYPES and not length
+            template.append(keys[i].replace("%", "%%") + "%s")
+            values.append(v if one_int else f"text({v})")
+            each.append(f"    out.append(K[{i}] + str({values[-1]}))")
+    header = "m.get_srcSystem(), m.get_srcComponent(), m.get_seq()"
+    whole = f"(T % ({', '.join([header, *values])},)).encode()"
+    lines = ["def write(m):"]
+    if len(fields) == 1:
+        lines.append("    v0 = get(m)")
+    elif fields:
+        lines.append(f"    {', '.join(f'v{i}' for i in range(len(fields)))} = get(m)")
+    if finite:
+        lines.append(f"    if fin({' + '.join(finite)}):")
+        lines.append(f"        return {whole}")
+        lines.append(f"    out = [H % ({header})]")
+        lines.extend(each)
+        lines.append('    return ("".join(out) + "}").encode()')
+    else:
+        lines.append(f"    return {whole}")
+    space: dict[str, Any] = {
+        "T": "".join(template) + "}",
+        "H": head,
+        "K": keys,
+        "get": attrgetter(*(name for name, _, _ in fields)) if fields else None,
+        "fin": math.isfinite,
+        "floats": _json_floats,
+        "text": _json_text,
+    }
+    exec("\n".join(lines), space)
+    write: Callable[[Any], bytes] = space["write"]
+    return write
+
+
 class MavlinkDecoder:
     """Decodes whole MAVLink frames of one dialect into JSON-ready dicts (not thread-safe)."""
 
@@ -221,3 +300,21 @@ class MavlinkDecoder:
                 value = list(value)
             payload[name] = value
         return msgid, msg.get_type(), payload
+
+    def decode_json(self, frame: bytes) -> tuple[int, str, bytes] | None:
+        """``(msgid, MSGNAME, JSON)`` of a frame (`decode`'s payload as `dumps` writes it),
+        or None if it is unknown or corrupt."""
+        try:
+            msg = self._mav.decode(bytearray(frame))
+        except (self._error, IndexError, ValueError):
+            return None
+        return self.json(msg)
+
+    def json(self, msg: Any) -> tuple[int, str, bytes] | None:
+        """``(msgid, MSGNAME, JSON)``: `view`'s payload as `dumps` writes it, byte for byte,
+        made without building it (half the time), or None if the id is not in the
+        dialect."""
+        msgid = msg.get_msgId()
+        if msgid not in self._known:
+            return None
+        return msgid, msg.get_type(), _json_writer(self.dialect, msgid)(msg)

@@ -84,10 +84,15 @@ class RecordingWriter:
         self._closed = False
         self._message_count = 0
         self._schemas: dict[tuple[str, bytes], int] = {}
-        self._channels: dict[Any, int] = {}  # key -> channel id
+        self._channels: dict[str, int] = {}  # topic -> channel id
+        # MAVLink message id -> its JSON channel's id, one dict per direction (an Enum key
+        # hashes in Python: a tenth of the time of a write)
+        self._mavlink_in: dict[int, int] = {}
+        self._mavlink_out: dict[int, int] = {}
+        self._raw_id = 0  # /mavlink/raw's channel id once it has one
         self._topic_kind: dict[str, Any] = {}  # topic -> value type or JSON schema name
         self._json_topics: dict[str, int] = {}  # topic -> channel id
-        self._sequence: dict[int, int] = {}
+        self._sequence: list[int] = [0]  # channel id -> its next sequence number
         tool = {"version": __version__, "dialect": dialect, "mavlink": "2.0"}
         self._sink = RecordingSink(
             self.path,
@@ -224,34 +229,52 @@ class RecordingWriter:
         these bytes (a link's parser has done it); used when it is of this recording's
         dialect, which saves decoding the frame again."""
         frame = bytes(frame)
+        raw = rawframe.encode(direction, frame)
+        # the two messages' times and sequence numbers as _add checks and keeps them, here
+        # inline: this runs for every frame (tens of thousands per flight)
+        if type(log_time_ns) is not int or log_time_ns <= 0:
+            raise ValueError(f"log_time_ns must be a positive int, got {log_time_ns!r}")
+        publish = log_time_ns if publish_time_ns is None else publish_time_ns
         with self._lock:
             self._check_open()
-            raw_id = self._channels.get(MAVLINK_RAW)
-            if raw_id is None:
-                schema_id = self._schema(
-                    rawframe.SCHEMA_NAME, PROTOBUF_ENCODING, rawframe.SCHEMA_DATA
-                )
-                meta = {"dialect": self.dialect}
-                raw_id = self._channel(MAVLINK_RAW, MAVLINK_RAW, PROTOBUF_ENCODING, schema_id, meta)
-            self._add(raw_id, log_time_ns, publish_time_ns, rawframe.encode(direction, frame))
+            raw_id = self._raw_id or self._raw_channel()
+            sequence, add = self._sequence, self._sink.add
+            try:
+                add(raw_id, sequence[raw_id], log_time_ns, publish, raw)
+            except struct.error as exc:  # raised before anything was added
+                raise ValueError(f"times must fit an unsigned 64-bit int: {exc}") from exc
+            sequence[raw_id] += 1
+            self._message_count += 1
             if decoded is not None and self._decoder.owns(decoded):
-                view = self._decoder.view(decoded)
+                view = self._decoder.json(decoded)
             else:
-                view = self._decoder.decode(frame)
+                view = self._decoder.decode_json(frame)
             if view is None:
                 return
-            msgid, msg_name, payload = view
-            key = (direction, msgid)
-            channel_id = self._channels.get(key)
+            msgid, msg_name, data = view
+            channels = self._mavlink_in if direction is Direction.IN else self._mavlink_out
+            channel_id = channels.get(msgid)
             if channel_id is None:
-                name, schema = mavlink_schema(self.dialect, msgid)
-                schema_id = self._schema(name, JSONSCHEMA_ENCODING, schema)
-                topic = mavlink_topic(direction, msg_name)
-                channel_id = self._channel(key, topic, JSON_ENCODING, schema_id)
-                self._topic_kind[topic] = name
-            self._add(channel_id, log_time_ns, publish_time_ns, dumps(payload))
+                channel_id = self._mavlink_channel(direction, msgid, msg_name)
+                channels[msgid] = channel_id
+            add(channel_id, sequence[channel_id], log_time_ns, publish, data)
+            sequence[channel_id] += 1
+            self._message_count += 1
 
     # --- internals (called with the lock held) -----------------------------------------------
+
+    def _raw_channel(self) -> int:
+        schema_id = self._schema(rawframe.SCHEMA_NAME, PROTOBUF_ENCODING, rawframe.SCHEMA_DATA)
+        meta = {"dialect": self.dialect}
+        self._raw_id = self._channel(MAVLINK_RAW, MAVLINK_RAW, PROTOBUF_ENCODING, schema_id, meta)
+        return self._raw_id
+
+    def _mavlink_channel(self, direction: Direction, msgid: int, msg_name: str) -> int:
+        name, schema = mavlink_schema(self.dialect, msgid)
+        schema_id = self._schema(name, JSONSCHEMA_ENCODING, schema)
+        topic = mavlink_topic(direction, msg_name)
+        self._topic_kind[topic] = name
+        return self._channel(None, topic, JSON_ENCODING, schema_id)
 
     def _check_open(self) -> None:
         # a failed write or fsync is raised by the sink on the next write, metadata or flush
@@ -267,15 +290,19 @@ class RecordingWriter:
 
     def _channel(
         self,
-        key: Any,
+        key: str | None,
         topic: str,
         encoding: str,
         schema_id: int,
         meta: dict[str, str] | None = None,
     ) -> int:
+        """A new channel, known by ``key`` in `_channels` unless None (a MAVLink JSON
+        channel: the caller keeps it)."""
         channel_id = self._sink.register_channel(topic, encoding, schema_id, meta or {})
-        self._channels[key] = channel_id
-        self._sequence[channel_id] = 0
+        if key is not None:
+            self._channels[key] = channel_id
+        self._sequence.append(0)
+        assert len(self._sequence) == channel_id + 1
         return channel_id
 
     def _add(
