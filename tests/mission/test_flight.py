@@ -3,6 +3,7 @@ photographs, what it builds, and how it ends when nothing matches or a view is b
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 
@@ -17,6 +18,7 @@ from uavtool.mission import (
     DiagonalView,
     ModelBuilt,
     Outcome,
+    Params,
     Photo,
     Plan,
     Recognition,
@@ -27,7 +29,7 @@ from uavtool.mission import (
 )
 from uavtool.mission.search import look_altitude_m
 from uavtool.mission.survey import overview_ceiling_m
-from uavtool.nav import Viewpoint, ViewpointFailure
+from uavtool.nav import Viewpoint, ViewpointFailure, ViewpointParams
 from uavtool.runner.evaluate import model_iou
 from uavtool.world import Scene, building_footprint, load_scene
 from uavtool.world.hard import HardOptions, generate_hard_scene_with_info
@@ -225,7 +227,10 @@ def test_no_match_reports_and_lands(scene_name: str, why: str, visits: int) -> N
 def test_blocked_viewpoint_is_reported_and_the_flight_completes(
     sides: tuple[str, ...], impossible: tuple[str, ...]
 ) -> None:
-    flown = fly(scenes.walled(sides))
+    """With level cameras only (``viewpoints.max_pitch_down_deg`` 0), walls round the target
+    leave no side photo."""
+    level = Params(viewpoints=dataclasses.replace(ViewpointParams(), max_pitch_down_deg=0.0))
+    flown = fly(scenes.walled(sides), level)
     flight = flown.flight
     outcome = flight.outcome
     assert outcome.status is Status.PARTIAL
@@ -284,3 +289,22 @@ def test_a_neighbour_of_a_close_colour_is_no_part_of_the_side_silhouette() -> No
     (model,) = flown.flight.of_type(ModelBuilt)
     assert model_iou(model.vertices_m, model.faces, scene) > 0.8
     assert not any("touches the image border" in t for t in flown.flight.texts())
+
+
+@pytest.mark.parametrize("sides", [("north", "south", "west", "east"), ("north", "south")])
+def test_walls_round_the_target_are_looked_over(sides: tuple[str, ...]) -> None:
+    """8 m walls 8-10 m from the target, whose heights the survey measured: a camera rises
+    and looks down over them; the photo says its foot is hidden, so the model keeps what it
+    cannot see below the silhouette, and the model is built."""
+    flown = fly(scenes.walled(sides))
+    flight = flown.flight
+    assert flight.outcome.status is Status.COMPLETED, flight.outcome.reason
+    (views,) = flight.of_type(Viewpoints)
+    assert isinstance(views.front, Viewpoint) and -40.0 <= views.front.pitch_deg < 0.0
+    assert isinstance(views.right, Viewpoint)  # looking down only where walls are in the way
+    assert (views.right.pitch_deg < 0.0) == ("east" in sides)
+    assert any("foot is hidden" in t for t in flight.texts())
+    (model,) = flight.of_type(ModelBuilt)
+    scene = scenes.walled(sides)
+    assert model_iou(model.vertices_m, model.faces, scene) > 0.6
+    assert_home_safely(flown)

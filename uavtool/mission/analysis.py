@@ -5,16 +5,20 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from uavtool.camera import Intrinsics
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from uavtool.camera import Intrinsics, project
 from uavtool.mission.errors import MissionInputError
 from uavtool.mission.observations import Photo, U8Array
 from uavtool.mission.params import Params
-from uavtool.nav.heights import outline_residual_px, roof_from_photos
-from uavtool.nav.parallax import highest_inner_edge_m
+from uavtool.nav import NavError, ground_point
+from uavtool.nav.heights import higher_part_m, outline_residual_px, roof_from_photos
 from uavtool.vision import Shape, best_match, mirror_score, vectorize
 from uavtool.vision.merge import merge_touching
 from uavtool.vision.model3d import central_shape
-from uavtool.vision.vectorize import hue_distance_deg, roof_inside
+from uavtool.vision.vectorize import ground_mask, hue_distance_deg, inner_walls
 
 
 def nadir_shapes(params: Params, image_rgb: U8Array) -> tuple[Shape, ...]:
@@ -141,42 +145,57 @@ def roof_between(a: Shape, photo_a: Photo, b: Shape, photo_b: Photo) -> float | 
     if residual > ONE_ROOF_PX:
         return None
     # ... and nothing inside the outline may stand higher: tiers of one colour show from
-    # above only as edges inside the lowest tier's outline.
-    top = inner_top_m(a, photo_a, b, photo_b)
-    return roof if top is None or top <= roof + NOT_FLAT_M else None
+    # above only as walls inside the lowest tier's outline.
+    flat = not (not_flat(a, photo_a, roof, photo_b) or not_flat(b, photo_b, roof, photo_a))
+    return roof if flat else None
 
 
-def inner_top_m(a: Shape, photo_a: Photo, b: Shape, photo_b: Photo) -> float | None:
-    """How high the edges inside one roof's outlines (``a`` in ``photo_a``, ``b`` in
-    ``photo_b``) stand, from their parallax between the two photos: the higher of the two
-    plane sweeps (each photo's inner edges against the other; a wall between tiers often
-    shows in only one of them). None when neither outline holds edges the photos agree on."""
-    ceiling_m = min(photo_a.pose.pos_enu_m[2], photo_b.pose.pos_enu_m[2]) - 1.0
-    tops = [
-        highest_inner_edge_m(
-            p.image_rgb,
-            p.pose,
-            roof_inside(p.image_rgb, s, inset_px=INSET_PX),
-            o.image_rgb,
-            o.pose,
-            p.intrinsics,
-            lo_m=0.0,
-            hi_m=ceiling_m,
-        )
-        for s, p, o in ((a, photo_a, photo_b), (b, photo_b, photo_a))
-    ]
-    return max((t for t in tops if t is not None), default=None)
+def not_flat(shape: Shape, photo: Photo, roof_m: float, other: Photo | None = None) -> bool:
+    """Whether the walls seen inside ``shape``'s outline (a nadir ``photo``) show a part of
+    the building standing at least ``NOT_FLAT_M`` above the roof the outline is at. A wall
+    whose place on the roof ``other`` (another nadir photo) shows as ground is a courtyard's
+    far wall, going down, not a higher part's."""
+    walls = inner_walls(photo.image_rgb, shape)
+    if other is not None and walls:
+        ground = ground_mask(other.image_rgb)
+        walls = [w for w in walls if not _shows_ground(w, photo, other, roof_m, ground)]
+    top = higher_part_m(walls, photo.pose, photo.intrinsics, roof_m=roof_m)
+    return top is not None and top > roof_m + NOT_FLAT_M
 
 
-INSET_PX = 3
-"""How far inside a roof's outline (and from the ground showing through it) an edge must lie
-to be the roof's inside: its outline's own edge is a few pixels wide."""
+_GROUND_SHARE = 0.2
+"""The share of a wall's pixels that, carried to the other photo on the roof's plane, must
+fall on ground for the wall to be a courtyard's."""
+
+
+def _shows_ground(
+    wall_px: npt.NDArray[np.int32], photo: Photo, other: Photo, plane_m: float, ground: U8Array
+) -> bool:
+    k = photo.intrinsics
+    corners = [(0.0, 0.0), (k.width_px - 1.0, 0.0), (k.width_px - 1.0, k.height_px - 1.0)]
+    corners.append((0.0, k.height_px - 1.0))
+    try:
+        world = [
+            (*ground_point(u, v, photo.pose, k, plane_z_m=plane_m), plane_m) for u, v in corners
+        ]
+    except NavError:
+        return False
+    there = project(np.array(world), other.pose, other.intrinsics)
+    if not bool(np.all(there[:, 2] > 0.0)):
+        return False
+    h = cv2.getPerspectiveTransform(np.array(corners, np.float32), there[:, :2].astype(np.float32))
+    uv = cv2.perspectiveTransform(wall_px.reshape(-1, 1, 2).astype(np.float32), h)[:, 0, :]
+    u, v = np.round(uv[:, 0]).astype(np.int64), np.round(uv[:, 1]).astype(np.int64)
+    seen = (u >= 0) & (u < ground.shape[1]) & (v >= 0) & (v < ground.shape[0])
+    if not seen.any():
+        return False
+    return float((ground[v[seen], u[seen]] > 0).mean()) >= _GROUND_SHARE
+
 
 NOT_FLAT_M = 3.0
-"""How much higher than its outline's height a roof's inner edges may stand for the roof to
-count as flat: half of ``mission.min_above_roof_m``'s default, so a step the sweep missed
-still leaves half the clearance over the outline's height. A stepped tower's tiers are
-5-25 m apart; the sweep's error on the overviews is a few metres."""
+"""How much higher than its outline's height a part of a roof may stand for the roof to
+count as flat: half of ``mission.min_above_roof_m``'s default, so a step below it still
+leaves half the clearance over the outline's height."""
 
 
 ONE_ROOF_PX = 1.0

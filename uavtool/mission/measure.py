@@ -28,6 +28,7 @@ from uavtool.mission.survey import (
     Obstacle,
     Survey,
     anywhere,
+    below_camera_m,
     footprint_at,
     points_of_interest,
     same_colour,
@@ -100,7 +101,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
             ]
     assumed_m = m.params.mission.assumed_roof_m
     obstacles = tuple(
-        Obstacle(o, assumed_m, False, anywhere(o, seen.photo, assumed_m))
+        Obstacle(o, assumed_m, False, anywhere(o, seen.photo, below_camera_m(m, seen.photo)))
         if h is None
         else Obstacle(o, h, True, footprint_at(o, seen.photo, h))
         for o, h in zip(others, others_m, strict=True)

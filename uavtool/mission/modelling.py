@@ -68,8 +68,9 @@ def photograph_and_model(
         plane_z_m=min(found.roof_m, _below(found.photo)),
     )
     rect = min_area_rect(footprint)
-    others = obstacles_around(m, seen, found.poi.shape_index)
-    front, right = plan_viewpoints(rect, others, k, vp_params)
+    around = obstacles_around(m, seen, found.poi.shape_index)
+    others = [f for f, _ in around]
+    front, right = plan_viewpoints(rect, others, k, vp_params, [h for _, h in around])
     front_heading = (
         front.heading_deg if isinstance(front, Viewpoint) else (rect.long_axis_deg + 90.0) % 360.0
     )
@@ -104,20 +105,29 @@ def photograph_and_model(
         m.no_model = f"the top photo never showed the whole building ({p.max_looks} tries)"
         return
     # The top photo, low over the target, measures the neighbours the overview could not.
-    obstacles = remeasured_obstacles(m, seen, found.poi.shape_index, top_photo, top_shapes)
+    remeasured = remeasured_obstacles(m, seen, found.poi.shape_index, top_photo, top_shapes)
+    obstacles = [f for f, _ in remeasured]
+    heights = [h for _, h in remeasured]
     # The top photo is centred on the building: plan the side photos from its footprint.
     footprint = ground_polygon(
         obj.polygon_px, top_photo.pose, top_photo.intrinsics, plane_z_m=found.roof_m
     )
     rect = min_area_rect(footprint)
-    front, right = plan_viewpoints(rect, obstacles, top_photo.intrinsics, vp_params)
+    front, right = plan_viewpoints(rect, obstacles, top_photo.intrinsics, vp_params, heights)
     m.viewpoints = Viewpoints(footprint, top, front, right)
     m.emit(m.viewpoints)
 
     # Backing away must keep clear of the survey's cautious footprints too: a neighbour
     # measured again may have been paired with the wrong roof.
     sides = SidePlan(
-        rect, obstacles, obstacles + others, beyond_the_frame(seen), k, vp_params, transit_m
+        rect,
+        obstacles,
+        obstacles + others,
+        beyond_the_frame(seen),
+        k,
+        vp_params,
+        transit_m,
+        heights=heights,
     )
     views: dict[str, View] = {}
     taken: dict[str, Viewpoint] = {}

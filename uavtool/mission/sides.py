@@ -32,6 +32,7 @@ from uavtool.mission.outputs import Level
 from uavtool.mission.search import photo_shapes
 from uavtool.nav import Rect, Viewpoint, ViewpointFailure, ViewpointParams, plan_towards
 from uavtool.nav.geometry import point_polygon_distance
+from uavtool.nav.viewpoints import foot_hidden
 from uavtool.vision import Shape
 from uavtool.vision.model3d import View, same_colour
 
@@ -67,6 +68,16 @@ class SidePlan:
     transit_m: float
     grown: bool = False
     """A photo showed the building taller than the viewpoints were first planned for."""
+    heights: list[float] = dataclasses.field(default_factory=list)
+    """Each of ``obstacles``' roof heights (``math.inf`` where not measured): a camera
+    looking down may see the building's top over a lower one. Empty: as tall as any."""
+
+    def sight(self) -> tuple[list[Ring], list[float] | None]:
+        """The footprints a camera must see past, with their heights (None: unknown)."""
+        footprints = self.obstacles + self.unknown
+        if not self.heights:
+            return footprints, None
+        return footprints, self.heights + [math.inf] * len(self.unknown)
 
     def taller(self, m: SearchMission, height_m: float) -> None:
         """Plan from now on for a building ``height_m`` tall."""
@@ -105,14 +116,9 @@ def _towards(
 ) -> Viewpoint | ViewpointFailure:
     cx, cy = plan.rect.center_en
     direction = (vp.pos_enu_m[0] - cx, vp.pos_enu_m[1] - cy)
+    footprints, heights = plan.sight()
     return plan_towards(
-        vp.name,
-        plan.rect,
-        direction,
-        plan.obstacles + plan.unknown,
-        plan.intrinsics,
-        params,
-        vp.fallback,
+        vp.name, plan.rect, direction, footprints, plan.intrinsics, params, vp.fallback, heights
     )
 
 
@@ -152,6 +158,8 @@ def side_view(
         taller = _taller_view(m, plan, vp, photo.pose) if edges == {"top"} else None
         moved = taller if taller is not None else _backed_away(m, plan, vp, step_m)
         if moved is None:
+            moved = _looking_down_instead(m, plan, vp)
+        if moved is None:
             break
         vp = moved
         x, y, z = vp.pos_enu_m
@@ -161,7 +169,15 @@ def side_view(
         )
         yield from m.travel((x, y, z), vp.heading_deg, plan.transit_m, f"{vp.name} viewpoint")
     yield from m.move((x, y, plan.transit_m), vp.heading_deg, f"climb from the {vp.name} viewpoint")
-    return View(silhouette, photo.pose, photo.intrinsics), vp
+    footprints, heights = plan.sight()
+    hidden = (
+        vp.pitch_deg < 0.0
+        and heights is not None
+        and foot_hidden(photo.pose.pos_enu_m, plan.rect.corners(), footprints, heights)
+    )
+    if hidden:
+        m.event(Level.INFO, f"{vp.name} photo: the building's foot is hidden behind its neighbours")
+    return View(silhouette, photo.pose, photo.intrinsics, foot_hidden=hidden), vp
 
 
 def _in_line(shapes: tuple[Shape, ...], rect: Rect, photo: Photo) -> tuple[Shape, ...]:
@@ -201,6 +217,29 @@ def _taller_view(
         Level.INFO,
         f"{vp.name} photo: the building's top is cut: it is over {at_least_m:.1f} m tall; "
         f"again from {found.distance_m:.1f} m at {found.pos_enu_m[2]:.1f} m up",
+    )
+    return found
+
+
+def _looking_down_instead(m: SearchMission, plan: SidePlan, vp: Viewpoint) -> Viewpoint | None:
+    """With no room to back away from a level view that cuts the building: from the same
+    direction, a camera further off (found with the planner's rules) or one that rises and
+    looks down; None when neither fits, or the view already looked down."""
+    if vp.pitch_deg < 0.0:
+        return None
+    found = _towards(plan, vp, plan.params)
+    if not isinstance(found, Viewpoint) or not (
+        found.pitch_deg < 0.0 or found.distance_m > vp.distance_m
+    ):
+        return None
+    m.event(
+        Level.INFO,
+        f"{vp.name} photo: planned again from {found.distance_m:.1f} m"
+        + (
+            f", looking down {-found.pitch_deg:.0f}° from {found.pos_enu_m[2]:.1f} m"
+            if found.pitch_deg < 0.0
+            else ""
+        ),
     )
     return found
 

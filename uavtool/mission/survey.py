@@ -78,7 +78,7 @@ def survey(m: SearchMission) -> Wait[Survey]:
     measured = [h is not None for h in found]
     roofs = [p.assumed_roof_m if h is None else h for h in found]
     footprints = tuple(
-        footprint_at(s, high, h) if h is not None else anywhere(s, high, p.assumed_roof_m)
+        footprint_at(s, high, h) if h is not None else anywhere(s, high, below_camera_m(m, high))
         for s, h in zip(shapes, found, strict=True)
     )
     pois = points_of_interest(m, shapes, high, roofs, measured, footprints)
@@ -217,13 +217,16 @@ def building_top_m(seen: Survey, parts: frozenset[int]) -> float:
 
 def obstacles_around(
     m: SearchMission, seen: Survey, target: int
-) -> list[tuple[tuple[float, float], ...]]:
+) -> list[tuple[tuple[tuple[float, float], ...], float]]:
     """The survey's footprints of every building but the target (and its other roofs), and
-    of everything else that is not ground."""
+    of everything else that is not ground, each with its roof's height (``math.inf`` where
+    not measured)."""
     own = same_building(m, seen, target)
-    return [f for i, f in enumerate(seen.footprints) if i not in own] + [
-        o.footprint for o in seen.obstacles
-    ]
+    return [
+        (f, seen.roofs_m[i] if seen.measured[i] else math.inf)
+        for i, f in enumerate(seen.footprints)
+        if i not in own
+    ] + [(o.footprint, o.roof_m if o.measured else math.inf) for o in seen.obstacles]
 
 
 def beyond_the_frame(seen: Survey) -> list[tuple[tuple[float, float], ...]]:
@@ -255,22 +258,23 @@ def beyond_the_frame(seen: Survey) -> list[tuple[tuple[float, float], ...]]:
 
 def remeasured_obstacles(
     m: SearchMission, seen: Survey, target: int, photo: Photo, shapes: tuple[Shape, ...]
-) -> list[tuple[tuple[float, float], ...]]:
-    """The footprints of every building but ``target`` (and its other roofs), those of
-    unknown height measured again against a later nadir ``photo`` (its ``shapes``) where it
-    shows them whole."""
+) -> list[tuple[tuple[tuple[float, float], ...], float]]:
+    """The footprints of every building but ``target`` (and its other roofs), each with its
+    roof's height (``math.inf`` where not measured), those of unknown height measured again
+    against a later nadir ``photo`` (its ``shapes``) where it shows them whole."""
     p = m.params.mission
     own = same_building(m, seen, target)
-    out = [o.footprint for o in seen.obstacles]
+    out = [(o.footprint, o.roof_m if o.measured else math.inf) for o in seen.obstacles]
     for i, shape in enumerate(seen.shapes):
         if i in own:
             continue
         footprint = seen.footprints[i]
+        height = seen.roofs_m[i] if seen.measured[i] else math.inf
         if not seen.measured[i] and not shape.cut_by_border:
             roof = _measure_against(m, shape, seen.photo, photo, shapes)
             if roof is not None and roof <= p.assumed_roof_m + p.min_above_roof_m:
-                footprint = footprint_at(shape, seen.photo, roof)
-        out.append(footprint)
+                footprint, height = footprint_at(shape, seen.photo, roof), roof
+        out.append((footprint, height))
     return out
 
 
@@ -290,6 +294,14 @@ def _measure_against(
         if miss <= m.params.viewpoints.max_distance_m and (best is None or miss < best[0]):
             best = (miss, cand)
     return None if best is None else roof_between(shape, photo, best[1], other)
+
+
+def below_camera_m(m: SearchMission, photo: Photo) -> float:
+    """The tallest a roof seen in a nadir ``photo`` may be, when nothing measured it: a roof
+    is below the camera (by the least clearance a look keeps over a roof); ``assumed_roof_m``
+    is a guess, and a tower may stand taller (a roof's outline seen from above lies nearer
+    the camera's nadir the taller it is)."""
+    return photo.pose.pos_enu_m[2] - m.params.mission.min_above_roof_m
 
 
 def anywhere(shape: Shape, photo: Photo, tallest_m: float) -> tuple[tuple[float, float], ...]:

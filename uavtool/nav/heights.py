@@ -20,7 +20,10 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from uavtool.camera import CameraPose, Intrinsics
+import numpy as np
+import numpy.typing as npt
+
+from uavtool.camera import CameraPose, Intrinsics, project
 from uavtool.nav.geometry import point_segment_distance
 
 SIZE_ERROR = 0.01
@@ -272,3 +275,47 @@ def _reprojected(
             )
         )
     return out
+
+
+def higher_part_m(
+    walls_px: Sequence[npt.NDArray[np.int32]],
+    pose: CameraPose,
+    intrinsics: Intrinsics,
+    *,
+    roof_m: float,
+) -> float | None:
+    """How high, at least, the part of a building stands whose walls a nadir photo shows
+    inside the roof at ``roof_m`` (``walls_px``: each wall's pixels). A wall's foot and top
+    lie on one ray from the photo's nadir point, the top further out: at radii ``ρ_foot``
+    and ``ρ_top`` with ``ρ_foot / ρ_top = (A - top) / (A - foot)`` for a camera ``A`` up.
+    With its foot on the roof (a higher part may stand on a part higher still, so this is a
+    least height), ``top = roof + (A - roof) (1 - ρ_foot / ρ_top)``; the strip's radial
+    width is taken a pixel narrower than seen, for its pixels' edges. None without walls, or
+    for a photo not taken straight down."""
+    if not walls_px or abs(pose.pitch_deg + 90.0) > _NADIR_DEG:
+        return None
+    cam_x, cam_y, cam_z = pose.pos_enu_m
+    u0, v0, _ = project(np.array([[cam_x, cam_y, cam_z - 1.0]]), pose, intrinsics)[0]
+    above_m = cam_z - roof_m
+    if not above_m > 0.0:
+        return None
+    tops: list[float] = []
+    for wall in walls_px:
+        du = wall[:, 0].astype(np.float64) - u0
+        dv = wall[:, 1].astype(np.float64) - v0
+        rho = np.hypot(du, dv)
+        if float(rho.max()) < 2.0:
+            continue  # straight under the camera: no perspective to go by
+        step = 1.0 / max(float(rho.mean()), 1.0)  # about a pixel of arc
+        bins = np.floor(np.arctan2(dv, du) / step).astype(np.int64)
+        heights = []
+        for b in np.unique(bins):
+            r = rho[bins == b]
+            width = float(r.max() - r.min())  # a pixel narrower than its pixels span
+            heights.append(roof_m + above_m * width / (float(r.max()) + 0.5))
+        tops.append(float(np.median(heights)))
+    return max(tops, default=None)
+
+
+_NADIR_DEG = 10.0
+"""How far from straight down a photo may look for :func:`higher_part_m`."""

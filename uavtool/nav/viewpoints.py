@@ -24,7 +24,13 @@ from typing import Any
 
 from uavtool.camera import Intrinsics
 from uavtool.nav.errors import NavParamError
-from uavtool.nav.geometry import Point, as_points, point_polygon_distance, triangle_hits_polygon
+from uavtool.nav.geometry import (
+    Point,
+    as_points,
+    point_in_polygon,
+    point_polygon_distance,
+    triangle_hits_polygon,
+)
 from uavtool.nav.rect import Rect
 
 _OPPOSITE = {"long-a": "long-b", "long-b": "long-a", "short-a": "short-b", "short-b": "short-a"}
@@ -179,6 +185,7 @@ def _plan_one(
     obstacles: list[list[Point]],
     intrinsics: Intrinsics,
     params: ViewpointParams,
+    heights: Sequence[float] | None = None,
 ) -> Viewpoint | ViewpointFailure:
     """Try the first side, then the opposite one, at growing distances; first clear wins."""
     side_len = rect.length_m if first_side.startswith("long") else rect.width_m
@@ -236,7 +243,17 @@ def _plan_one(
             mid = ((end1[0] + end2[0]) / 2.0, (end1[1] + end2[1]) / 2.0)
             ends = (end1, end2)
             found = _looking_down(
-                name, side, mid, ends, normal, depth, side_len, obstacles, intrinsics, params
+                name,
+                side,
+                mid,
+                ends,
+                normal,
+                depth,
+                side_len,
+                obstacles,
+                intrinsics,
+                params,
+                heights,
             )
             if isinstance(found, Viewpoint):
                 return found
@@ -257,12 +274,15 @@ def _looking_down(
     obstacles: list[list[Point]],
     intrinsics: Intrinsics,
     params: ViewpointParams,
+    heights: Sequence[float] | None = None,
 ) -> Viewpoint | str:
     """A camera out along ``normal`` from ``mid`` (the middle of the near wall) that rises
     and looks down (:func:`tilted_camera`), at the first distance from the horizontal need
     (``across_m`` wide) or the safety margin, growing, where it keeps the margin and sees
-    the points ``seen`` (the wall's ends, or every corner) past the obstacles (as tall as
-    any: a level camera's rule); else what stopped it."""
+    the points ``seen`` (the wall's ends, or every corner) past the obstacles; else what
+    stopped it. Without ``heights`` the obstacles are as tall as any (a level camera's
+    rule); with them (``math.inf``: unknown), the camera may see the building's top over a
+    lower obstacle, its lower part hidden (:func:`foot_hidden` says so)."""
     tan_h = (intrinsics.width_px / 2.0) / intrinsics.fx_px
     distance = max((1.0 + params.margin) * (across_m / 2.0) / tan_h, params.safety_margin_m)
     why = "too close to look down at steeply enough"
@@ -277,12 +297,21 @@ def _looking_down(
             near = any(
                 point_polygon_distance(cam, poly) < params.safety_margin_m for poly in obstacles
             )
-            hidden = any(
-                triangle_hits_polygon((cam, a, b), poly)
-                for poly in obstacles
-                for i, a in enumerate(seen)
-                for b in seen[i + 1 :]
-            )
+            if heights is None:
+                hidden = any(
+                    triangle_hits_polygon((cam, a, b), poly)
+                    for poly in obstacles
+                    for i, a in enumerate(seen)
+                    for b in seen[i + 1 :]
+                )
+            else:
+                top = params.assumed_height_m
+                eye = (cam[0], cam[1], found[0])
+                hidden = any(
+                    _sight_blocked(eye, (q[0], q[1], top), poly, h)
+                    for poly, h in zip(obstacles, heights, strict=True)
+                    for q in seen
+                )
             if not near and not hidden:
                 z, pitch = found
                 return Viewpoint(
@@ -296,6 +325,51 @@ def _looking_down(
                 )
             why = "no line of sight" if hidden else "no room"
     return f"{side} looking down: {why}"
+
+
+def _sight_blocked(
+    eye: tuple[float, float, float],
+    point: tuple[float, float, float],
+    footprint: Sequence[Point],
+    height_m: float,
+) -> bool:
+    """Whether the straight line from ``eye`` to ``point`` passes through a building of
+    ``footprint`` standing ``height_m`` tall (``math.inf``: of unknown height)."""
+    (ex, ey, ez), (px, py, pz) = eye, point
+    if point_in_polygon((px, py), footprint):
+        return False  # the point stands in it (a building touching the target)
+    dx, dy = px - ex, py - ey
+    ts = [0.0] if point_in_polygon((ex, ey), footprint) else []
+    n = len(footprint)
+    for i in range(n):
+        (ax, ay), (bx, by) = footprint[i], footprint[(i + 1) % n]
+        ux, uy = bx - ax, by - ay
+        den = dx * uy - dy * ux
+        if den == 0.0:
+            continue  # parallel: the line meets the building at another edge too
+        t = ((ax - ex) * uy - (ay - ey) * ux) / den
+        u = ((ax - ex) * dy - (ay - ey) * dx) / den
+        if 0.0 <= t <= 1.0 and 0.0 <= u <= 1.0:
+            ts.append(t)
+    # Inside the footprint the line is lowest where it leaves it (it descends to the point,
+    # or rises): at one of these crossings.
+    return any(ez + (pz - ez) * t < height_m for t in ts)
+
+
+def foot_hidden(
+    eye: tuple[float, float, float],
+    corners: Sequence[Point],
+    obstacles: Sequence[Sequence[Point]],
+    heights: Sequence[float],
+) -> bool:
+    """Whether a building stands between ``eye`` and the foot of any of ``corners`` (its
+    footprint's, on the ground): the photo then shows the building's top over it, not its
+    walls down to the ground."""
+    return any(
+        _sight_blocked(eye, (x, y, 0.0), poly, h)
+        for poly, h in zip(obstacles, heights, strict=True)
+        for x, y in corners
+    )
 
 
 def _oblique(
@@ -340,6 +414,7 @@ def _from_direction(
     obstacles: list[list[Point]],
     intrinsics: Intrinsics,
     params: ViewpointParams,
+    heights: Sequence[float] | None = None,
 ) -> Viewpoint | str:
     """A camera out from the rectangle's centre along the unit vector ``u``, looking back at
     it, at the first distance (growing as square-on ones do) where it keeps the safety
@@ -394,6 +469,7 @@ def _from_direction(
         obstacles,
         intrinsics,
         params,
+        heights,
     )
     if isinstance(down, Viewpoint):
         return dataclasses.replace(down, fallback=f"{label}, {down.fallback}")
@@ -405,6 +481,7 @@ def plan_viewpoints(
     obstacles: Sequence[Sequence[tuple[float, float]]] | Sequence[Any],
     intrinsics: Intrinsics,
     params: ViewpointParams | None = None,
+    heights: Sequence[float] | None = None,
 ) -> tuple[Viewpoint | ViewpointFailure, Viewpoint | ViewpointFailure]:
     """The front and right viewpoints of ``target``, clear of ``obstacles``.
 
@@ -412,18 +489,21 @@ def plan_viewpoints(
     Front faces ``long-a`` first, right the short side at heading front − 90°; each
     candidate must keep ``safety_margin_m`` from every obstacle and see its whole side
     past them (obstacles are treated as infinitely tall). Fallbacks: the opposite side,
-    then both sides at distances grown by ``distance_step`` up to ``max_distance_m``.
+    then both sides at distances grown by ``distance_step`` up to ``max_distance_m``, then
+    cameras turned round the building, last cameras that rise and look down at it. With
+    ``heights`` (each obstacle's, ``math.inf`` where unknown) a camera looking down may see
+    the building's top over lower obstacles.
     When the front has no position, the right photo is planned against the first-choice
     front heading.
     """
     params = params or ViewpointParams()
     polys = [as_points(p, what=f"obstacles[{i}]") for i, p in enumerate(obstacles)]
-    front = _plan_one("front", target, "long-a", polys, intrinsics, params)
+    front = _plan_one("front", target, "long-a", polys, intrinsics, params, heights)
     front_side = front.side if isinstance(front, Viewpoint) else "long-a"
     # long-a looks along θ − 90, so its right camera looks along θ − 180: it faces short-a
     # (outward normal θ); symmetrically long-b → short-b.
     right_side = "short-a" if front_side == "long-a" else "short-b"
-    right = _plan_one("right", target, right_side, polys, intrinsics, params)
+    right = _plan_one("right", target, right_side, polys, intrinsics, params, heights)
     return front, right
 
 
@@ -435,6 +515,7 @@ def plan_towards(
     intrinsics: Intrinsics,
     params: ViewpointParams,
     label: str,
+    heights: Sequence[float] | None = None,
 ) -> Viewpoint | ViewpointFailure:
     """A camera out from ``target``'s centre along ``direction_en`` (east, north; any
     length), looking back at it, at the first distance where it keeps the safety margin and
@@ -444,7 +525,7 @@ def plan_towards(
         return ViewpointFailure(name, f"{name}: no direction to look from")
     polys = [as_points(p, what=f"obstacles[{i}]") for i, p in enumerate(obstacles)]
     u = (direction_en[0] / n, direction_en[1] / n)
-    found = _from_direction(name, target, u, name, label, polys, intrinsics, params)
+    found = _from_direction(name, target, u, name, label, polys, intrinsics, params, heights)
     return found if isinstance(found, Viewpoint) else ViewpointFailure(name, f"{name}: {found}")
 
 

@@ -24,6 +24,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+import cv2
 import numpy as np
 import trimesh
 
@@ -46,6 +47,10 @@ class View:
     shapes: tuple[Shape, ...]
     pose: CameraPose
     intrinsics: Intrinsics
+    foot_hidden: bool = False
+    """The object's lower part is hidden behind something nearer (a camera looking down over
+    a lower building): below its silhouette the photo says nothing, so nothing there is
+    carved away (the top view's footprint still bounds it)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -194,14 +199,38 @@ def _normalised_rings(view: View) -> list[FloatArray]:
 
 
 def _cone(view: View) -> Any:
-    """The viewing cone of a silhouette, between the near and far depths, in world ENU."""
+    """The viewing cone of a silhouette, between the near and far depths, in world ENU; for
+    a view whose foot is hidden, of the silhouette and all below it in the image."""
     import manifold3d  # noqa: PLC0415
 
-    rings = [r * _NEAR_M for r in _normalised_rings(view)]
+    rings = [r * _NEAR_M for r in _normalised_rings(_down_to_the_edge(view))]
     section = manifold3d.CrossSection(rings, manifold3d.FillRule.EvenOdd)
     scale = _FAR_M / _NEAR_M
     cone = section.extrude(_FAR_M - _NEAR_M, scale_top=(scale, scale)).translate((0, 0, _NEAR_M))
     return cone.transform(_world_from_camera_3x4(view.pose))
+
+
+def _down_to_the_edge(view: View) -> View:
+    """``view`` itself, or (foot hidden) one whose silhouette also holds every pixel below
+    it in its column, down past the image's bottom edge: one outline, no holes."""
+    if not view.foot_hidden:
+        return view
+    k = view.intrinsics
+    mask = np.zeros((k.height_px, k.width_px), np.uint8)
+    for shape in view.shapes:
+        cv2.fillPoly(mask, [np.round(shape.polygon_px).astype(np.int32).reshape(-1, 1, 2)], 255)
+    column_has = mask.any(axis=0)
+    first = np.where(column_has, mask.argmax(axis=0), k.height_px)
+    below = np.arange(k.height_px)[:, None] >= first[None, :]
+    filled = np.where(below, 255, 0).astype(np.uint8)
+    contours, _ = cv2.findContours(filled, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
+    shapes = []
+    for contour in contours:
+        outline: FloatArray = contour[:, 0, :].astype(np.float64)
+        # past the bottom edge: the cone must reach below the lowest pixel's ray
+        outline[outline[:, 1] >= k.height_px - 1, 1] = 2.0 * k.height_px
+        shapes.append(Shape.from_rings(colour_rgb=(0, 0, 0), polygon_px=outline))
+    return View(tuple(shapes), view.pose, view.intrinsics)
 
 
 def _world_from_camera_3x4(pose: CameraPose) -> list[list[float]]:

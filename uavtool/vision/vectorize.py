@@ -146,10 +146,55 @@ def roof_inside(
     cv2.fillPoly(inside, [_ring(shape.polygon_px)], 255)
     for hole in shape.holes_px:
         cv2.fillPoly(inside, [_ring(hole)], 0)
-    ground = _near(frame, _mode_rgb(frame[::4, ::4]), tolerance_dn)  # every 16th pixel will do
-    inside = cv2.bitwise_and(inside, cv2.bitwise_not(ground))
+    inside = cv2.bitwise_and(inside, cv2.bitwise_not(ground_mask(frame, tolerance_dn=tolerance_dn)))
     side = 2 * inset_px + 1
     return cv2.erode(inside, np.ones((side, side), np.uint8))
+
+
+def ground_mask(frame_rgb: U8Array, *, tolerance_dn: int = 15) -> CvArray:
+    """255 where a pixel has the ground's colour (the frame's most common, to 8 levels)."""
+    frame = _check_frame(frame_rgb)
+    return _near(frame, _mode_rgb(frame[::4, ::4]), tolerance_dn)  # every 16th pixel will do
+
+
+def inner_walls(
+    frame_rgb: U8Array, shape: Shape, *, tolerance_dn: int = 15, least_px: int = 3
+) -> list[npt.NDArray[np.int32]]:
+    """The walls seen inside ``shape``'s roof: strips of another shade of its colour (the
+    same hue; grey for a grey roof) that touch neither the ground nor the outline. Seen from
+    above, a roof's own walls lie outside its outline, and a courtyard's go down to the
+    ground that shows between them: a wall inside the outline stands on this roof, under a
+    higher part of the building. Each strip is its ``(n, 2)`` pixels ``(u, v)``, at least
+    ``least_px`` of them."""
+    frame = _check_frame(frame_rgb)
+    inside = roof_inside(frame, shape, inset_px=1, tolerance_dn=tolerance_dn)
+    roof = np.array(shape.colour_rgb, np.int16)
+    other = (np.abs(frame.astype(np.int16) - roof).max(axis=2) > 2 * tolerance_dn).astype(np.uint8)
+    hsv = cv2.cvtColor(frame, cv2.COLOR_RGB2HSV)
+    roof_hsv = cv2.cvtColor(np.array([[shape.colour_rgb]], np.uint8), cv2.COLOR_RGB2HSV)[0, 0]
+    grey = int(roof_hsv[1]) < _GREY_SATURATION
+    if grey:
+        alike = hsv[:, :, 1] < _GREY_SATURATION
+    else:
+        d = np.abs(hsv[:, :, 0].astype(np.int16) - int(roof_hsv[0]))
+        alike = (np.minimum(d, 180 - d) <= _WALL_HUE_HALF_DEG) & (hsv[:, :, 1] >= _GREY_SATURATION)
+    strips = (inside > 0) & (other > 0) & alike
+    ground = ground_mask(frame, tolerance_dn=tolerance_dn)
+    near_ground = cv2.dilate(ground, np.ones((5, 5), np.uint8)) > 0
+    count, labels = cv2.connectedComponents(strips.astype(np.uint8), connectivity=8)
+    out: list[npt.NDArray[np.int32]] = []
+    for label in range(1, count):
+        vs, us = np.nonzero(labels == label)
+        if len(us) >= least_px and not near_ground[vs, us].any():
+            out.append(np.stack([us, vs], axis=1).astype(np.int32))
+    return out
+
+
+_GREY_SATURATION = 40
+"""OpenCV saturation (0-255) under which a colour counts as grey (its hue says nothing)."""
+_WALL_HUE_HALF_DEG = 8
+"""How far (OpenCV hue units, 2° each) a wall's hue may lie from its roof's: a wall is the
+roof's colour, shaded."""
 
 
 def _ring(points: FloatArray) -> CvArray:
