@@ -74,6 +74,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         (f"point of interest {k}", f"measure-{k}", seen.pois[k], -1) for k in order
     ]
     stops += [(f"obstacle {j}", f"measure-obstacle-{j}", None, j) for j in range(len(others))]
+    views = [] if seen.lower is None else [seen.lower]  # nadir photos that show the ground
     for what, tag, poi, j in stops:
         if poi is not None:
             if measured[poi.shape_index]:
@@ -85,6 +86,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
             x, y = ground_point(*others[j].centroid_px, seen.photo.pose, seen.photo.intrinsics)
         yield from m.move((x, y, ceiling_m), seen.photo.pose.heading_deg, f"over {what}, measuring")
         photo = yield from m.photo(tag, -90.0)
+        views.append(photo)
         shapes = photo_shapes(m, photo)
         for i, shape in enumerate(seen.shapes):
             if not measured[i]:
@@ -101,7 +103,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
             ]
     assumed_m = m.params.mission.assumed_roof_m
     obstacles = tuple(
-        Obstacle(o, assumed_m, False, anywhere(o, seen.photo, below_camera_m(m, seen.photo)))
+        Obstacle(o, assumed_m, False, anywhere(o, seen.photo, below_camera_m(m, seen.photo), views))
         if h is None
         else Obstacle(o, h, True, footprint_at(o, seen.photo, h))
         for o, h in zip(others, others_m, strict=True)
@@ -112,8 +114,13 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
             f"{len(obstacles)} obstacles of no building colour (grey, or a darker shade): roofs "
             + ", ".join(f"{o.roof_m:.1f} m" if o.measured else "unknown" for o in obstacles),
         )
+    tallest_m = below_camera_m(m, seen.photo)
     footprints = tuple(
-        footprint_at(s, seen.photo, roofs[i]) if measured[i] and not seen.measured[i] else fp
+        footprint_at(s, seen.photo, roofs[i])
+        if measured[i] and not seen.measured[i]
+        else fp
+        if measured[i]
+        else anywhere(s, seen.photo, tallest_m, views)  # the tour's photos rule out more
         for i, (s, fp) in enumerate(zip(seen.shapes, seen.footprints, strict=True))
     )
     pois = points_of_interest(m, seen.shapes, seen.photo, roofs, measured, footprints)

@@ -9,10 +9,14 @@ A building whose height could not be measured is assumed as tall as
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
-from uavtool.camera import Intrinsics
+import cv2
+import numpy as np
+
+from uavtool.camera import Intrinsics, project
 from uavtool.mission.analysis import cut_edges, roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
@@ -21,7 +25,7 @@ from uavtool.mission.search import photo_shapes
 from uavtool.nav import NavError, ground_point, ground_polygon, min_area_rect
 from uavtool.nav.geometry import convex_hull, point_polygon_distance
 from uavtool.vision import Shape
-from uavtool.vision.vectorize import hue_distance_deg
+from uavtool.vision.vectorize import ground_mask, hue_distance_deg
 
 if TYPE_CHECKING:
     from uavtool.mission.base import Wait
@@ -78,7 +82,9 @@ def survey(m: SearchMission) -> Wait[Survey]:
     measured = [h is not None for h in found]
     roofs = [p.assumed_roof_m if h is None else h for h in found]
     footprints = tuple(
-        footprint_at(s, high, h) if h is not None else anywhere(s, high, below_camera_m(m, high))
+        footprint_at(s, high, h)
+        if h is not None
+        else anywhere(s, high, below_camera_m(m, high), (low,))
         for s, h in zip(shapes, found, strict=True)
     )
     pois = points_of_interest(m, shapes, high, roofs, measured, footprints)
@@ -304,12 +310,57 @@ def below_camera_m(m: SearchMission, photo: Photo) -> float:
     return photo.pose.pos_enu_m[2] - m.params.mission.min_above_roof_m
 
 
-def anywhere(shape: Shape, photo: Photo, tallest_m: float) -> tuple[tuple[float, float], ...]:
+def anywhere(
+    shape: Shape, photo: Photo, tallest_m: float, others: Sequence[Photo] = ()
+) -> tuple[tuple[float, float], ...]:
     """Where a building of unknown height (up to ``tallest_m``) may stand: its roof's outline
-    projected on the ground and on the tallest roof plane, and everything between."""
-    ground = footprint_at(shape, photo, 0.0)
-    top = footprint_at(shape, photo, tallest_m)
-    return tuple(convex_hull([*ground, *top]))
+    projected on every roof plane it may be at, from the ground up, and everything between.
+    A height is ruled out where one of ``others`` (other nadir photos) sees, whole, the
+    ground that the building would stand on at that height."""
+    heights = [0.0]
+    step_m = _HEIGHT_STEP_M
+    while heights[-1] + step_m < tallest_m:
+        heights.append(heights[-1] + step_m)
+    heights.append(tallest_m)
+    feet = [footprint_at(shape, photo, h) for h in heights]
+    if others:
+        # Where a building stands, no camera above it sees the ground: neither on its base
+        # nor where its roof would show.
+        grounds = [(o, ground_mask(o.image_rgb)) for o in others]
+        kept = [
+            f
+            for f, h in zip(feet, heights, strict=True)
+            if not any(_ground_there(f, 0.0, o, g) or _ground_there(f, h, o, g) for o, g in grounds)
+        ]
+        feet = kept or feet  # every height ruled out: the photos disagree, keep them all
+    return tuple(convex_hull([p for f in feet for p in f]))
+
+
+_HEIGHT_STEP_M = 2.0
+"""The roof planes a building of unknown height is placed on, this far apart."""
+_GROUND_SEEN = 0.9
+"""The share of a footprint's pixels in the other photo that must be ground to rule it out."""
+
+
+def _ground_there(
+    footprint: tuple[tuple[float, float], ...], z_m: float, photo: Photo, ground: Any
+) -> bool:
+    """Whether ``photo`` sees ``footprint`` (at height ``z_m``) whole, and as ground."""
+    k = photo.intrinsics
+    if not z_m < photo.pose.pos_enu_m[2]:
+        return False
+    uvz = project(np.array([(x, y, z_m) for x, y in footprint]), photo.pose, k)
+    if not bool(np.all(uvz[:, 2] > 0.0)):
+        return False
+    us, vs = uvz[:, 0], uvz[:, 1]
+    if us.min() < 0.0 or vs.min() < 0.0 or us.max() > k.width_px - 1 or vs.max() > k.height_px - 1:
+        return False
+    inside = np.zeros(ground.shape, np.uint8)
+    cv2.fillPoly(inside, [np.round(uvz[:, :2]).astype(np.int32).reshape(-1, 1, 2)], 255)
+    area = cv2.countNonZero(inside)
+    if area == 0:
+        return False
+    return cv2.countNonZero(cv2.bitwise_and(inside, ground)) >= _GROUND_SEEN * area
 
 
 def _extent_m(footprint: tuple[tuple[float, float], ...]) -> float:
