@@ -11,17 +11,19 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from shapely.geometry import Point, Polygon  # type: ignore[import-untyped]
 
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.mission import Status
 from uavtool.mission.analysis import NOT_FLAT_M, nadir_shapes, not_flat, roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.params import Params
+from uavtool.mission.survey import anywhere
 from uavtool.nav.heights import higher_part_m
 from uavtool.runner.fly import FlyConfig, fly
 from uavtool.vision import Shape
 from uavtool.vision.vectorize import inner_walls
-from uavtool.world import Scene, load_scene, render, scene_from_dict
+from uavtool.world import Scene, load_scene, render, scene_from_dict, scene_to_dict
 
 DATA = Path(__file__).parent / "data"
 K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
@@ -148,3 +150,30 @@ def test_a_courtyard_whose_ground_is_hidden_is_still_one_flat_roof() -> None:
     ground where the wall seemed to stand."""
     summary = fly(FlyConfig(scene=str(DATA / "town-1035.yaml"), no_record=True))
     assert summary.evaluation.matched_building == "b05" == summary.evaluation.target_building
+
+
+def test_where_a_roof_of_unknown_height_may_stand() -> None:
+    """A 40 m tower 30 m east of home, its roof unmeasured: from 117 m over home its outline
+    could be a roof anywhere from the ground up to just below the camera, so its building
+    anywhere from 30 m out to nearly over home (a 25 m guess left out where it stands). A
+    photo over the tower, from the same altitude, sees the ground where the taller and the
+    lower roofs would stand: what remains holds the tower and no longer reaches home."""
+    tower = {
+        "name": "tower",
+        "color": [54, 160, 217],
+        "blocks": [_block(_square(30.0, 0.0, 4.0), 0.0, 40.0)],
+    }
+    data = scene_to_dict(_scene())
+    data["buildings"] = [tower]
+    data["target"] = "tower"
+    scene = scene_from_dict(data)
+    home = _photo(scene, 0.0, 0.0, 117.0, 0)
+    over = _photo(scene, 30.0, 0.0, 117.0, 1)
+    shape = _shape(home, (54, 160, 217))
+    wide = Polygon(anywhere(shape, home, 111.0))
+    narrow = Polygon(anywhere(shape, home, 111.0, (over,)))
+    true = Polygon(_square(30.0, 0.0, 4.0))
+    assert wide.distance(Point(0.0, 0.0)) < 3.0  # up to 111 m: nearly over home
+    assert Polygon(anywhere(shape, home, 25.0)).intersection(true).area < 0.5 * true.area
+    assert narrow.intersection(true).area > 0.9 * true.area  # the tower stays in
+    assert narrow.distance(Point(0.0, 0.0)) > 15.0  # but home is clear of it
