@@ -320,7 +320,12 @@ def _looking_down(
                     heading_deg=_heading(-normal[0], -normal[1]),
                     side=side,
                     distance_m=distance,
-                    fallback=f"{side} side, looking down {-pitch:.0f}° from {z:.1f} m",
+                    fallback=f"{side} side, "
+                    + (
+                        f"looking down {-pitch:.0f}° from {z:.1f} m"
+                        if pitch < 0.0
+                        else f"level from {z:.1f} m, {distance:.1f} m off"
+                    ),
                     pitch_deg=pitch,
                 )
             why = "no line of sight" if hidden else "no room"
