@@ -1,5 +1,6 @@
-"""Background fsync: failures surface as `RecordingError`, `close` waits for every sync, and
-threads sharing a writer lose or reorder nothing while chunks are synced behind them."""
+"""Background writes and fsync: failures surface as `RecordingError`, `close` waits for every
+write and sync, a writer waits once a few chunks wait for the thread, and threads sharing a
+writer lose or reorder nothing while chunks are written and synced behind them."""
 
 from __future__ import annotations
 
@@ -17,7 +18,8 @@ import pytest
 
 from tests.recording.sample import OBS_SCHEMA, T0_NS, write_sample
 from uavtool.recording import RecordingError, RecordingReader, RecordingWriter
-from uavtool.recording.encoder import MAGIC
+from uavtool.recording.encoder import MAGIC, Chunk, McapEncoder
+from uavtool.recording.syncer import BACKLOG
 
 
 def _eio(fd: int) -> None:
@@ -25,7 +27,7 @@ def _eio(fd: int) -> None:
 
 
 def _sync_threads() -> list[str]:
-    return [t.name for t in threading.enumerate() if t.name.startswith("fsync ")]
+    return [t.name for t in threading.enumerate() if t.name.startswith("recording ")]
 
 
 def _writer(path: Path, **kwargs: object) -> RecordingWriter:
@@ -206,7 +208,7 @@ def test_background_fsync_does_not_change_the_bytes(tmp_path: Path) -> None:
 @pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 def test_a_writer_dropped_without_close_ends_its_sync_thread(tmp_path: Path) -> None:
     def sync_threads() -> list[threading.Thread]:
-        return [t for t in threading.enumerate() if t.name == "fsync dropped.mcap"]
+        return [t for t in threading.enumerate() if t.name == "recording dropped.mcap"]
 
     writer = _writer(tmp_path / "dropped.mcap")
     _write(writer, 0)
@@ -218,3 +220,57 @@ def test_a_writer_dropped_without_close_ends_its_sync_thread(tmp_path: Path) -> 
     gc.collect()
     threads[0].join(timeout=5.0)
     assert not threads[0].is_alive()
+
+
+def test_a_failed_background_chunk_write_is_raised_by_later_writes_and_close(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def full(self: McapEncoder, chunk: object) -> None:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(McapEncoder, "write_chunk", full)
+    writer = _writer(tmp_path / "full.mcap")
+    problem = r"full\.mcap: cannot write: No space left on device"
+    _step, message = _first_failure(writer, 5000, 0.001)
+    assert re.search(problem, message)
+    with pytest.raises(RecordingError, match=problem):
+        writer.close()
+    assert _sync_threads() == []
+
+
+def test_a_writer_waits_once_backlog_chunks_wait_for_the_thread(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A writer that holds the GIL can starve the thread: past `BACKLOG` waiting chunks the
+    writer waits, so a crash never loses more than those."""
+    release = threading.Event()
+    real_write = McapEncoder.write_chunk
+
+    def stuck(self: McapEncoder, chunk: Chunk) -> None:
+        release.wait(10.0)
+        real_write(self, chunk)
+
+    monkeypatch.setattr(McapEncoder, "write_chunk", stuck)
+    writer = _writer(tmp_path / "slow.mcap")
+    steps = 2 * BACKLOG + 6  # every second write closes a chunk (10 ns of log time)
+    done: list[int] = []
+
+    def produce() -> None:
+        for step in range(steps):
+            _write(writer, step)
+            done.append(step)
+
+    producer = threading.Thread(target=produce)
+    producer.start()
+    try:
+        time.sleep(0.3)
+        # the first chunk being written, BACKLOG more waiting: the next close (step
+        # 2 * BACKLOG + 3) waits
+        assert len(done) == 2 * BACKLOG + 3
+    finally:
+        release.set()
+        producer.join()
+        writer.close()
+    with RecordingReader(tmp_path / "slow.mcap") as reader:
+        assert reader.health.whole
+        assert [json.loads(m.data)["step"] for m in reader.messages()] == list(range(steps))

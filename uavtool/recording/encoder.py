@@ -21,6 +21,7 @@ from __future__ import annotations
 import struct
 import zlib
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import BinaryIO
 
 import zstandard
@@ -53,6 +54,15 @@ def _map(pairs: Mapping[str, str]) -> bytes:
 
 def _record(opcode: int, body: bytes) -> bytes:
     return _REC.pack(opcode, len(body)) + body
+
+
+@dataclass(frozen=True, slots=True)
+class Chunk:
+    """A chunk ended by `McapEncoder.take_chunk`: its records, uncompressed, and its message
+    index (channel id -> [log time, offset in the chunk, log time, offset, ...])."""
+
+    records: bytearray
+    index: dict[int, list[int]]
 
 
 class McapEncoder:
@@ -135,20 +145,38 @@ class McapEncoder:
     def close_chunk(self) -> None:
         """Compress the open chunk, write it and its message indexes, flush the file. A chunk
         without messages stays open (its schema/channel records move on to the next one)."""
-        if not self._index:
+        chunk = self.take_chunk()
+        if chunk is not None:
+            self.write_chunk(chunk)
+        else:
             self._file.flush()
-            return
-        records = self._chunk
+
+    def take_chunk(self) -> Chunk | None:
+        """End the open chunk and start the next, without writing it: `write_chunk` does,
+        maybe on another thread, before anything written after it. None if it holds no
+        message (its schema/channel records then stay for the next one)."""
+        if not self._index:
+            return None
+        chunk = Chunk(self._chunk, self._index)
+        self._chunk = bytearray()
+        self._index = {}
+        return chunk
+
+    def write_chunk(self, chunk: Chunk) -> None:
+        """Compress a chunk `take_chunk` ended, write it and its message indexes, flush the
+        file. Chunks must be written in the order they were taken, and before any metadata
+        or the summary that follows them."""
+        records = chunk.records
         compressed = self._zstd.compress(records)
-        start_ns = min(min(ix[0::2]) for ix in self._index.values())
-        end_ns = max(max(ix[0::2]) for ix in self._index.values())
+        start_ns = min(min(ix[0::2]) for ix in chunk.index.values())
+        end_ns = max(max(ix[0::2]) for ix in chunk.index.values())
         length = _CHUNK_FIXED + len(compressed)
         head = _CHUNK_HEAD.pack(_CHUNK, length, start_ns, end_ns, len(records), zlib.crc32(records))
         parts = [head, _ZSTD, _U64.pack(len(compressed)), compressed]
         chunk_offset = self._pos
         index_pos = chunk_offset + _REC.size + length
         offsets = []
-        for channel_id, index in self._index.items():
+        for channel_id, index in chunk.index.items():
             n = len(index)
             parts.append(_MSG_INDEX_HEAD.pack(_MESSAGE_INDEX, 6 + 8 * n, channel_id, 8 * n))
             parts.append(struct.pack(f"<{n}Q", *index))
@@ -172,8 +200,6 @@ class McapEncoder:
         if self._start_ns is None or start_ns < self._start_ns:
             self._start_ns = start_ns
         self._end_ns = max(self._end_ns, end_ns)
-        self._chunk = bytearray()
-        self._index = {}
         self._write(b"".join(parts))
         self._file.flush()
 

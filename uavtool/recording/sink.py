@@ -1,9 +1,10 @@
 """`RecordingSink`: where a recording's bytes go, and how durably.
 
-It owns the file, the `McapEncoder` and the chunk policy: the open chunk is closed, written
-and flushed to the OS once it spans ``interval_ns`` of log time or holds ``budget_bytes``,
-so a SIGKILL loses at most that chunk. With ``fsync`` a `Syncer` then puts each closed
-chunk on disk in the background, against a power cut, without making the writer wait.
+It owns the file, the `McapEncoder` and the chunk policy: the open chunk is closed once it
+spans ``interval_ns`` of log time or holds ``budget_bytes``; a `Syncer` thread then
+compresses it, writes and flushes it to the OS at once, so a SIGKILL loses about that chunk
+at most, and with ``fsync`` puts it on disk, against a power cut, without making the writer
+wait. Metadata records after the start go through the same thread, in order.
 
 The first failed write or fsync breaks the sink for good: every later call raises
 `RecordingError` naming the file and the OS error, and so does `close` (which still
@@ -17,7 +18,6 @@ import os
 import weakref
 from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import NoReturn
 
 from uavtool.recording.encoder import McapEncoder
 from uavtool.recording.errors import RecordingError, create_file
@@ -47,7 +47,6 @@ class RecordingSink:
         self._error: OSError | None = None  # the failed write or fsync, once there is one
         self._problem = ""
         self._closed = False
-        self._syncer: Syncer | None = None
         self._file = create_file(path)
         try:
             self._encoder = McapEncoder(self._file, library=library)
@@ -58,11 +57,10 @@ class RecordingSink:
             with contextlib.suppress(OSError):  # the buffered bytes fail again
                 self._file.close()
             raise RecordingError(path, f"cannot write: {exc.strerror or exc}") from exc
-        if fsync:
-            self._syncer = Syncer(self._file.fileno(), path.name)
-            # A sink dropped without close() still ends its thread (the file is still open
-            # when this runs); close() runs it first, and it runs once.
-            self._stop_syncer = weakref.finalize(self, self._syncer.stop)
+        self._syncer = Syncer(self._file.fileno(), path.name, fsync=fsync)
+        # A sink dropped without close() still ends its thread (the file is still open when
+        # this runs); close() runs it first, and it runs once.
+        self._stop_syncer = weakref.finalize(self, self._syncer.stop)
 
     def check(self) -> None:
         """Raise `RecordingError` if a write or fsync has failed."""
@@ -79,19 +77,17 @@ class RecordingSink:
         return self._encoder.register_channel(topic, encoding, schema_id, metadata)
 
     def add_metadata(self, name: str, pairs: Mapping[str, str]) -> None:
+        """Write a metadata record after every chunk closed so far (on the thread)."""
         self.check()
-        try:
-            self._encoder.add_metadata(name, pairs)
-        except OSError as exc:
-            self._fail("cannot write", exc)
+        encoder, record = self._encoder, dict(pairs)
+        self._syncer.submit(lambda: encoder.add_metadata(name, record))
 
     def add(
         self, channel_id: int, sequence: int, log_time_ns: int, publish_time_ns: int, data: bytes
     ) -> None:
         """Add a message; close the chunk if it now spans the interval or fills the budget.
         `struct.error` (times or sequence out of range) leaves everything unchanged."""
-        syncer = self._syncer
-        if self._error is not None or (syncer is not None and syncer.failure is not None):
+        if self._error is not None or self._syncer.failure is not None:
             self.check()
         size = self._encoder.add_message(channel_id, sequence, log_time_ns, publish_time_ns, data)
         start_ns = self._chunk_start_ns
@@ -101,37 +97,37 @@ class RecordingSink:
             self.close_chunk()
 
     def close_chunk(self) -> None:
-        """Write the open chunk to the OS now and ask for an fsync (returns at once)."""
+        """Hand the open chunk to the thread, which writes it to the OS (and with fsync
+        syncs it) at once; returns at once."""
         self.check()
-        try:
-            self._encoder.close_chunk()
-        except OSError as exc:
-            self._fail("cannot write", exc)
+        chunk = self._encoder.take_chunk()
         self._chunk_start_ns = None
-        if self._syncer is not None:
-            self._syncer.request()
+        if chunk is not None:
+            write = self._encoder.write_chunk
+            self._syncer.submit(lambda: write(chunk))
 
     def wait_synced(self) -> None:
-        """Block until every chunk closed so far is on disk (no-op without fsync)."""
-        if self._syncer is not None:
-            self._syncer.wait()
+        """Block until every chunk closed so far is written and (with fsync) on disk."""
+        self._syncer.wait()
         self.check()
 
     def close(self) -> None:
-        """Write the summary, wait for every fsync, fsync the end and close the file.
-        Idempotent; raises `RecordingError` (after releasing the file) if anything failed."""
+        """Let the thread write what it holds, write the last chunk and the summary, fsync
+        the whole file and close it. Idempotent; raises `RecordingError` (after releasing
+        the file) if anything failed."""
         if self._closed:
             return
         self._closed = True
+        # every job run (not synced: the fsync below covers them): from here on this
+        # thread alone writes
+        self._stop_syncer.detach()
+        self._syncer.stop(sync=False)
         self._take_sync_failure()
         if self._error is None:
             try:
                 self._encoder.finish()
             except OSError as exc:
                 self._record("cannot write", exc)
-        if self._syncer is not None:
-            self._stop_syncer()
-            self._take_sync_failure()
         if self._fsync and self._error is None:
             try:
                 os.fsync(self._file.fileno())
@@ -146,13 +142,9 @@ class RecordingSink:
 
     def _take_sync_failure(self) -> None:
         syncer = self._syncer
-        if self._error is None and syncer is not None and syncer.failure is not None:
-            self._record("cannot sync to disk", syncer.failure)
+        if self._error is None and syncer.failure is not None:
+            self._record(syncer.problem, syncer.failure)
 
     def _record(self, what: str, exc: OSError) -> None:
         self._error = exc
         self._problem = f"{what}: {exc.strerror or exc}; the recording stopped there"
-
-    def _fail(self, what: str, exc: OSError) -> NoReturn:
-        self._record(what, exc)
-        raise RecordingError(self.path, self._problem) from exc

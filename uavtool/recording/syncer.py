@@ -1,52 +1,81 @@
-"""`Syncer`: fsyncs one open file on a background thread, so writers never wait for the disk.
+"""`Syncer`: writes a recording's closed chunks to its file on a background thread, and with
+``fsync`` puts them on disk, so writers never wait for compression or the disk.
 
-The caller writes (and flushes) its data to the OS itself, which is all a SIGKILL needs, then
-calls `request`; the thread fsyncs everything written so far, against a power cut. Requests
-that arrive while an fsync runs are served together by the next one, so a slow disk costs
-fewer fsyncs rather than a longer queue. The first failed fsync stops the thread and is kept
-in `failure` for the owner to report: after a failed fsync Linux may drop the dirty pages and
-report success next time, so retrying would hide lost data.
+The caller hands over jobs (compress and write a chunk, write a metadata record) in file
+order; the thread runs them in that order, each handing its bytes to the OS (all a SIGKILL
+needs), then, with ``fsync``, fsyncs everything written so far, against a power cut. Jobs
+that arrive while an fsync runs are written and synced together by the next one, so a slow
+disk costs fewer fsyncs rather than a longer queue. zstd and the file's writes release the
+GIL: a chunk is compressed while the flight goes on.
+
+The first failed job or fsync stops the thread and is kept in `failure` (with `problem`:
+what failed) for the owner to report; later jobs are not run. After a failed fsync Linux
+may drop the dirty pages and report success next time, so retrying would hide lost data.
 """
 
 from __future__ import annotations
 
 import os
 import threading
+from collections import deque
+from collections.abc import Callable
+
+WRITE_FAILED = "cannot write"
+SYNC_FAILED = "cannot sync to disk"
+BACKLOG = 8
+"""Jobs (chunks) that may wait for the thread before `Syncer.submit` waits too."""
 
 
 class Syncer:
-    """Background fsync of file descriptor ``fd``; ``name`` labels the thread."""
+    """Background writes (and with ``fsync`` fsyncs) of file descriptor ``fd``; ``name``
+    labels the thread."""
 
-    def __init__(self, fd: int, name: str) -> None:
+    def __init__(self, fd: int, name: str, *, fsync: bool = True) -> None:
         self._fd = fd
+        self._fsync = fsync
         self._cond = threading.Condition(threading.Lock())
-        self._requested = 0  # requests made so far
-        self._synced = 0  # requests covered by a finished fsync
+        self._jobs: deque[Callable[[], None]] = deque()
+        self._submitted = 0  # jobs handed over so far
+        self._done = 0  # jobs run (and with fsync, synced: see _served)
+        self._synced = 0  # jobs covered by a finished fsync
         self._stopping = False
+        self._final_sync = True  # whether stopping still syncs the last jobs
         self._ended = False  # the thread has returned (or died)
         self.failure: OSError | None = None  # set once, by the thread
-        self._thread = threading.Thread(target=self._run, name=f"fsync {name}", daemon=True)
+        self.problem = ""  # WRITE_FAILED or SYNC_FAILED, with `failure`
+        self._thread = threading.Thread(target=self._run, name=f"recording {name}", daemon=True)
         self._thread.start()
 
-    def request(self) -> None:
-        """Ask for an fsync of everything written so far; returns at once."""
+    def submit(self, job: Callable[[], None]) -> None:
+        """Run ``job`` after every job handed over before it. Returns at once unless
+        `BACKLOG` jobs already wait: then it first waits for the thread (which a writer
+        holding the GIL can starve), so a crash loses no more than those."""
         with self._cond:
-            self._requested += 1
+            while len(self._jobs) >= BACKLOG and self.failure is None and not self._ended:
+                self._cond.wait()
+            self._jobs.append(job)
+            self._submitted += 1
             self._cond.notify_all()
 
     def wait(self) -> None:
-        """Block until every request made before this call is on disk or an fsync failed."""
+        """Block until every job handed over before this call has run and (with fsync) is
+        on disk, or a job or an fsync failed."""
         with self._cond:
-            target = self._requested
-            while self._synced < target and self.failure is None and not self._ended:
+            target = self._submitted
+            while self._served() < target and self.failure is None and not self._ended:
                 self._cond.wait()
 
-    def stop(self) -> None:
-        """Serve the outstanding requests, then end the thread. Idempotent."""
+    def stop(self, *, sync: bool = True) -> None:
+        """Run the outstanding jobs and (with fsync, unless ``sync`` is false: the owner
+        fsyncs the file itself next) sync them, then end the thread. Idempotent."""
         with self._cond:
             self._stopping = True
+            self._final_sync = self._final_sync and sync
             self._cond.notify_all()
         self._thread.join()
+
+    def _served(self) -> int:
+        return self._synced if self._fsync else self._done
 
     def _run(self) -> None:
         try:
@@ -56,20 +85,40 @@ class Syncer:
                 self._ended = True
                 self._cond.notify_all()
 
+    def _fail(self, problem: str, exc: OSError) -> None:
+        with self._cond:
+            self.failure, self.problem = exc, problem
+            self._cond.notify_all()
+
     def _serve(self) -> None:
         while True:
             with self._cond:
-                while self._synced == self._requested and not self._stopping:
+                while not self._jobs and self._synced == self._done and not self._stopping:
                     self._cond.wait()
-                if self._synced == self._requested:  # stopping, nothing left
+                job = self._jobs.popleft() if self._jobs else None
+                if job is not None:
+                    self._cond.notify_all()  # a writer waiting for room in the backlog
+                if job is None and (
+                    self._synced == self._done or (self._stopping and not self._final_sync)
+                ):  # stopping, nothing left to do
                     return
-                target = self._requested
+            if job is not None:
+                try:
+                    job()
+                except OSError as exc:
+                    self._fail(WRITE_FAILED, exc)
+                    return
+                with self._cond:
+                    self._done += 1
+                    if not self._fsync:
+                        self._synced = self._done
+                    self._cond.notify_all()
+                continue
+            target = self._done  # every job written: one fsync covers them all
             try:
                 os.fsync(self._fd)
             except OSError as exc:
-                with self._cond:
-                    self.failure = exc
-                    self._cond.notify_all()
+                self._fail(SYNC_FAILED, exc)
                 return
             with self._cond:
                 self._synced = target

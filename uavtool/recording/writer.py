@@ -2,7 +2,7 @@
 
 What is recorded lives here: topics, schemas, channels, per-channel sequence numbers, the
 JSON view of MAVLink frames, one lock so several threads can share the writer. Where the
-bytes go and how durably (1 s chunks handed to the OS, background fsync, failures) is
+bytes go and how durably (1 s chunks written and fsynced by a background thread, failures) is
 `RecordingSink`'s job; the MCAP bytes themselves are `McapEncoder`'s.
 
 Determinism: the writer never reads a clock or a random source; every time comes from the
@@ -134,9 +134,10 @@ class RecordingWriter:
         self._sink.wait_synced()
 
     def close(self) -> None:
-        """Write the summary (indexes, statistics), wait for every fsync and close the file.
-        Idempotent. Raises `RecordingError` if any write or fsync failed: the file is then
-        not whole (`uavtool info --recover` rescues what it holds)."""
+        """Wait for the chunks still being written, write the last one and the summary
+        (indexes, statistics), fsync the file and close it. Idempotent. Raises
+        `RecordingError` if any write or fsync failed: the file is then not whole
+        (`uavtool info --recover` rescues what it holds)."""
         with self._lock:
             if not self._closed:
                 self._closed = True
