@@ -181,6 +181,19 @@ class RecordingWriter:
             data = dumps(payload)
         except (ValueError, TypeError) as exc:
             raise ValueError(f"topic {topic!r}: payload is not JSON: {exc}") from exc
+        self.write_json_bytes(topic, data, log_time_ns=log_time_ns, publish_time_ns=publish_time_ns)
+
+    def write_json_bytes(
+        self,
+        topic: str,
+        data: bytes,
+        *,
+        log_time_ns: int,
+        publish_time_ns: int | None = None,
+    ) -> None:
+        """Write a JSON object already encoded as `dumps` writes it (compact UTF-8, no NaN)
+        to a topic declared with `add_json_topic`: for a caller that makes the bytes faster
+        than a dict and `json` would. The bytes are not checked."""
         with self._lock:
             self._check_open()
             channel_id = self._json_topics.get(topic)

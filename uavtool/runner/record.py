@@ -16,7 +16,9 @@ boot is in the payloads (``time_boot_ms``).
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import math
 import time
 from collections.abc import Callable
 from typing import Any
@@ -135,6 +137,10 @@ class MissionRecorder:
         elif isinstance(obs, Telemetry):
             self._markers.telemetry(obs.pos_enu_m)
             write_vehicle(self.writer, obs.pos_enu_m, obs.heading_deg, self.home, t)
+        data = telemetry_json(step, obs) if isinstance(obs, Telemetry) else None
+        if data is not None:
+            self.writer.write_json_bytes(OBSERVATIONS, data, log_time_ns=t)
+            return
         payload = {"step": step, **encode_observation(obs)}
         self.writer.write_json(OBSERVATIONS, payload, log_time_ns=t)
 
@@ -185,6 +191,66 @@ class MissionRecorder:
 
     def outcome(self, record: dict[str, Any]) -> None:
         self.writer.add_metadata("outcome", {k: _text(v) for k, v in record.items()})
+
+
+_TELEMETRY_FIELDS = (
+    "time_boot_ms",
+    "pos_enu_m",
+    "vel_enu_m_s",
+    "heading_deg",
+    "mode",
+    "armed",
+    "landed",
+    "gimbal_pitch_deg",
+    "gimbal_yaw_deg",
+    "battery_pct",
+)
+_TELEMETRY = (
+    '{"step":%d,"type":"Telemetry","time_boot_ms":%d,"pos_enu_m":[%r,%r,%r],'
+    '"vel_enu_m_s":[%r,%r,%r],"heading_deg":%r,"mode":%s,"armed":%s,"landed":%s,'
+    '"gimbal_pitch_deg":%r,"gimbal_yaw_deg":%r,"battery_pct":%d}'
+)
+_BOOL = {True: "true", False: "false"}
+_encode_str: Callable[[str], str] = json.encoder.encode_basestring
+
+
+def telemetry_json(step: int, t: Telemetry) -> bytes | None:
+    """``dumps({"step": step, **encode_observation(t)})`` byte for byte in less than half the time
+    (a flight records thousands of samples), or None when a value is not of the plain type
+    the template writes (a numpy number, a NaN: the general path then decides) or
+    `Telemetry`'s fields are not the ones it knows."""
+    p, v = t.pos_enu_m, t.vel_enu_m_s
+    if _FIELDS_NOW != _TELEMETRY_FIELDS or len(p) != 3 or len(v) != 3:
+        return None
+    floats = (*p, *v, t.heading_deg, t.gimbal_pitch_deg, t.gimbal_yaw_deg)
+    if not (
+        type(step) is int
+        and type(t.time_boot_ms) is int
+        and type(t.battery_pct) is int
+        and type(t.mode) is str
+        and type(t.armed) is bool
+        and type(t.landed) is bool
+        and all(type(x) is float for x in floats)
+        and math.isfinite(sum(floats))
+    ):
+        return None
+    text = _TELEMETRY % (
+        step,
+        t.time_boot_ms,
+        *p,
+        *v,
+        t.heading_deg,
+        _encode_str(t.mode),
+        _BOOL[t.armed],
+        _BOOL[t.landed],
+        t.gimbal_pitch_deg,
+        t.gimbal_yaw_deg,
+        t.battery_pct,
+    )
+    return text.encode()
+
+
+_FIELDS_NOW = tuple(f.name for f in dataclasses.fields(Telemetry))
 
 
 def output_bytes(out: Output) -> bytes | None:
