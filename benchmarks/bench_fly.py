@@ -6,20 +6,24 @@ at the speed of the flight"), in one run, as ratios:
 - ``fly --no-record``, and the recording's share of ``fly`` over it, goal <= 10 %;
 - ``fly --no-record --rerun FILE.rrd`` (today at its default pace; the baseline needed
   ``--speedup max`` for that, and took the flight's vehicle time, ~229 s, without it);
-- ``replay --check recordings/golden/paper.mcap``, goal <= 0.5 s;
+- ``replay --check recordings/golden/paper.mcap``, goal <= 0.5 s (the baseline replays its
+  own commit's golden: the golden's format moved on since);
 - ``uavtool --version``: start-up;
 - and the flight alone, in this process: vehicle seconds per wall second.
 
 The baseline's ``uavtool`` package is extracted with ``git archive`` and run from the same
 virtualenv; the variants take turns in every round, so a machine whose speed drifts treats
-them alike.
+them alike. Every command runs once first, uncounted, with Python's bytecode cache on (in a
+folder of its own, whatever ``PYTHONDONTWRITEBYTECODE`` says): an installed package has its
+``.pyc`` files, and compiling uavtool's ~150 modules again costs every command ~0.2 s. The
+report names the machine (cores, load average before and after) and both commits.
 
     python benchmarks/bench_fly.py [--quick] [--runs N] [--baseline COMMIT]
 
 ``--quick``: one round (``--runs 1``). The baseline commit must be in the clone (``git fetch
 --unshallow`` in a shallow one). A command the baseline cannot run here is reported with its
-error and no ratio: 675267c's ``fly`` (recording) fails on Python 3.13 with numpy 2.5 (the
-schema bug fixed since), so compare on 3.11 or 3.12.
+error and no ratio: 675267c's ``fly`` (recording) fails with numpy 2.5 (the schema bug fixed
+since; Python 3.12 and 3.13 here), so compare on 3.11 (numpy 2.4).
 """
 
 from __future__ import annotations
@@ -40,13 +44,16 @@ from uavtool.runner.fly import FlyConfig, fly
 
 ROOT = Path(__file__).resolve().parents[1]
 BASELINE = "675267c"
+GOLDEN = "recordings/golden/paper.mcap"
 
 
 def extract(commit: str, into: Path) -> Path:
-    """The ``uavtool`` package as it was at ``commit``, under ``into`` (a plain copy, no
-    worktree: it goes with ``into``)."""
+    """The ``uavtool`` package and the paper golden as they were at ``commit``, under ``into``
+    (a plain copy, no worktree: it goes with ``into``)."""
     done = subprocess.run(
-        ["git", "-C", str(ROOT), "archive", commit, "uavtool"], check=False, capture_output=True
+        ["git", "-C", str(ROOT), "archive", commit, "uavtool", GOLDEN],
+        check=False,
+        capture_output=True,
     )
     if done.returncode != 0:
         why = done.stderr.decode(errors="replace").strip()
@@ -60,10 +67,14 @@ def extract(commit: str, into: Path) -> Path:
     return into
 
 
-def run(args: list[str], *, cwd: Path, pythonpath: Path | None = None) -> tuple[float, str | None]:
+def run(
+    args: list[str], *, cwd: Path, pycache: Path, pythonpath: Path | None = None
+) -> tuple[float, str | None]:
     """(wall seconds, None) of ``uavtool ARGS`` in a fresh process, or (nan, why) if it
-    failed: the last line it wrote to stderr."""
+    failed: the last line it wrote to stderr. Bytecode is cached under ``pycache``."""
     env = dict(os.environ)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    env["PYTHONPYCACHEPREFIX"] = str(pycache)
     if pythonpath is not None:
         env["PYTHONPATH"] = str(pythonpath)
     t0 = time.perf_counter()
@@ -89,6 +100,23 @@ def _goal(value: float, limit: float) -> str:
     return "met" if value <= limit else "NOT met"
 
 
+def _commit(rev: str) -> str:
+    """The short hash of ``rev``; for HEAD, '+ changes' when the work tree differs."""
+    git = ["git", "-C", str(ROOT)]
+    short = subprocess.run(
+        [*git, "rev-parse", "--short", rev], check=False, capture_output=True, text=True
+    )
+    name = short.stdout.strip() or rev
+    if rev == "HEAD":
+        dirty = subprocess.run([*git, "diff", "--quiet", "HEAD", "--", "uavtool"], check=False)
+        name += " + changes" if dirty.returncode else ""
+    return name
+
+
+def _load() -> str:
+    return ", ".join(f"{v:.2f}" for v in os.getloadavg())
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
@@ -100,7 +128,7 @@ def main() -> None:
         parser.set_defaults(runs=1)
     args = parser.parse_args()
     n = args.runs
-    golden = str(ROOT / "recordings" / "golden" / "paper.mcap")
+    golden = str(ROOT / GOLDEN)
     with tempfile.TemporaryDirectory() as tmp_text:
         tmp = Path(tmp_text)
         base = extract(args.baseline, tmp / "baseline")
@@ -112,29 +140,40 @@ def main() -> None:
                 ["fly", "-q", "--no-record", "--rerun", rrd],
                 ["fly", "-q", "--no-record", "--rerun", rrd, "--speedup", "max"],
             ),
-            "replay --check": (["replay", "--check", golden], ["replay", "--check", golden]),
+            "replay --check": (
+                ["replay", "--check", golden],
+                ["replay", "--check", str(base / GOLDEN)],
+            ),
             "--version": (["--version"], ["--version"]),
         }
         today: dict[str, list[float]] = {k: [] for k in commands}
         then: dict[str, list[float]] = {k: [] for k in commands}
         failed: dict[str, str] = {}  # the baseline's failures (e.g. on a newer Python)
-        for _ in range(n):
+        load_before = _load()
+        for i in range(n + 1):  # round 0 fills the bytecode caches: not counted
             for name, (now_args, base_args) in commands.items():
-                t, why = run(now_args, cwd=tmp)
+                t, why = run(now_args, cwd=tmp, pycache=tmp / "pyc-today")
                 if why is not None:
                     raise SystemExit(f"uavtool {' '.join(now_args)} failed: {why}")
-                today[name].append(t)
-                t, why = run(base_args, cwd=tmp, pythonpath=base)
-                then[name].append(t)
+                t_base, why = run(base_args, cwd=tmp, pycache=tmp / "pyc-base", pythonpath=base)
                 if why is not None:
                     failed[name] = why
+                if i:
+                    today[name].append(t)
+                    then[name].append(t_base)
+        load_after = _load()
         size = max(p.stat().st_size for p in (tmp / "recordings").glob("*.mcap"))
         flights = []
         for i in range(n):  # the flight alone, in this process: no start-up, recording on
             s = fly(FlyConfig(record=tmp / f"inproc{i}.mcap"))
             flights.append((s.vehicle_time_s / s.flight_wall_s, s.vehicle_time_s, s.flight_wall_s))
     med = statistics.median
+    python = ".".join(str(v) for v in sys.version_info[:3])
     print(f"uavtool (paper, defaults, {n} rounds, fresh processes, variants take turns)")
+    print(
+        f"  today {_commit('HEAD')}, baseline {_commit(args.baseline)}; Python {python}, "
+        f"{os.cpu_count()} cores, load average {load_before} before, {load_after} after"
+    )
     print(f"  {'':<22} {'today':>8} {args.baseline:>8} {'ratio':>7}   runs today | baseline")
     for name in commands:
         a, b = med(today[name]), med(then[name])
@@ -142,7 +181,6 @@ def main() -> None:
             f"  {name:<22} {a:7.2f}s {b:7.2f}s {a / b:6.3f}x   "
             f"{_runs(today[name])} | {_runs(then[name])}"
         )
-    python = ".".join(str(v) for v in sys.version_info[:3])
     for name, why in failed.items():  # no ratio for it (nan): say why
         print(f"  {args.baseline} failed '{name}' on Python {python}: {why}")
     fly_s, bare_s = med(today["fly"]), med(today["fly --no-record"])
