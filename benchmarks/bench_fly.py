@@ -31,6 +31,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -69,14 +70,17 @@ def extract(commit: str, into: Path) -> Path:
 
 def run(
     args: list[str], *, cwd: Path, pycache: Path, pythonpath: Path | None = None
-) -> tuple[float, str | None]:
-    """(wall seconds, None) of ``uavtool ARGS`` in a fresh process, or (nan, why) if it
-    failed: the last line it wrote to stderr. Bytecode is cached under ``pycache``."""
+) -> tuple[float, float, str | None]:
+    """(wall seconds, CPU seconds, None) of ``uavtool ARGS`` in a fresh process, or (nan,
+    nan, why) if it failed: the last line it wrote to stderr. CPU is user + system time of
+    the process and its threads, which other work on the machine changes much less than
+    the wall time. Bytecode is cached under ``pycache``."""
     env = dict(os.environ)
     env.pop("PYTHONDONTWRITEBYTECODE", None)
     env["PYTHONPYCACHEPREFIX"] = str(pycache)
     if pythonpath is not None:
         env["PYTHONPATH"] = str(pythonpath)
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     done = subprocess.run(
         [sys.executable, "-m", "uavtool", *args],
@@ -86,10 +90,13 @@ def run(
         cwd=cwd,
         env=env,
     )
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
     if done.returncode != 0:
         lines = (done.stderr or done.stdout).strip().splitlines() or [f"exit {done.returncode}"]
-        return math.nan, lines[-1]
-    return time.perf_counter() - t0, None
+        return math.nan, math.nan, lines[-1]
+    return wall, cpu, None
 
 
 def _runs(times: list[float]) -> str:
@@ -148,19 +155,25 @@ def main() -> None:
         }
         today: dict[str, list[float]] = {k: [] for k in commands}
         then: dict[str, list[float]] = {k: [] for k in commands}
+        today_cpu: dict[str, list[float]] = {k: [] for k in commands}
+        then_cpu: dict[str, list[float]] = {k: [] for k in commands}
         failed: dict[str, str] = {}  # the baseline's failures (e.g. on a newer Python)
         load_before = _load()
         for i in range(n + 1):  # round 0 fills the bytecode caches: not counted
             for name, (now_args, base_args) in commands.items():
-                t, why = run(now_args, cwd=tmp, pycache=tmp / "pyc-today")
+                t, cpu, why = run(now_args, cwd=tmp, pycache=tmp / "pyc-today")
                 if why is not None:
                     raise SystemExit(f"uavtool {' '.join(now_args)} failed: {why}")
-                t_base, why = run(base_args, cwd=tmp, pycache=tmp / "pyc-base", pythonpath=base)
+                t_base, cpu_base, why = run(
+                    base_args, cwd=tmp, pycache=tmp / "pyc-base", pythonpath=base
+                )
                 if why is not None:
                     failed[name] = why
                 if i:
                     today[name].append(t)
                     then[name].append(t_base)
+                    today_cpu[name].append(cpu)
+                    then_cpu[name].append(cpu_base)
         load_after = _load()
         size = max(p.stat().st_size for p in (tmp / "recordings").glob("*.mcap"))
         flights = []
@@ -174,13 +187,14 @@ def main() -> None:
         f"  today {_commit('HEAD')}, baseline {_commit(args.baseline)}; Python {python}, "
         f"{os.cpu_count()} cores, load average {load_before} before, {load_after} after"
     )
-    print(f"  {'':<22} {'today':>8} {args.baseline:>8} {'ratio':>7}   runs today | baseline")
-    for name in commands:
-        a, b = med(today[name]), med(then[name])
-        print(
-            f"  {name:<22} {a:7.2f}s {b:7.2f}s {a / b:6.3f}x   "
-            f"{_runs(today[name])} | {_runs(then[name])}"
-        )
+    for what, now_s, base_s in (("wall", today, then), ("CPU", today_cpu, then_cpu)):
+        print(f"  {what:<22} {'today':>8} {args.baseline:>8} {'ratio':>7}   runs today | baseline")
+        for name in commands:
+            a, b = med(now_s[name]), med(base_s[name])
+            print(
+                f"  {name:<22} {a:7.2f}s {b:7.2f}s {a / b:6.3f}x   "
+                f"{_runs(now_s[name])} | {_runs(base_s[name])}"
+            )
     for name, why in failed.items():  # no ratio for it (nan): say why
         print(f"  {args.baseline} failed '{name}' on Python {python}: {why}")
     fly_s, bare_s = med(today["fly"]), med(today["fly --no-record"])
@@ -192,6 +206,11 @@ def main() -> None:
         f"  recording's share of fly over --no-record: {share * 100:+.1f} % "
         f"(baseline {base_share * 100:+.1f} %); goal <= 10 %: {_goal(share, 0.10)}; "
         f"file {size / 1e6:.2f} MB"
+    )
+    cpu_share = med(today_cpu["fly"]) / med(today_cpu["fly --no-record"]) - 1.0
+    base_cpu_share = med(then_cpu["fly"]) / med(then_cpu["fly --no-record"]) - 1.0
+    print(
+        f"  the same in CPU time: {cpu_share * 100:+.1f} % (baseline {base_cpu_share * 100:+.1f} %)"
     )
     print(f"  goal replay --check <= 0.5 s: {_goal(check_s, 0.5)} ({check_s:.2f} s)")
     rate, vehicle_s, wall_s = sorted(flights)[n // 2]
