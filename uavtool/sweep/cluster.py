@@ -86,15 +86,20 @@ def open_client(
     if scheduler is not None:
         # The user's scheduler: its address and Dask's own configuration say how to reach it
         # (a tls:// one takes its credentials from distributed.comm.tls.*).
+        no_credentials = InputError(
+            f"--scheduler {scheduler}: cannot connect: a tls:// scheduler needs TLS "
+            "credentials in Dask's configuration (distributed.comm.tls.*)"
+        )
+        if scheduler.startswith("tls://") and not _tls_credentials():
+            # Checked first: a Client that fails in its constructor for want of them can
+            # hang when it is collected (distributed's LoopRunner lock).
+            raise no_credentials
         try:
             client = Client(scheduler, timeout="10s")
         except (OSError, TimeoutError, ValueError) as exc:
             raise InputError(f"--scheduler {scheduler}: cannot connect: {exc}") from None
-        except TypeError:  # distributed's word for a tls:// address without credentials
-            raise InputError(
-                f"--scheduler {scheduler}: cannot connect: a tls:// scheduler needs TLS "
-                "credentials in Dask's configuration (distributed.comm.tls.*)"
-            ) from None
+        except TypeError:  # distributed's word for incomplete TLS credentials
+            raise no_credentials from None
         with _closing(client):
             yield client
         return
@@ -121,6 +126,15 @@ def open_client(
         raise
     with _closing(client, cluster):
         yield client
+
+
+def _tls_credentials() -> bool:
+    """Whether Dask's configuration names a CA and a client certificate and key."""
+    from distributed.security import Security  # noqa: PLC0415 — heavy; sweeps only
+
+    security = Security()  # its fields are set from the configuration at run time
+    names = ("tls_ca_file", "tls_client_cert", "tls_client_key")
+    return all(getattr(security, name, None) for name in names)
 
 
 CLOSE_TIMEOUT_S = 10.0
