@@ -24,8 +24,11 @@ def test_floor_over_tiers_and_unknown_roofs() -> None:
     assert m.floor_at(0.5, 0.5) == 43.0 + margin  # over the lower tier, 1.5 m from the top
     assert m.floor_at(-5.0, -5.0) == 0.0  # 7 m from either: nothing to clear
     m.ceiling_m = 117.4
-    m.unknown = {3: ((20.0, 0.0), (26.0, 0.0), (26.0, 6.0), (20.0, 6.0))}
-    assert m.floor_at(18.0, 3.0) == 117.4  # within the margin of a roof of unknown height
+    where = ((20.0, 0.0), (26.0, 0.0), (26.0, 6.0), (20.0, 6.0))
+    m.unknown = {3: (where, 115.0)}  # nothing rules out a roof up to just below the ceiling
+    assert m.floor_at(18.0, 3.0) == 117.4  # within the margin of it: the ceiling, no higher
     assert m.floor_at(9.0, 3.0) == 20.0 + margin  # 3 m from the lower tier, 5 m from the top
-    m.learn_roof(3, m.unknown[3], 8.0)  # a closer look measured it
+    m.unknown = {3: (where, 30.0)}  # the ground seen around it rules out more than 30 m
+    assert m.floor_at(18.0, 3.0) == 30.0 + margin
+    m.learn_roof(3, where, 8.0)  # a closer look measured it
     assert m.floor_at(18.0, 3.0) == 8.0 + margin

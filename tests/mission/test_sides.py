@@ -6,9 +6,9 @@ import numpy as np
 
 from uavtool.camera import Intrinsics
 from uavtool.mission import Status
-from uavtool.mission.analysis import cut_edges
 from uavtool.runner.fly import FlyConfig, fly
 from uavtool.vision import Shape
+from uavtool.vision.shapes import cut_edges
 
 K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
 

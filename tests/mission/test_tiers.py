@@ -18,7 +18,7 @@ from uavtool.mission import Status
 from uavtool.mission.analysis import NOT_FLAT_M, nadir_shapes, not_flat, roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.params import Params
-from uavtool.mission.survey import anywhere
+from uavtool.mission.survey import anywhere, unknown_roof
 from uavtool.nav.heights import higher_part_m
 from uavtool.runner.fly import FlyConfig, fly
 from uavtool.vision import Shape
@@ -177,3 +177,25 @@ def test_where_a_roof_of_unknown_height_may_stand() -> None:
     assert Polygon(anywhere(shape, home, 25.0)).intersection(true).area < 0.5 * true.area
     assert narrow.intersection(true).area > 0.9 * true.area  # the tower stays in
     assert narrow.distance(Point(0.0, 0.0)) > 15.0  # but home is clear of it
+
+
+def test_the_highest_a_roof_of_unknown_height_may_be() -> None:
+    """The same tower, 40 m tall: with nothing but the photo over home, its roof may be up
+    to just below the camera; the photo over it sees the ground where the taller roofs'
+    buildings would stand, so what is left is bounded — above the true 40 m (a bound that
+    cuts a real roof would fly into it), and well below the camera."""
+    tower = {
+        "name": "tower",
+        "color": [54, 160, 217],
+        "blocks": [_block(_square(30.0, 0.0, 4.0), 0.0, 40.0)],
+    }
+    data = scene_to_dict(_scene())
+    data["buildings"] = [tower]
+    data["target"] = "tower"
+    scene = scene_from_dict(data)
+    home = _photo(scene, 0.0, 0.0, 117.0, 0)
+    over = _photo(scene, 30.0, 0.0, 117.0, 1)
+    shape = _shape(home, (54, 160, 217))
+    assert unknown_roof(shape, home, 111.0).upper_m == 111.0
+    upper = unknown_roof(shape, home, 111.0, (over,)).upper_m
+    assert 40.0 <= upper <= 60.0  # 56 m here: the 2 m planes up to 54 m are left

@@ -1,5 +1,6 @@
 from __future__ import annotations
 
+import dataclasses
 import functools
 
 import manifold3d
@@ -18,6 +19,7 @@ from uavtool.vision.model3d import (
     open_beneath,
     same_colour,
 )
+from uavtool.vision.shapes import cut_edges
 from uavtool.world import building_mesh, load_scene, render
 
 K = Intrinsics.from_hfov()
@@ -152,3 +154,24 @@ def test_a_diagonal_view_carves_what_the_square_on_views_cannot_see_through() ->
     assert _occupied(four.mesh, deck)
     assert four.mesh.is_watertight
     assert four.mesh.volume < three.mesh.volume
+
+
+def test_a_foot_below_the_frame_is_said_nothing_about() -> None:
+    """A front photo so close and low that the building's foot is below the frame: the
+    silhouette touches the bottom edge. As it is, the outline is incomplete and refused;
+    marked as a view whose foot the photo does not show, the model is built, standing on
+    the ground, as large as from a whole front photo. A cut at another edge still fails."""
+    close = dict(POSES, front=CameraPose((10.0, -22.0, 5.0), 0.0, 0.0))  # 10 m south, low
+    v = _views(close)
+    assert cut_edges(v["front"].shapes, K) == {"bottom"}
+    with pytest.raises(ModelInputError, match="touches the image border"):
+        build_model(v["top"], v["front"], v["right"])
+    front = dataclasses.replace(v["front"], foot_hidden=True)
+    model = build_model(v["top"], front, v["right"])
+    assert model.mesh.is_watertight
+    assert model.mesh.bounds[0, 2] == pytest.approx(0.0, abs=1e-6)
+    assert model.mesh.volume == pytest.approx(_paper_model().mesh.volume, rel=0.1)
+    beside = _views(dict(POSES, front=CameraPose((4.0, -22.0, 5.0), 0.0, 0.0)))["front"]
+    assert "left" in cut_edges(beside.shapes, K) or "right" in cut_edges(beside.shapes, K)
+    with pytest.raises(ModelInputError, match="touches the image border"):
+        build_model(v["top"], dataclasses.replace(beside, foot_hidden=True), v["right"])

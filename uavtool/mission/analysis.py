@@ -205,25 +205,3 @@ finer is carried to the other photo at the measured height. Outlines are simplif
 blend of heights lies further off. Measured: flat roofs 0.03-0.6 px; tiers 1.5 m apart
 0.9 px; tiers 5 m apart 1.2 px; a black 23 m block with its walls 10 px. Above the limit no
 height is given (the blend would be lower than the top)."""
-
-
-_EDGE_PX = 1.0  # an outline this close to the frame's edge touches it
-
-
-def cut_edges(silhouette: tuple[Shape, ...], k: Intrinsics) -> set[str]:
-    """Which edges of the frame (``top``, ``bottom``, ``left``, ``right``) the silhouette's
-    outlines touch."""
-    edges: set[str] = set()
-    for shape in silhouette:
-        if not shape.cut_by_border:
-            continue
-        us, vs = shape.polygon_px[:, 0], shape.polygon_px[:, 1]
-        for edge, touches in (
-            ("left", float(us.min()) <= _EDGE_PX),
-            ("right", float(us.max()) >= k.width_px - 1 - _EDGE_PX),
-            ("top", float(vs.min()) <= _EDGE_PX),
-            ("bottom", float(vs.max()) >= k.height_px - 1 - _EDGE_PX),
-        ):
-            if touches:
-                edges.add(edge)
-    return edges

@@ -27,11 +27,12 @@ from uavtool.mission.search import photo_shapes
 from uavtool.mission.survey import (
     Obstacle,
     Survey,
-    anywhere,
+    Unknown,
     below_camera_m,
     footprint_at,
     points_of_interest,
     same_colour,
+    unknown_place,
 )
 from uavtool.nav import NavError, ground_point
 from uavtool.nav.heights import roof_from_cut_outline
@@ -102,10 +103,11 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
                 for o, h in zip(others, others_m, strict=True)
             ]
     assumed_m = m.params.mission.assumed_roof_m
+    tallest_m = below_camera_m(m, seen.photo)
     obstacles = tuple(
-        Obstacle(o, assumed_m, False, anywhere(o, seen.photo, below_camera_m(m, seen.photo), views))
+        Obstacle(o, assumed_m, False, *unknown_place(o, seen.photo, tallest_m, views, seen.regions))
         if h is None
-        else Obstacle(o, h, True, footprint_at(o, seen.photo, h))
+        else Obstacle(o, h, True, footprint_at(o, seen.photo, h), h)
         for o, h in zip(others, others_m, strict=True)
     )
     if obstacles:
@@ -114,15 +116,15 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
             f"{len(obstacles)} obstacles of no building colour (grey, or a darker shade): roofs "
             + ", ".join(f"{o.roof_m:.1f} m" if o.measured else "unknown" for o in obstacles),
         )
-    tallest_m = below_camera_m(m, seen.photo)
-    footprints = tuple(
-        footprint_at(s, seen.photo, roofs[i])
+    places = [  # for the roofs still unknown, the tour's photos rule out more
+        Unknown(footprint_at(s, seen.photo, roofs[i]), roofs[i])
         if measured[i] and not seen.measured[i]
-        else fp
+        else Unknown(fp, roofs[i])
         if measured[i]
-        else anywhere(s, seen.photo, tallest_m, views)  # the tour's photos rule out more
+        else unknown_place(s, seen.photo, tallest_m, views, seen.regions)
         for i, (s, fp) in enumerate(zip(seen.shapes, seen.footprints, strict=True))
-    )
+    ]
+    footprints = tuple(place.footprint for place in places)
     pois = points_of_interest(m, seen.shapes, seen.photo, roofs, measured, footprints)
     taller = [
         f"{poi.index} ({poi.roof_m:.1f} m)"
@@ -138,14 +140,17 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         (fp, roof) for fp, roof, ok in zip(footprints, roofs, measured, strict=True) if ok
     ) + tuple((o.footprint, o.roof_m) for o in obstacles if o.measured)
     m.unknown = {
-        i: fp for i, (fp, ok) in enumerate(zip(footprints, measured, strict=True)) if not ok
+        i: place for i, (place, ok) in enumerate(zip(places, measured, strict=True)) if not ok
     }
-    m.unknown.update({-1 - j: o.footprint for j, o in enumerate(obstacles) if not o.measured})
+    m.unknown.update(
+        {-1 - j: Unknown(o.footprint, o.upper_m) for j, o in enumerate(obstacles) if not o.measured}
+    )
     return replace(
         seen,
         roofs_m=tuple(roofs),
         measured=tuple(measured),
         footprints=footprints,
+        uppers_m=tuple(place.upper_m for place in places),
         pois=pois,
         obstacles=obstacles,
     )

@@ -59,9 +59,10 @@ class SearchMission(FlightMission):
         """The altitude that clears every known roof (once the survey has measured them)."""
         self.ceiling_m: float | None = None
         """The second overview's altitude: every roof it showed is below it."""
-        self.unknown: dict[int, tuple[tuple[float, float], ...]] = {}
-        """Where buildings of unknown height may stand (by the overview shape's index; an
-        obstacle's is negative): a way near one crosses at the ceiling."""
+        self.unknown: dict[int, tuple[tuple[tuple[float, float], ...], float]] = {}
+        """Where buildings of unknown height may stand, and the highest each roof may be (by
+        the overview shape's index; an obstacle's is negative): a way near one crosses over
+        that by the margin."""
         self.roofs: tuple[tuple[tuple[tuple[float, float], ...], float], ...] = ()
         """Every measured roof: (footprint, height above home)."""
         self.viewpoints: Viewpoints | None = None
@@ -126,12 +127,9 @@ class SearchMission(FlightMission):
         x, y, z = pos_enu_m
         cruise = max(transit_m, z)
         here = self.last.pos_enu_m if self.last is not None else (x, y, cruise)
-        if (
-            self.ceiling_m is not None
-            and cruise < self.ceiling_m
-            and self._near_unknown(here, (x, y))
-        ):
-            cruise = self.ceiling_m
+        over = self._over_unknown(here, (x, y))
+        if over > cruise:
+            cruise = over
             self.event(
                 Level.INFO,
                 f"{what}: a roof of unknown height near the way: across at {cruise:.1f} m",
@@ -144,17 +142,17 @@ class SearchMission(FlightMission):
 
     def floor_at(self, x: float, y: float) -> float:
         """The lowest altitude over (x, y) that keeps the safety margin (and the arrival
-        radius) above every roof within the margin of it; the ceiling near a roof of unknown
-        height. (A look aimed at one tier of a stepped tower must not descend onto another.)"""
+        radius) above every roof within the margin of it, and above the highest a roof of
+        unknown height there may be. (A look aimed at one tier of a stepped tower must not
+        descend onto another.)"""
         margin_m = self.params.viewpoints.safety_margin_m
         need = 0.0
         for footprint, roof_m in self.roofs:
             if point_polygon_distance((x, y), footprint) <= margin_m:
                 need = max(need, roof_m + margin_m + self.params.mission.arrive_radius_m)
-        if self.ceiling_m is not None and any(
-            point_polygon_distance((x, y), fp) <= margin_m for fp in self.unknown.values()
-        ):
-            need = max(need, self.ceiling_m)
+        for footprint, upper_m in self.unknown.values():
+            if point_polygon_distance((x, y), footprint) <= margin_m:
+                need = max(need, self._clear_of(upper_m))
         return need
 
     def learn_roof(
@@ -164,11 +162,25 @@ class SearchMission(FlightMission):
         self.unknown.pop(index, None)
         self.roofs = (*self.roofs, (footprint, roof_m))
 
-    def _near_unknown(self, here: Vec3, there: tuple[float, float]) -> bool:
-        """Whether the ground track from ``here`` to ``there`` passes within the safety
-        margin of where a building of unknown height may stand."""
+    def _over_unknown(self, here: Vec3, there: tuple[float, float]) -> float:
+        """The altitude that clears, by the margin, the highest every building of unknown
+        height within the safety margin of the ground track from ``here`` to ``there`` may
+        be (0 when none is)."""
         margin_m = self.params.viewpoints.safety_margin_m
         a = (here[0], here[1])
-        return any(
-            segment_polygon_distance(a, there, fp) <= margin_m for fp in self.unknown.values()
+        return max(
+            (
+                self._clear_of(upper_m)
+                for footprint, upper_m in self.unknown.values()
+                if segment_polygon_distance(a, there, footprint) <= margin_m
+            ),
+            default=0.0,
         )
+
+    def _clear_of(self, upper_m: float) -> float:
+        """The altitude that keeps the safety margin, and the arrival radius, over a roof of
+        unknown height that may be ``upper_m`` high; never above the ceiling (every roof the
+        second overview showed is below it)."""
+        p = self.params
+        need = upper_m + p.viewpoints.safety_margin_m + p.mission.arrive_radius_m
+        return need if self.ceiling_m is None else min(need, self.ceiling_m)

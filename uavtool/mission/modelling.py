@@ -159,6 +159,12 @@ def photograph_and_model(
         (taken["front"].pos_enu_m, taken["right"].pos_enu_m),
         obj.colour_rgb,
     )
+    if open_beneath(model, ground_z_m=m.params.model.ground_z_m) >= _STANDS_ON_NOTHING:
+        # A building stands on something: a model with nothing at all near the ground is
+        # what side photos that never saw its foot carved, not the building.
+        m.no_model = "the side photos never saw the building's foot: the model stands on nothing"
+        m.event(Level.WARNING, f"model not built: {m.no_model}")
+        return
     mesh = model.mesh
     m.model = ModelBuilt(
         tuple(tuple(v) for v in mesh.vertices.tolist()),
@@ -177,6 +183,10 @@ def photograph_and_model(
         Level.INFO,
         f"model built: height {model.height_m:.2f} m, volume {float(mesh.volume):.1f} m³",
     )
+
+
+_STANDS_ON_NOTHING = 0.99
+"""The share of a model's footprint open beneath it from which it is no building's model."""
 
 
 def _diagonal(

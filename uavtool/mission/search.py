@@ -64,14 +64,18 @@ def photo_shapes(m: SearchMission, photo: Photo, *, nadir: bool = True) -> tuple
     return shapes
 
 
-def look_altitude_m(m: SearchMission, poi: PointOfInterest, intrinsics: Intrinsics) -> float:
+def look_altitude_m(
+    m: SearchMission, poi: PointOfInterest, intrinsics: Intrinsics, roof_m: float | None = None
+) -> float:
     """Where to look at ``poi`` from: its footprint spans ``look_fill`` of the photo, and the
-    camera is at least ``min_above_roof_m`` over its roof."""
+    camera is at least ``min_above_roof_m`` over its roof (``roof_m``, if given, else the
+    point of interest's)."""
     p = m.params.mission
+    roof = poi.roof_m if roof_m is None else roof_m
     fit = fit_altitude_m(
-        roof_m=poi.roof_m, extent_m=poi.extent_m, intrinsics=intrinsics, fill=p.look_fill
+        roof_m=roof, extent_m=poi.extent_m, intrinsics=intrinsics, fill=p.look_fill
     )
-    return max(fit, poi.roof_m + p.min_above_roof_m)
+    return max(fit, roof + p.min_above_roof_m)
 
 
 def search(
@@ -95,11 +99,10 @@ def search(
         k = todo.pop(0)
         poi = pois[k]
         x, y = poi.pos_en_m
-        # a roof of unknown height is looked at from the ceiling: a closer look follows only
-        # once a look has measured it
-        alt = min(look_altitude_m(m, poi, overview.intrinsics), ceiling_m)
-        if not poi.roof_measured:
-            alt = ceiling_m
+        # a roof of unknown height is looked at from over the highest it may be: a closer
+        # look follows only once a look has measured it
+        upper = None if poi.roof_measured else m.unknown.get(poi.shape_index, (None, ceiling_m))[1]
+        alt = min(look_altitude_m(m, poi, overview.intrinsics, upper), ceiling_m)
         alt = max(alt, m.floor_at(x, y))
         yield from m.travel((x, y, alt), None, transit_m, f"point of interest {k}")
         m.visited.append(k)
@@ -303,4 +306,7 @@ def _look_again(
     else:
         return None
     x, y = ground_point(u, v, photo.pose, photo.intrinsics, plane_z_m=min(roof_m, look.alt_m - 1))
-    return (x, y, min(look.alt_m + p.recheck_climb_m, ceiling_m)), why
+    there = (x, y, min(look.alt_m + p.recheck_climb_m, ceiling_m))
+    if math.dist(there, photo.pose.pos_enu_m) <= p.arrive_radius_m:
+        return None  # the same photo again: nothing to learn
+    return there, why

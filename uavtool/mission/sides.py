@@ -26,7 +26,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from uavtool.camera import CameraPose, Intrinsics, project
-from uavtool.mission.analysis import cut_edges
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level
 from uavtool.mission.search import photo_shapes
@@ -35,6 +34,7 @@ from uavtool.nav.geometry import point_polygon_distance
 from uavtool.nav.viewpoints import foot_hidden
 from uavtool.vision import Shape
 from uavtool.vision.model3d import View, same_colour
+from uavtool.vision.shapes import cut_edges
 
 if TYPE_CHECKING:
     from uavtool.mission.base import Wait
@@ -170,13 +170,16 @@ def side_view(
         yield from m.travel((x, y, z), vp.heading_deg, plan.transit_m, f"{vp.name} viewpoint")
     yield from m.move((x, y, plan.transit_m), vp.heading_deg, f"climb from the {vp.name} viewpoint")
     footprints, heights = plan.sight()
-    hidden = (
-        vp.pitch_deg < 0.0
-        and heights is not None
-        and foot_hidden(photo.pose.pos_enu_m, plan.rect.corners(), footprints, heights)
+    hidden = heights is not None and foot_hidden(
+        photo.pose.pos_enu_m, plan.rect.corners(), footprints, heights
     )
     if hidden:
         m.event(Level.INFO, f"{vp.name} photo: the building's foot is hidden behind its neighbours")
+    elif edges == {"bottom"}:
+        # No room for a view of the whole height: the photo says nothing below the frame,
+        # as below a foot hidden behind a neighbour, and the top photo bounds the rest.
+        hidden = True
+        m.event(Level.INFO, f"{vp.name} photo: the building's foot is below the frame")
     return View(silhouette, photo.pose, photo.intrinsics, foot_hidden=hidden), vp
 
 

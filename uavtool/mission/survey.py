@@ -11,13 +11,13 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import cv2
 import numpy as np
 
 from uavtool.camera import Intrinsics, project
-from uavtool.mission.analysis import cut_edges, roof_between
+from uavtool.mission.analysis import roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
 from uavtool.mission.params import MissionParams
@@ -25,7 +25,8 @@ from uavtool.mission.search import photo_shapes
 from uavtool.nav import NavError, ground_point, ground_polygon, min_area_rect
 from uavtool.nav.geometry import convex_hull, point_polygon_distance
 from uavtool.vision import Shape
-from uavtool.vision.vectorize import ground_mask, hue_distance_deg
+from uavtool.vision.shapes import cut_edges
+from uavtool.vision.vectorize import ground_mask, hue_distance_deg, not_ground_regions
 
 if TYPE_CHECKING:
     from uavtool.mission.base import Wait
@@ -44,6 +45,11 @@ class Survey:
     measured: tuple[bool, ...]
     footprints: tuple[tuple[tuple[float, float], ...], ...]
     pois: tuple[PointOfInterest, ...]
+    uppers_m: tuple[float, ...]
+    """Per shape, the highest its roof may be: the roof's height where measured, else the
+    highest no photo rules out (:func:`unknown_place`)."""
+    regions: tuple[Shape, ...]
+    """The outlines of what is not ground in ``photo`` (:func:`not_ground_regions`)."""
     lower: Photo | None = None
     """The lower overview photo."""
     obstacles: tuple[Obstacle, ...] = ()
@@ -65,6 +71,20 @@ class Obstacle:
     roof_m: float
     measured: bool
     footprint: tuple[tuple[float, float], ...]
+    upper_m: float
+    """The highest its roof may be (``roof_m`` when measured)."""
+
+    @property
+    def height_m(self) -> float:
+        """Its height as an obstacle: the highest its roof may be."""
+        return self.roof_m if self.measured else self.upper_m
+
+
+class Unknown(NamedTuple):
+    """Where a building of unknown height may stand, and the highest its roof may be."""
+
+    footprint: tuple[tuple[float, float], ...]
+    upper_m: float
 
 
 def survey(m: SearchMission) -> Wait[Survey]:
@@ -81,12 +101,14 @@ def survey(m: SearchMission) -> Wait[Survey]:
     found = [_measure(m, shape, high, low, low_shapes) for shape in shapes]
     measured = [h is not None for h in found]
     roofs = [p.assumed_roof_m if h is None else h for h in found]
-    footprints = tuple(
-        footprint_at(s, high, h)
+    regions = not_ground_regions(high.image_rgb, m.params.vectorize)
+    places = [
+        Unknown(footprint_at(s, high, h), h)
         if h is not None
-        else anywhere(s, high, below_camera_m(m, high), (low,))
+        else unknown_place(s, high, below_camera_m(m, high), (low,), regions)
         for s, h in zip(shapes, found, strict=True)
-    )
+    ]
+    footprints = tuple(place.footprint for place in places)
     pois = points_of_interest(m, shapes, high, roofs, measured, footprints)
     known = sum(measured)
     m.event(
@@ -94,7 +116,10 @@ def survey(m: SearchMission) -> Wait[Survey]:
         f"roof heights measured for {known} of {len(shapes)} buildings"
         + (f" (others assumed {p.assumed_roof_m:g} m)" if known < len(shapes) else ""),
     )
-    return Survey(high, shapes, tuple(roofs), tuple(measured), footprints, pois, lower=low)
+    uppers = tuple(place.upper_m for place in places)
+    return Survey(
+        high, shapes, tuple(roofs), tuple(measured), footprints, pois, uppers, regions, lower=low
+    )
 
 
 def points_of_interest(
@@ -225,14 +250,12 @@ def obstacles_around(
     m: SearchMission, seen: Survey, target: int
 ) -> list[tuple[tuple[tuple[float, float], ...], float]]:
     """The survey's footprints of every building but the target (and its other roofs), and
-    of everything else that is not ground, each with its roof's height (``math.inf`` where
-    not measured)."""
+    of everything else that is not ground, each with its roof's height (where not measured,
+    the highest it may be)."""
     own = same_building(m, seen, target)
-    return [
-        (f, seen.roofs_m[i] if seen.measured[i] else math.inf)
-        for i, f in enumerate(seen.footprints)
-        if i not in own
-    ] + [(o.footprint, o.roof_m if o.measured else math.inf) for o in seen.obstacles]
+    return [(f, seen.uppers_m[i]) for i, f in enumerate(seen.footprints) if i not in own] + [
+        (o.footprint, o.height_m) for o in seen.obstacles
+    ]
 
 
 def beyond_the_frame(seen: Survey) -> list[tuple[tuple[float, float], ...]]:
@@ -266,16 +289,17 @@ def remeasured_obstacles(
     m: SearchMission, seen: Survey, target: int, photo: Photo, shapes: tuple[Shape, ...]
 ) -> list[tuple[tuple[tuple[float, float], ...], float]]:
     """The footprints of every building but ``target`` (and its other roofs), each with its
-    roof's height (``math.inf`` where not measured), those of unknown height measured again
-    against a later nadir ``photo`` (its ``shapes``) where it shows them whole."""
+    roof's height (where not measured, the highest it may be), those of unknown height
+    measured again against a later nadir ``photo`` (its ``shapes``) where it shows them
+    whole."""
     p = m.params.mission
     own = same_building(m, seen, target)
-    out = [(o.footprint, o.roof_m if o.measured else math.inf) for o in seen.obstacles]
+    out = [(o.footprint, o.height_m) for o in seen.obstacles]
     for i, shape in enumerate(seen.shapes):
         if i in own:
             continue
         footprint = seen.footprints[i]
-        height = seen.roofs_m[i] if seen.measured[i] else math.inf
+        height = seen.uppers_m[i]
         if not seen.measured[i] and not shape.cut_by_border:
             roof = _measure_against(m, shape, seen.photo, photo, shapes)
             if roof is not None and roof <= p.assumed_roof_m + p.min_above_roof_m:
@@ -310,13 +334,58 @@ def below_camera_m(m: SearchMission, photo: Photo) -> float:
     return photo.pose.pos_enu_m[2] - m.params.mission.min_above_roof_m
 
 
+def unknown_place(
+    shape: Shape,
+    photo: Photo,
+    tallest_m: float,
+    others: Sequence[Photo],
+    regions: Sequence[Shape],
+) -> Unknown:
+    """Where the building whose roof is ``shape`` (unmeasured) may stand, and the highest it
+    may be: :func:`unknown_roof` of the roof, and of everything not ground around it in the
+    photo (``regions``; its walls, a part of another colour, a neighbour touching it in the
+    photo). A region cut by the frame may hold a higher roof beyond it: up to ``tallest_m``."""
+    place = unknown_roof(shape, photo, tallest_m, others)
+    region = _region_of(shape, regions)
+    if region is None:
+        return place
+    if region.cut_by_border:
+        return Unknown(place.footprint, tallest_m)
+    whole = unknown_roof(region, photo, tallest_m, others)
+    return Unknown(
+        tuple(convex_hull([*place.footprint, *whole.footprint])),
+        max(place.upper_m, whole.upper_m),
+    )
+
+
+def _region_of(shape: Shape, regions: Sequence[Shape]) -> Shape | None:
+    """The region holding most of ``shape``'s corners and its centroid (None: none does)."""
+    points = [(float(u), float(v)) for u, v in shape.polygon_px] + [shape.centroid_px]
+
+    def inside(region: Shape) -> int:
+        ring = np.asarray(region.polygon_px, np.float32).reshape(-1, 1, 2)
+        return sum(cv2.pointPolygonTest(ring, p, False) >= 0 for p in points)
+
+    best = max(regions, key=inside, default=None)
+    return best if best is not None and inside(best) > len(points) // 2 else None
+
+
 def anywhere(
     shape: Shape, photo: Photo, tallest_m: float, others: Sequence[Photo] = ()
 ) -> tuple[tuple[float, float], ...]:
+    """Where a building of unknown height may stand (:func:`unknown_roof`)."""
+    return unknown_roof(shape, photo, tallest_m, others).footprint
+
+
+def unknown_roof(
+    shape: Shape, photo: Photo, tallest_m: float, others: Sequence[Photo] = ()
+) -> Unknown:
     """Where a building of unknown height (up to ``tallest_m``) may stand: its roof's outline
-    projected on every roof plane it may be at, from the ground up, and everything between.
-    A height is ruled out where one of ``others`` (other nadir photos) sees, whole, the
-    ground that the building would stand on at that height."""
+    projected on every roof plane it may be at, from the ground up, and everything between;
+    and the highest its roof may be. A height is ruled out where one of ``others`` (other
+    nadir photos) sees, whole, the ground that the building would stand on at that height:
+    no building stands where a camera sees the ground. The roof may be up to a plane's step
+    above the highest plane left (it was not tried)."""
     heights = [0.0]
     step_m = _HEIGHT_STEP_M
     while heights[-1] + step_m < tallest_m:
@@ -328,12 +397,14 @@ def anywhere(
         # nor where its roof would show.
         grounds = [(o, ground_mask(o.image_rgb)) for o in others]
         kept = [
-            f
+            (f, h)
             for f, h in zip(feet, heights, strict=True)
             if not any(_ground_there(f, 0.0, o, g) or _ground_there(f, h, o, g) for o, g in grounds)
         ]
-        feet = kept or feet  # every height ruled out: the photos disagree, keep them all
-    return tuple(convex_hull([p for f in feet for p in f]))
+        if kept:  # every height ruled out: the photos disagree, keep them all
+            feet, heights = [f for f, _ in kept], [h for _, h in kept]
+    upper = min(max(heights) + _HEIGHT_STEP_M, tallest_m)
+    return Unknown(tuple(convex_hull([p for f in feet for p in f])), upper)
 
 
 _HEIGHT_STEP_M = 2.0

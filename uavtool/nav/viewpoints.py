@@ -228,7 +228,7 @@ def _plan_one(
         factor *= params.distance_step
     for offset in params.oblique_deg if tried else ():  # none fit at all: say so below
         for side in (first_side, _OPPOSITE[first_side]):
-            found = _oblique(name, rect, side, offset, obstacles, intrinsics, params)
+            found = _oblique(name, rect, side, offset, obstacles, intrinsics, params, heights)
             if isinstance(found, Viewpoint):
                 return found
             tried.append(found)
@@ -385,10 +385,12 @@ def _oblique(
     obstacles: list[list[Point]],
     intrinsics: Intrinsics,
     params: ViewpointParams,
+    heights: Sequence[float] | None = None,
 ) -> Viewpoint | str:
     """A camera on ``side``'s normal turned ``offset_deg`` around the building's centre, at
     the first distance (growing as square-on ones do) where it keeps the safety margin and
-    sees every corner past the obstacles; else what blocked it."""
+    sees every corner past the obstacles (level, or rising to look down over obstacles of
+    known ``heights``); else what blocked it."""
     _, _, normal = _side_geometry(rect, side)
     a = math.radians(offset_deg)
     u = (
@@ -404,6 +406,7 @@ def _oblique(
         obstacles,
         intrinsics,
         params,
+        heights,
     )
     if isinstance(found, Viewpoint):
         return found

@@ -33,7 +33,7 @@ from uavtool.geo import wrap_180
 from uavtool.vision.colour import hue_distance_deg
 from uavtool.vision.errors import ModelInputError
 from uavtool.vision.params import ModelParams
-from uavtool.vision.shapes import FloatArray, Shape
+from uavtool.vision.shapes import FloatArray, Shape, cut_edges
 
 # Depth range of the side viewing cones, metres along the optical axis.
 _NEAR_M = 0.25
@@ -49,8 +49,9 @@ class View:
     intrinsics: Intrinsics
     foot_hidden: bool = False
     """The object's lower part is hidden behind something nearer (a camera looking down over
-    a lower building): below its silhouette the photo says nothing, so nothing there is
-    carved away (the top view's footprint still bounds it)."""
+    a lower building) or below the frame: below its silhouette the photo says nothing, so
+    nothing there is carved away (the top view's footprint still bounds it), and the
+    silhouette may touch the frame's bottom edge."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -162,7 +163,10 @@ def _check_views(top: View, front: View, right: View, p: ModelParams, more: Sequ
     for name, view in [("top", top), *sides]:
         if not view.shapes:
             raise ModelInputError(f"{name}: no silhouette of the object in the photo")
-        if not p.allow_border_cut and any(s.cut_by_border for s in view.shapes):
+        cut = cut_edges(view.shapes, view.intrinsics)
+        if view.foot_hidden:
+            cut -= {"bottom"}  # below the silhouette the photo says nothing anyway
+        if not p.allow_border_cut and cut:
             raise ModelInputError(
                 f"{name}: the object touches the image border, so its outline is incomplete; "
                 "take the photo from further away"

@@ -3,10 +3,15 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
+
+if TYPE_CHECKING:
+    from uavtool.camera import Intrinsics
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -93,3 +98,25 @@ def perimeter(ring: FloatArray) -> float:
     """Length of a closed ring ``(n, 2)``, summed in a fixed order."""
     d = np.concatenate([ring[1:], ring[:1]]) - ring
     return math.fsum(np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]).tolist())
+
+
+_EDGE_PX = 1.0  # an outline this close to the frame's edge touches it
+
+
+def cut_edges(silhouette: Sequence[Shape], k: Intrinsics) -> set[str]:
+    """Which edges of the frame (``top``, ``bottom``, ``left``, ``right``) the silhouette's
+    outlines touch."""
+    edges: set[str] = set()
+    for shape in silhouette:
+        if not shape.cut_by_border:
+            continue
+        us, vs = shape.polygon_px[:, 0], shape.polygon_px[:, 1]
+        for edge, touches in (
+            ("left", float(us.min()) <= _EDGE_PX),
+            ("right", float(us.max()) >= k.width_px - 1 - _EDGE_PX),
+            ("top", float(vs.min()) <= _EDGE_PX),
+            ("bottom", float(vs.max()) >= k.height_px - 1 - _EDGE_PX),
+        ):
+            if touches:
+                edges.add(edge)
+    return edges

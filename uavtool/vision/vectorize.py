@@ -28,7 +28,15 @@ U8Array = npt.NDArray[np.uint8]
 CvArray = npt.NDArray[Any]
 
 # hue_of and hue_distance_deg live in uavtool.vision.colour; importable from here too.
-__all__ = ["CvArray", "U8Array", "hue_distance_deg", "hue_of", "non_ground", "vectorize"]
+__all__ = [
+    "CvArray",
+    "U8Array",
+    "hue_distance_deg",
+    "hue_of",
+    "non_ground",
+    "not_ground_regions",
+    "vectorize",
+]
 
 
 def vectorize(frame_rgb: U8Array, params: VectorizeParams | None = None) -> tuple[Shape, ...]:
@@ -115,10 +123,7 @@ def non_ground(
     of a colour, which :func:`vectorize` leaves out, are here."""
     p = params if params is not None else VectorizeParams()
     frame = _check_frame(frame_rgb)
-    cv2.setNumThreads(1)
-    mask = cv2.bitwise_not(_near(frame, _mode_rgb(frame), tolerance_dn))
-    if p.denoise_px > 1:
-        mask = cv2.medianBlur(mask, p.denoise_px)
+    mask = _not_ground_mask(frame, p, tolerance_dn)
     regions = _regions(mask, mask, (0, 0), frame.shape[:2], 1, p)
     roofs: list[_Region] = []
     for r in regions:
@@ -133,6 +138,30 @@ def non_ground(
     shapes = [(-shape.area_px, order, shape) for order, _r, shape in _traced(frame, roofs, p)]
     shapes.sort(key=lambda t: t[:2])
     return tuple(s for *_, s in shapes)
+
+
+def not_ground_regions(
+    frame_rgb: U8Array, params: VectorizeParams | None = None, *, tolerance_dn: int = 15
+) -> tuple[Shape, ...]:
+    """The outlines of the regions of an RGB frame that are not the ground (as
+    :func:`non_ground` tells it), roofs and walls together, largest first: one building
+    with everything seen of it, or several that touch in the photo."""
+    p = params if params is not None else VectorizeParams()
+    frame = _check_frame(frame_rgb)
+    mask = _not_ground_mask(frame, p, tolerance_dn)
+    regions = _regions(mask, mask, (0, 0), frame.shape[:2], 1, p)
+    shapes = [(-shape.area_px, order, shape) for order, _r, shape in _traced(frame, regions, p)]
+    shapes.sort(key=lambda t: t[:2])
+    return tuple(s for *_, s in shapes)
+
+
+def _not_ground_mask(frame: U8Array, p: VectorizeParams, tolerance_dn: int) -> CvArray:
+    """255 where a pixel differs from the ground's colour, denoised."""
+    cv2.setNumThreads(1)
+    mask = cv2.bitwise_not(_near(frame, _mode_rgb(frame), tolerance_dn))
+    if p.denoise_px > 1:
+        mask = cv2.medianBlur(mask, p.denoise_px)
+    return mask
 
 
 def roof_inside(
