@@ -21,7 +21,7 @@ from uavtool.recording.topics import (
     TELEMETRY,
     VEHICLE_EVENTS,
 )
-from uavtool.runner.record import ClockNs, write_camera_frame, write_vehicle
+from uavtool.runner.record import ClockNs, write_camera_frame
 
 TELEMETRY_SCHEMA = {
     "title": "uavtool.Telemetry",
@@ -84,7 +84,7 @@ class PassiveRecorder:
         now = self.clock_ns()
         self.counts["telemetry"] += 1
         self.writer.write_json(TELEMETRY, encode_observation(t), log_time_ns=now)
-        write_vehicle(self.writer, t.pos_enu_m, t.heading_deg, self.origin, now)
+        self.writer.write_vehicle(t.pos_enu_m, t.heading_deg, self.origin, log_time_ns=now)
 
     def frame(self, f: Frame) -> None:
         now = self.clock_ns()

@@ -18,6 +18,7 @@ import os
 import weakref
 from collections.abc import Iterable, Mapping
 from pathlib import Path
+from typing import BinaryIO
 
 from uavtool.recording.encoder import McapEncoder
 from uavtool.recording.errors import RecordingError, create_file
@@ -26,8 +27,9 @@ from uavtool.recording.syncer import Syncer
 
 class RecordingSink:
     """An MCAP file being written at ``path``; its header and ``metadata`` records are
-    written (and handed to the OS) at once. Not thread-safe: the writer serializes calls.
-    Raises `RecordingError` if the file cannot be created or written."""
+    written (and handed to the OS) at once; ``file``: ``path`` already open (it is created
+    otherwise). Not thread-safe: the writer serializes calls. Raises `RecordingError` if the
+    file cannot be created or written."""
 
     def __init__(
         self,
@@ -38,6 +40,7 @@ class RecordingSink:
         interval_ns: int,
         budget_bytes: int,
         fsync: bool,
+        file: BinaryIO | None = None,
     ) -> None:
         self.path = path
         self._interval_ns = interval_ns
@@ -47,7 +50,7 @@ class RecordingSink:
         self._error: OSError | None = None  # the failed write or fsync, once there is one
         self._problem = ""
         self._closed = False
-        self._file = create_file(path)
+        self._file = create_file(path) if file is None else file
         try:
             self._encoder = McapEncoder(self._file, library=library)
             for name, pairs in metadata:

@@ -12,9 +12,10 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from enum import Enum, IntEnum
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from uavtool.camera import CameraPose, Intrinsics
+if TYPE_CHECKING:  # numpy with it: a writer process needs none of it
+    from uavtool.camera import CameraPose, Intrinsics
 
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]

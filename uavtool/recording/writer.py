@@ -12,17 +12,20 @@ mcap versions; `McapEncoder` writes the bytes mcap's own `Writer` would).
 
 from __future__ import annotations
 
+import importlib
 import struct
 import threading
 from collections.abc import Mapping
+from functools import cache
 from pathlib import Path
-from types import TracebackType
-from typing import Any
+from types import ModuleType, TracebackType
+from typing import TYPE_CHECKING, Any, BinaryIO, Protocol
 
 from mcap.writer import LIBRARY_IDENTIFIER
 
 from uavtool import __version__
-from uavtool.recording import foxglove, rawframe
+from uavtool.geo import GeoPoint, geo_from_enu
+from uavtool.recording import rawframe
 from uavtool.recording.errors import RecordingError
 from uavtool.recording.schemas import (
     DEFAULT_DIALECT,
@@ -36,18 +39,86 @@ from uavtool.recording.schemas import (
     mavlink_topic,
 )
 from uavtool.recording.sink import RecordingSink
-from uavtool.recording.values import Direction
+from uavtool.recording.topics import FIX, POSE
+from uavtool.recording.values import Direction, LocationFix, Pose, PosesInFrame
+
+if TYPE_CHECKING:
+    from uavtool.recording.foxglove import FoxgloveValue
 
 LIBRARY = f"uavtool/{__version__}; {LIBRARY_IDENTIFIER}"
 TOOL_METADATA = "uavtool"  # name of the metadata record the writer adds itself
 
 
-def _check_topic(topic: str) -> None:
+@cache
+def foxglove_module() -> ModuleType:
+    """`uavtool.recording.foxglove`, imported when first needed: a writer process is handed
+    Foxglove messages already encoded, and needs none of Foxglove's modules."""
+    return importlib.import_module("uavtool.recording.foxglove")
+
+
+class MessageWriter(Protocol):
+    """What a flight's recorder needs of a writer: `RecordingWriter`, or the same in a
+    process of its own (`uavtool.recording.process.ProcessWriter`)."""
+
+    def add_metadata(self, name: str, record: Mapping[str, str]) -> None: ...
+
+    def add_json_topic(
+        self, topic: str, *, schema_name: str, schema: Mapping[str, Any]
+    ) -> None: ...
+
+    def write_json(
+        self,
+        topic: str,
+        payload: Mapping[str, Any],
+        *,
+        log_time_ns: int,
+        publish_time_ns: int | None = None,
+    ) -> None: ...
+
+    def write_json_bytes(
+        self, topic: str, data: bytes, *, log_time_ns: int, publish_time_ns: int | None = None
+    ) -> None: ...
+
+    def write(
+        self,
+        topic: str,
+        value: FoxgloveValue,
+        *,
+        log_time_ns: int,
+        publish_time_ns: int | None = None,
+    ) -> None: ...
+
+    def write_mavlink(
+        self,
+        frame: bytes,
+        *,
+        direction: Direction,
+        log_time_ns: int,
+        publish_time_ns: int | None = None,
+        decoded: Any = None,
+    ) -> None: ...
+
+    def write_vehicle(
+        self,
+        pos_enu_m: tuple[float, float, float],
+        heading_deg: float,
+        origin: GeoPoint | None,
+        *,
+        log_time_ns: int,
+    ) -> None: ...
+
+    def close(self) -> None: ...
+
+
+def check_topic(topic: str) -> None:
+    """`ValueError` unless ``topic`` may be written with `RecordingWriter.write` or a JSON
+    topic."""
     if not topic.startswith("/") or topic.startswith("/mavlink/"):
         raise ValueError(f"topic {topic!r}: must start with '/' and not with '/mavlink/'")
 
 
-def _check_metadata(name: str, record: Mapping[str, str]) -> None:
+def check_metadata(name: str, record: Mapping[str, str]) -> None:
+    """`ValueError` unless ``record`` may be written as metadata named ``name``."""
     if name == TOOL_METADATA:
         raise ValueError(f"metadata name {name!r} is reserved for the writer")
     if not all(isinstance(k, str) and isinstance(v, str) for k, v in record.items()):
@@ -59,6 +130,8 @@ class RecordingWriter:
 
     ``metadata`` maps record names (``mission``, ``scene``, ``seeds``, ``flight`` …) to
     string key/value pairs, written first after a ``uavtool`` record (tool version, dialect).
+    ``file``: the file already opened for ``path`` (binary, written from its start), which the
+    writer then owns; by default it creates ``path``.
     Every ``write_*`` takes ``log_time_ns`` (receive time, > 0, one epoch per file) and
     optionally ``publish_time_ns`` (defaults to the log time). Raises
     `ValueError` on misuse (time ≤ 0, unregistered topic, NaN in JSON, writing after close)
@@ -74,10 +147,11 @@ class RecordingWriter:
         chunk_interval_ns: int = 1_000_000_000,
         chunk_bytes: int = 1 << 20,
         fsync: bool = True,
+        file: BinaryIO | None = None,
     ) -> None:
         self._decoder = MavlinkDecoder(dialect)  # checks the dialect before creating a file
         for name, record in (metadata or {}).items():
-            _check_metadata(name, record)
+            check_metadata(name, record)
         self.dialect = dialect
         self.path = Path(path)
         self._lock = threading.Lock()
@@ -92,6 +166,7 @@ class RecordingWriter:
         self._raw_id = 0  # /mavlink/raw's channel id once it has one
         self._topic_kind: dict[str, Any] = {}  # topic -> value type or JSON schema name
         self._json_topics: dict[str, int] = {}  # topic -> channel id
+        self._protobuf_schema: dict[str, str] = {}  # topic -> its Protobuf schema's name
         self._sequence: list[int] = [0]  # channel id -> its next sequence number
         tool = {"version": __version__, "dialect": dialect, "mavlink": "2.0"}
         self._sink = RecordingSink(
@@ -101,6 +176,7 @@ class RecordingWriter:
             interval_ns=chunk_interval_ns,
             budget_bytes=chunk_bytes,
             fsync=fsync,
+            file=file,
         )
 
     # --- lifecycle ---------------------------------------------------------------------------
@@ -147,14 +223,14 @@ class RecordingWriter:
 
     def add_metadata(self, name: str, record: Mapping[str, str]) -> None:
         """Add a named metadata record (e.g. the mission outcome at the end)."""
-        _check_metadata(name, record)
+        check_metadata(name, record)
         with self._lock:
             self._check_open()
             self._sink.add_metadata(name, dict(record))
 
     def add_json_topic(self, topic: str, *, schema_name: str, schema: Mapping[str, Any]) -> None:
         """Declare a JSON topic with its JSON schema; `write_json` then writes to it."""
-        _check_topic(topic)
+        check_topic(topic)
         with self._lock:
             self._check_open()
             known = self._topic_kind.get(topic)
@@ -204,27 +280,66 @@ class RecordingWriter:
     def write(
         self,
         topic: str,
-        value: foxglove.FoxgloveValue,
+        value: FoxgloveValue,
         *,
         log_time_ns: int,
         publish_time_ns: int | None = None,
     ) -> None:
         """Write an image, calibration, transform, fix, poses, log entry or model (Foxglove)."""
-        _check_topic(topic)
+        check_topic(topic)
         kind = type(value)
+        foxglove = foxglove_module()
         data = foxglove.encode(value, log_time_ns)
         with self._lock:
             self._check_open()
             channel_id = self._channels.get(topic)
             if channel_id is None:
-                schema_id = self._schema(
-                    foxglove.schema_name(kind), PROTOBUF_ENCODING, foxglove.schema_data(kind)
-                )
-                channel_id = self._channel(topic, topic, PROTOBUF_ENCODING, schema_id)
-                self._topic_kind[topic] = kind
-            elif self._topic_kind.get(topic) is not kind:
+                name, schema = foxglove.schema_name(kind), foxglove.schema_data(kind)
+                channel_id = self._protobuf_channel(topic, kind, name, schema)
+            elif (known := self._topic_kind.get(topic)) is not kind and (
+                known != foxglove.schema_name(kind)  # write_protobuf opened it: its schema
+            ):
+                raise ValueError(f"topic {topic!r} carries {known!r}, not {kind}")
+            self._add(channel_id, log_time_ns, publish_time_ns, data)
+
+    def write_vehicle(
+        self,
+        pos_enu_m: tuple[float, float, float],
+        heading_deg: float,
+        origin: GeoPoint | None,
+        *,
+        log_time_ns: int,
+    ) -> None:
+        """The vehicle's pose on ``/vehicle/pose`` and, when the local frame's ``origin`` is
+        known, its WGS-84 fix on ``/vehicle/fix`` (one of each per telemetry sample)."""
+        pose = Pose.from_enu_heading(pos_enu_m, heading_deg)
+        self.write(POSE, PosesInFrame((pose,)), log_time_ns=log_time_ns)
+        if origin is not None:
+            geo = geo_from_enu(origin, *pos_enu_m)
+            fix = LocationFix(geo.lat_deg, geo.lon_deg, geo.alt_amsl_m)
+            self.write(FIX, fix, log_time_ns=log_time_ns)
+
+    def write_protobuf(
+        self,
+        topic: str,
+        data: bytes,
+        *,
+        schema_name: str,
+        schema: bytes,
+        log_time_ns: int,
+        publish_time_ns: int | None = None,
+    ) -> None:
+        """Write a Protobuf message already encoded (``schema``: its FileDescriptorSet): the
+        same record `write` makes of a value that encodes to ``data``."""
+        with self._lock:
+            self._check_open()
+            channel_id = self._channels.get(topic)
+            if channel_id is None:
+                check_topic(topic)
+                channel_id = self._protobuf_channel(topic, schema_name, schema_name, schema)
+            elif self._protobuf_schema.get(topic) != schema_name:
                 raise ValueError(
-                    f"topic {topic!r} carries {self._topic_kind.get(topic)!r}, not {kind}"
+                    f"topic {topic!r} carries {self._topic_kind.get(topic)!r}, not {schema_name}"
                 )
             self._add(channel_id, log_time_ns, publish_time_ns, data)
 
@@ -282,6 +397,12 @@ class RecordingWriter:
         meta = {"dialect": self.dialect}
         self._raw_id = self._channel(MAVLINK_RAW, MAVLINK_RAW, PROTOBUF_ENCODING, schema_id, meta)
         return self._raw_id
+
+    def _protobuf_channel(self, topic: str, kind: Any, name: str, schema: bytes) -> int:
+        schema_id = self._schema(name, PROTOBUF_ENCODING, schema)
+        self._topic_kind[topic] = kind
+        self._protobuf_schema[topic] = name
+        return self._channel(topic, topic, PROTOBUF_ENCODING, schema_id)
 
     def _mavlink_channel(self, direction: Direction, msgid: int, msg_name: str) -> int:
         name, schema = mavlink_schema(self.dialect, msgid)

@@ -31,8 +31,10 @@ from uavtool.mission import Level, MissionInputs, Outcome, SearchMission
 from uavtool.mission.outputs import Result
 from uavtool.mission.params import to_dict, with_overrides
 from uavtool.plugins import DEFAULT, MissionRef, create_mission, resolve
-from uavtool.recording import RecordingError, RecordingWriter
+from uavtool.recording import ProcessWriter, RecordingError, RecordingWriter
 from uavtool.recording.files import atomic_output
+from uavtool.recording.process import core_to_spare
+from uavtool.recording.writer import MessageWriter
 from uavtool.runner.backends import open_backend
 from uavtool.runner.camera import open_camera
 from uavtool.runner.evaluate import Evaluation, evaluate
@@ -65,6 +67,11 @@ class FlyConfig:
     record: Path | None = None
     """None: ``recordings/<UTC time>.mcap``."""
     no_record: bool = False
+    record_in_process: bool | None = None
+    """Where the recording is written: True on the flight's own thread (`RecordingWriter`),
+    False in a process of its own (`ProcessWriter`: off the flight's path, but more work in
+    all), None: in a process of its own when a core is free for it (`core_to_spare`). The
+    file is the same either way. Sweeps say True: their flights keep every core busy."""
     mission: str = DEFAULT
     """Which mission flies: a registered name (``uavtool missions``) or ``module:Class``."""
     params: Any = None
@@ -201,9 +208,15 @@ def fly(
                 )
             )
             description = describe(config, scene, ref, target_png is not None)
-            writer = stack.enter_context(
-                RecordingWriter(partial, metadata=description.to_metadata())
-            )
+            metadata = description.to_metadata()
+            writer: MessageWriter
+            in_process = config.record_in_process
+            if in_process is None:
+                in_process = not core_to_spare()
+            if in_process:
+                writer = stack.enter_context(RecordingWriter(partial, metadata=metadata))
+            else:
+                writer = stack.enter_context(ProcessWriter(partial, metadata=metadata))
             recorder = MissionRecorder(writer, clock_ns=clock_ns)
             if target_png is not None:
                 recorder.target(target_png)

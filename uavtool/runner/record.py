@@ -24,7 +24,7 @@ from collections.abc import Callable
 from typing import Any
 
 from uavtool.camera import CameraPose, Intrinsics
-from uavtool.geo import GeoPoint, geo_from_enu
+from uavtool.geo import GeoPoint
 from uavtool.images import png_encode
 from uavtool.mission import Level, ModelBuilt, Observation, Output, Photo, Telemetry
 from uavtool.mission.codec import encode_observation, encode_output
@@ -35,29 +35,24 @@ from uavtool.recording import (
     CompressedImage,
     Direction,
     FrameTransform,
-    LocationFix,
     LogEntry,
     LogLevel,
     Model3D,
-    Pose,
-    PosesInFrame,
-    RecordingWriter,
     SceneMarkers,
 )
 from uavtool.recording.topics import (
     CALIBRATION,
     CAMERA_POSE,
     EVENTS,
-    FIX,
     IMAGE,
     MODEL,
     OBSERVATIONS,
     OUTPUTS,
     PICTURES,
-    POSE,
     SCENE,
     TARGET,
 )
+from uavtool.recording.writer import MessageWriter
 from uavtool.runner.markers import RouteMarkers
 
 _LEVELS = {Level.INFO: LogLevel.INFO, Level.WARNING: LogLevel.WARNING, Level.ERROR: LogLevel.ERROR}
@@ -68,7 +63,7 @@ ClockNs = Callable[[], int]
 
 
 def write_camera_frame(
-    writer: RecordingWriter,
+    writer: MessageWriter,
     png: bytes,
     intrinsics: Intrinsics,
     pose: CameraPose,
@@ -81,28 +76,11 @@ def write_camera_frame(
     writer.write(CAMERA_POSE, FrameTransform.from_camera_pose(pose), log_time_ns=t)
 
 
-def write_vehicle(
-    writer: RecordingWriter,
-    pos_enu_m: tuple[float, float, float],
-    heading_deg: float,
-    origin: GeoPoint | None,
-    log_time_ns: int,
-) -> None:
-    """The vehicle's pose on ``/vehicle/pose`` and, when the local frame's ``origin`` is
-    known, its WGS-84 fix on ``/vehicle/fix``."""
-    pose = Pose.from_enu_heading(pos_enu_m, heading_deg)
-    writer.write(POSE, PosesInFrame((pose,)), log_time_ns=log_time_ns)
-    if origin is not None:
-        geo = geo_from_enu(origin, *pos_enu_m)
-        fix = LocationFix(geo.lat_deg, geo.lon_deg, geo.alt_amsl_m)
-        writer.write(FIX, fix, log_time_ns=log_time_ns)
-
-
 class MissionRecorder:
     """Writes a flight into ``writer``, each message stamped by ``clock_ns``. ``home`` is the
     vehicle's home (for WGS-84 fixes)."""
 
-    def __init__(self, writer: RecordingWriter, *, clock_ns: ClockNs = time.time_ns) -> None:
+    def __init__(self, writer: MessageWriter, *, clock_ns: ClockNs = time.time_ns) -> None:
         self.writer = writer
         self.clock_ns = clock_ns
         self.home: GeoPoint | None = None
@@ -136,7 +114,7 @@ class MissionRecorder:
             self._scene(self._markers.photo(obs.pose), t)
         elif isinstance(obs, Telemetry):
             self._markers.telemetry(obs.pos_enu_m)
-            write_vehicle(self.writer, obs.pos_enu_m, obs.heading_deg, self.home, t)
+            self.writer.write_vehicle(obs.pos_enu_m, obs.heading_deg, self.home, log_time_ns=t)
         data = telemetry_json(step, obs) if isinstance(obs, Telemetry) else None
         if data is not None:
             self.writer.write_json_bytes(OBSERVATIONS, data, log_time_ns=t)

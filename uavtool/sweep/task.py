@@ -96,6 +96,7 @@ def _fly(
     config = FlyConfig(
         scene=scene,
         record=record,
+        record_in_process=True,  # every core flies: a writer process would only add work
         mission=flight.mission,
         params=with_overrides(mission.params_type(), flight.settings()),
         vehicle_params=flight.vehicle_params(),

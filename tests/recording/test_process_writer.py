@@ -1,0 +1,181 @@
+"""`ProcessWriter`: the same file as `RecordingWriter`, errors where they were, and a crash of
+the flight's process loses only the batch it had not sent."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from tests.recording.sample import OBS_SCHEMA, T0_NS, mavlink_frames, other_values
+from uavtool.geo import GeoPoint
+from uavtool.recording import (
+    Direction,
+    ProcessWriter,
+    RecordingError,
+    RecordingReader,
+    RecordingWriter,
+    summarize,
+)
+from uavtool.recording.process import BATCH_NS
+
+HOME = GeoPoint(47.397742, 8.545594, 488.0)
+
+
+def _write(writer: Any, seconds: float = 6.0, rate_hz: int = 400) -> None:
+    """Every kind of call, as a flight makes them, over ``seconds`` of log time."""
+    frames = mavlink_frames(int(seconds * rate_hz))
+    step_ns = 1_000_000_000 // rate_hz
+    writer.add_json_topic("/mission/observations", schema_name="test.Obs", schema=OBS_SCHEMA)
+    for i, (direction, frame) in enumerate(frames):
+        t = T0_NS + i * step_ns
+        writer.write_mavlink(frame, direction=direction, log_time_ns=t)
+        if i % 40 == 0:
+            writer.write_vehicle(
+                (1.0 * i, -2.0, 45.0), 10.0 + i, HOME if i else None, log_time_ns=t
+            )
+            writer.write_json("/mission/observations", {"step": i, "alt_m": 45.5}, log_time_ns=t)
+            writer.write_json_bytes(
+                "/mission/observations", b'{"step":-1}', log_time_ns=t, publish_time_ns=t + 1
+            )
+        if i % rate_hz == 0:
+            for topic, value in other_values():
+                writer.write(topic, value, log_time_ns=t)
+            writer.write_mavlink(frame, direction=Direction.IN, log_time_ns=t, publish_time_ns=5)
+            writer.write_mavlink(b"\xfd\x01junk", direction=Direction.OUT, log_time_ns=t)
+        if i == len(frames) // 2:
+            writer.add_metadata("halfway", {"i": str(i)})
+    writer.add_metadata("outcome", {"status": "completed"})
+
+
+def test_the_file_is_the_one_recording_writer_writes(tmp_path: Path) -> None:
+    metadata = {"mission": {"target": "red"}, "seeds": {"world": "7"}}
+    with RecordingWriter(tmp_path / "inline.mcap", metadata=metadata, fsync=False) as inline:
+        _write(inline)
+    with ProcessWriter(tmp_path / "process.mcap", metadata=metadata, fsync=False) as process:
+        _write(process)
+    assert process.message_count == inline.message_count > 0
+    assert (tmp_path / "process.mcap").read_bytes() == (tmp_path / "inline.mcap").read_bytes()
+
+
+def test_misuse_raises_at_the_call(tmp_path: Path) -> None:
+    with ProcessWriter(tmp_path / "a.mcap", fsync=False) as writer:
+        frame = mavlink_frames(1)[0][1]
+        with pytest.raises(ValueError, match="log_time_ns"):
+            writer.write_mavlink(frame, direction=Direction.IN, log_time_ns=0)
+        with pytest.raises(ValueError, match="log_time_ns"):
+            writer.write_mavlink(frame, direction=Direction.IN, log_time_ns=1 << 64)
+        with pytest.raises(ValueError, match="not a JSON topic"):
+            writer.write_json_bytes("/nope", b"{}", log_time_ns=T0_NS)
+        writer.add_json_topic("/j", schema_name="test.J", schema={"type": "object"})
+        with pytest.raises(ValueError, match="not JSON"):
+            writer.write_json("/j", {"x": float("nan")}, log_time_ns=T0_NS)
+        with pytest.raises(ValueError, match="already carries"):
+            writer.add_json_topic("/j", schema_name="test.K", schema={"type": "object"})
+        topic, value = other_values()[0]
+        writer.write(topic, value, log_time_ns=T0_NS)
+        with pytest.raises(ValueError, match="carries"):
+            writer.write(topic, other_values()[1][1], log_time_ns=T0_NS)  # type: ignore[arg-type]
+        with pytest.raises(ValueError, match="reserved"):
+            writer.add_metadata("uavtool", {})
+    with pytest.raises(ValueError, match="closed"):
+        writer.write_mavlink(frame, direction=Direction.IN, log_time_ns=T0_NS)
+    with pytest.raises(ValueError, match="dialect"):
+        ProcessWriter(tmp_path / "b.mcap", dialect="no_such_dialect")
+    assert not (tmp_path / "b.mcap").exists()
+
+
+def test_a_path_that_cannot_be_created_fails_at_once(tmp_path: Path) -> None:
+    with pytest.raises(RecordingError, match=r"missing/a\.mcap: cannot create"):
+        ProcessWriter(tmp_path / "missing" / "a.mcap")
+
+
+def test_a_full_disk_is_a_recording_error_at_a_later_call_and_at_close() -> None:
+    writer = ProcessWriter("/dev/full", fsync=False)
+    frames = mavlink_frames(50)
+    with pytest.raises(RecordingError, match="/dev/full: cannot write: No space left") as failed:
+        _until_it_fails(writer, frames)
+    with pytest.raises(RecordingError) as again:
+        writer.write_mavlink(frames[0][1], direction=Direction.IN, log_time_ns=T0_NS)
+    assert again.value is failed.value
+    with pytest.raises(RecordingError, match="No space left"):
+        writer.close()
+
+
+def test_a_writer_process_that_dies_is_a_recording_error(tmp_path: Path) -> None:
+    writer = ProcessWriter(tmp_path / "a.mcap", fsync=False)
+    os.kill(writer._proc.pid, signal.SIGKILL)
+    writer._proc.wait()
+    frame = mavlink_frames(1)[0][1]
+    with pytest.raises(RecordingError, match=r"writer process ended unexpectedly \(exit code -9\)"):
+        _until_it_fails(writer, [(Direction.IN, frame)])
+    with pytest.raises(RecordingError, match="ended unexpectedly"):
+        writer.close()
+
+
+def _until_it_fails(writer: ProcessWriter, frames: list[tuple[Direction, bytes]]) -> None:
+    """Write frames, 0.1 s of log time apart (a batch each), until a write raises."""
+    for i in range(100_000):  # the child's failure is heard at a later send
+        direction, frame = frames[i % len(frames)]
+        writer.write_mavlink(frame, direction=direction, log_time_ns=T0_NS + i * 10**8)
+
+
+_FLIGHT = """
+import sys, time
+from tests.recording.sample import mavlink_frames
+from uavtool.recording import ProcessWriter
+frames = mavlink_frames(50)
+writer = ProcessWriter(sys.argv[1])
+print(writer._proc.pid, flush=True)
+i = 0
+while True:
+    direction, frame = frames[i % 50]
+    writer.write_mavlink(frame, direction=direction, log_time_ns=time.time_ns())
+    i += 1
+    time.sleep(0.002)
+"""
+
+
+def test_a_killed_flight_loses_only_the_batch_it_had_not_sent(tmp_path: Path) -> None:
+    path = tmp_path / "killed.mcap"
+    repo = Path(__file__).resolve().parents[2]
+    env = {**os.environ, "PYTHONPATH": str(repo)}
+    flight = subprocess.Popen(
+        [sys.executable, "-c", _FLIGHT, str(path)], stdout=subprocess.PIPE, cwd=repo, env=env
+    )
+    try:
+        assert flight.stdout is not None
+        child = int(flight.stdout.readline())
+        time.sleep(2.5)
+        killed_at_ns = time.time_ns()
+        flight.send_signal(signal.SIGKILL)
+    finally:
+        flight.wait(timeout=30)
+        if flight.stdout is not None:
+            flight.stdout.close()
+    deadline = time.monotonic() + 30
+    while _alive(child) and time.monotonic() < deadline:  # it writes what it was sent
+        time.sleep(0.05)
+    assert not _alive(child)
+    info = summarize(path)
+    assert not info.whole
+    with RecordingReader(path) as reader:
+        last_ns = max(m.log_time_ns for m in reader.messages(["/mavlink/raw"]))
+    lost_s = (killed_at_ns - last_ns) / 1e9
+    assert 0.0 <= lost_s <= BATCH_NS / 1e9 + 0.3, lost_s  # plus scheduling slack
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    # a zombie (its parent, the killed flight, is gone: init reaps it) counts as ended
+    state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    return state != "Z"

@@ -1,0 +1,497 @@
+"""`ProcessWriter`: a `RecordingWriter` in a process of its own, off the flight's path.
+
+A lockstep flight runs as fast as one core allows, and Python's own cost per message (an MCAP
+record of each frame, its JSON view, the telemetry's Protobuf) took a third of it. The
+flight's thread now only checks each call and appends it, as a tuple of what it already holds
+(the frame's bytes, a time), to a batch; every `BATCH_NS` of log time (or `BATCH_CALLS`
+calls) the batch is pickled down a pipe to a child process, which makes the very calls on a
+`RecordingWriter` (decoding each frame again for its JSON view), so the file is the same,
+byte for byte, as one written in the flight's process.
+
+What is kept:
+
+- **Errors where they were.** Misuse (a time <= 0, an unknown topic, a payload that is not
+  JSON) raises `ValueError` at the call, as `RecordingWriter` does. A failure of the writer
+  (the disk full, its process gone) raises `RecordingError` at a later call or at `close`,
+  and from then on at every call.
+- **A crash loses little.** If the flight's process dies (a SIGKILL, a crash), the child
+  reads what was sent up to there, writes it out and stops, leaving the file unfinished:
+  only the batch not yet sent is lost, at most `BATCH_NS` of log time. Ctrl-C does not reach
+  the child (a session of its own): the flight's process decides, as before, what to write
+  last and when to close.
+- **Back pressure.** The pipe holds 1 MiB; a flight that outruns its writer waits for it.
+
+The child is a fresh interpreter (`subprocess`, never a fork: the flight may run threads,
+and in a Dask worker it is a daemon) with the parent's ``sys.path``; it imports the writer
+and pymavlink's dialect only, about 0.15 s of CPU on the other core while the flight starts.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import fcntl
+import json
+import os
+import pickle
+import subprocess
+import sys
+import threading
+import weakref
+from collections.abc import Mapping
+from pathlib import Path
+from types import TracebackType
+from typing import TYPE_CHECKING, Any, BinaryIO, NoReturn
+
+from uavtool.recording.errors import RecordingError, create_file
+from uavtool.recording.schemas import DEFAULT_DIALECT, dialect_module, dumps
+from uavtool.recording.topics import FIX, POSE
+from uavtool.recording.values import Direction, LocationFix, PosesInFrame
+from uavtool.recording.writer import (
+    RecordingWriter,
+    check_metadata,
+    check_topic,
+    foxglove_module,
+)
+
+if TYPE_CHECKING:
+    from uavtool.geo import GeoPoint
+    from uavtool.recording.foxglove import FoxgloveValue
+
+BATCH_NS = 1_000_000_000
+"""Log time a batch may span before it is sent: what a crash of the flight may lose. Each
+send wakes the child on another core, about 50 us in a virtual machine: a lockstep flight
+sends ~230 batches, not ~900 as it would every quarter second."""
+BATCH_CALLS = 2048
+"""Calls a batch may hold before it is sent."""
+PIPE_BYTES = 1 << 20
+
+# the calls, as the first item of each tuple in a batch (most frequent first)
+_MAV_IN, _MAV_OUT, _VEHICLE, _PROTO, _JSON, _PROTO_TOPIC, _JSON_TOPIC, _METADATA, _FLUSH, _CLOSE = (
+    range(10)
+)
+_END_NS = 1 << 64
+_CHILD = (
+    "import sys, json; sys.path[:] = json.loads(sys.argv[1]); "
+    "from uavtool.recording.process import serve; serve()"
+)
+
+
+def core_to_spare() -> bool:
+    """Whether a writer process would find a core of its own: at least two cores for this
+    process, and a load average (last minute) below their number less one half. Otherwise
+    it only adds its work to a busy machine, and the flight waits for it at the end."""
+    try:
+        cores = len(os.sched_getaffinity(0))
+        load = os.getloadavg()[0]
+    except (AttributeError, OSError):
+        return False
+    return cores >= 2 and load < cores - 0.5
+
+
+def _check_time(t: Any, what: str = "log_time_ns") -> None:
+    if type(t) is not int or not 0 < t < _END_NS:
+        raise ValueError(f"{what} must be a positive int that fits 64 bits, got {t!r}")
+
+
+class ProcessWriter:
+    """`RecordingWriter`'s writes, made by a child process (the module docstring says how).
+    Arguments as `RecordingWriter`'s; the file is created here, so a path that cannot be
+    written raises `RecordingError` at once. Use as a context manager; safe to share between
+    threads."""
+
+    def __init__(
+        self,
+        path: str | Path,
+        *,
+        metadata: Mapping[str, Mapping[str, str]] | None = None,
+        dialect: str = DEFAULT_DIALECT,
+        chunk_interval_ns: int = 1_000_000_000,
+        chunk_bytes: int = 1 << 20,
+        fsync: bool = True,
+    ) -> None:
+        dialect_module(dialect)  # ValueError before a file exists, as RecordingWriter
+        for name, record in (metadata or {}).items():
+            check_metadata(name, record)
+        self.dialect = dialect
+        self.path = Path(path)
+        self._lock = threading.Lock()
+        self._batch: list[tuple[Any, ...]] = []
+        self._ship_at = 0  # log time from which the next call sends the batch
+        self._pending = bytearray()  # pickled batches not yet in the pipe (Ctrl-C mid-write)
+        self._json_topics: set[str] = set()
+        self._topic_kind: dict[str, Any] = {}  # topic -> value type or JSON schema name
+        self._protobuf_topics: set[str] = set()  # topics whose schema the child was sent
+        self._vehicle = False  # write_vehicle was called
+        self._failure: RecordingError | None = None
+        self._closed = False
+        self._message_count = 0
+        file = create_file(self.path)
+        try:
+            self._proc = _spawn(file)
+            init = (
+                str(self.path),
+                file.fileno(),
+                {k: dict(v) for k, v in (metadata or {}).items()},
+                dialect,
+                chunk_interval_ns,
+                chunk_bytes,
+                fsync,
+            )
+        finally:
+            file.close()  # the child has its own descriptor
+        assert self._proc.stdin is not None
+        assert self._proc.stdout is not None
+        self._out = self._proc.stdin.fileno()
+        self._replies = self._proc.stdout
+        # dropped without close(): the child still ends (and keeps what it was sent)
+        self._finalizer = weakref.finalize(self, _abandon, self._proc)
+        self._send(pickle.dumps(init, protocol=pickle.HIGHEST_PROTOCOL))
+
+    # --- lifecycle ---------------------------------------------------------------------------
+
+    def __enter__(self) -> ProcessWriter:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        try:
+            self.close()
+        except RecordingError:
+            if not (isinstance(exc, RecordingError) and exc.path == str(self.path)):
+                raise
+
+    @property
+    def message_count(self) -> int:
+        """Messages in the file: known once it is closed (0 before)."""
+        return self._message_count
+
+    def flush(self) -> None:
+        """Send what is batched and wait until the child has closed its chunk and put it on
+        disk (`RecordingWriter.flush`)."""
+        with self._lock:
+            self._check_open()
+            self._batch.append((_FLUSH,))
+            self._ship(0)
+            self._reply()
+
+    def close(self) -> None:
+        """Send the rest, let the child write the summary, fsync and close the file, and wait
+        for it. Idempotent; raises `RecordingError` if anything failed (the file is then not
+        whole)."""
+        with self._lock:
+            if self._closed:
+                return
+            self._closed = True
+            try:
+                if self._failure is None:
+                    self._batch.append((_CLOSE,))
+                    self._ship(0)
+                    reply = self._reply()
+                    self._message_count = int(reply[1])
+            finally:
+                self._finalizer()
+            if self._failure is not None:
+                raise self._failure
+
+    # --- metadata and channels ---------------------------------------------------------------
+
+    def add_metadata(self, name: str, record: Mapping[str, str]) -> None:
+        check_metadata(name, record)
+        with self._lock:
+            self._check_open()
+            self._batch.append((_METADATA, name, dict(record)))
+            self._ship(0)
+
+    def add_json_topic(self, topic: str, *, schema_name: str, schema: Mapping[str, Any]) -> None:
+        check_topic(topic)
+        with self._lock:
+            self._check_open()
+            known = self._topic_kind.get(topic)
+            if known is not None:
+                if known != schema_name:
+                    raise ValueError(f"topic {topic!r} already carries {known!r}")
+                return
+            self._topic_kind[topic] = schema_name
+            self._json_topics.add(topic)
+            self._batch.append((_JSON_TOPIC, topic, schema_name, json.loads(dumps(schema))))
+
+    # --- writes ------------------------------------------------------------------------------
+
+    def write_json(
+        self,
+        topic: str,
+        payload: Mapping[str, Any],
+        *,
+        log_time_ns: int,
+        publish_time_ns: int | None = None,
+    ) -> None:
+        try:
+            data = dumps(payload)
+        except (ValueError, TypeError) as exc:
+            raise ValueError(f"topic {topic!r}: payload is not JSON: {exc}") from exc
+        self.write_json_bytes(topic, data, log_time_ns=log_time_ns, publish_time_ns=publish_time_ns)
+
+    def write_json_bytes(
+        self,
+        topic: str,
+        data: bytes,
+        *,
+        log_time_ns: int,
+        publish_time_ns: int | None = None,
+    ) -> None:
+        _check_time(log_time_ns)
+        if publish_time_ns is not None:
+            _check_time(publish_time_ns, "publish_time_ns")
+        with self._lock:
+            self._check_open()
+            if topic not in self._json_topics:
+                raise ValueError(f"topic {topic!r} is not a JSON topic: call add_json_topic first")
+            self._batch.append((_JSON, topic, data, log_time_ns, publish_time_ns))
+            if log_time_ns >= self._ship_at or len(self._batch) >= BATCH_CALLS:
+                self._ship(log_time_ns)
+
+    def write(
+        self,
+        topic: str,
+        value: FoxgloveValue,
+        *,
+        log_time_ns: int,
+        publish_time_ns: int | None = None,
+    ) -> None:
+        check_topic(topic)
+        _check_time(log_time_ns)
+        if publish_time_ns is not None:
+            _check_time(publish_time_ns, "publish_time_ns")
+        kind = type(value)
+        foxglove = foxglove_module()
+        data = foxglove.encode(value, log_time_ns)
+        with self._lock:
+            self._check_open()
+            if topic not in self._protobuf_topics:
+                self._check_kind(topic, kind)
+                self._protobuf_topics.add(topic)
+                schema = (foxglove.schema_name(kind), foxglove.schema_data(kind))
+                self._batch.append((_PROTO_TOPIC, topic, *schema))
+            elif self._topic_kind[topic] is not kind:
+                raise ValueError(f"topic {topic!r} carries {self._topic_kind[topic]!r}, not {kind}")
+            self._batch.append((_PROTO, topic, data, log_time_ns, publish_time_ns))
+            if log_time_ns >= self._ship_at or len(self._batch) >= BATCH_CALLS:
+                self._ship(log_time_ns)
+
+    def write_mavlink(
+        self,
+        frame: bytes,
+        *,
+        direction: Direction,
+        log_time_ns: int,
+        publish_time_ns: int | None = None,
+        decoded: Any = None,  # noqa: ARG002 - the child decodes the frame itself
+    ) -> None:
+        """`RecordingWriter.write_mavlink`; ``decoded`` is not used: the child decodes the
+        frame for its JSON view (on another core)."""
+        if type(log_time_ns) is not int or not 0 < log_time_ns < _END_NS:
+            _check_time(log_time_ns)
+        if publish_time_ns is not None:
+            _check_time(publish_time_ns, "publish_time_ns")
+        if type(frame) is not bytes:
+            frame = bytes(frame)
+        op = _MAV_IN if direction is Direction.IN else _MAV_OUT
+        with self._lock:
+            if self._closed or self._failure is not None:
+                self._check_open()
+            batch = self._batch
+            batch.append((op, frame, log_time_ns, publish_time_ns))
+            if log_time_ns >= self._ship_at or len(batch) >= BATCH_CALLS:
+                self._ship(log_time_ns)
+
+    def write_vehicle(
+        self,
+        pos_enu_m: tuple[float, float, float],
+        heading_deg: float,
+        origin: GeoPoint | None,
+        *,
+        log_time_ns: int,
+    ) -> None:
+        """`RecordingWriter.write_vehicle`: the child makes the pose and the fix."""
+        _check_time(log_time_ns)
+        with self._lock:
+            self._check_open()
+            if not self._vehicle:  # the topics it writes carry these from now on
+                self._vehicle = True
+                self._check_kind(POSE, PosesInFrame)
+                self._check_kind(FIX, LocationFix)
+            self._batch.append((_VEHICLE, pos_enu_m, heading_deg, origin, log_time_ns))
+            if log_time_ns >= self._ship_at or len(self._batch) >= BATCH_CALLS:
+                self._ship(log_time_ns)
+
+    # --- internals (called with the lock held) -----------------------------------------------
+
+    def _check_kind(self, topic: str, kind: Any) -> None:
+        """Raise `ValueError` if ``topic`` carries another kind; else it carries ``kind``."""
+        known = self._topic_kind.setdefault(topic, kind)
+        if known is not kind:
+            raise ValueError(f"topic {topic!r} carries {known!r}, not {kind}")
+
+    def _check_open(self) -> None:
+        if self._failure is not None:
+            raise self._failure
+        if self._closed:
+            raise ValueError(f"{self.path}: the recording is closed")
+
+    def _ship(self, log_time_ns: int) -> None:
+        """Send the batch down the pipe (waiting if the pipe is full); a child that ended
+        shows as a broken pipe."""
+        batch, self._batch = self._batch, []
+        self._ship_at = log_time_ns + BATCH_NS
+        self._send(pickle.dumps(batch, protocol=pickle.HIGHEST_PROTOCOL))
+
+    def _send(self, data: bytes) -> None:
+        pending = self._pending
+        pending += data
+        try:
+            while pending:
+                del pending[: os.write(self._out, pending)]
+        except BrokenPipeError:
+            self._child_ended()
+        except OSError as exc:
+            self._fail(f"cannot hand the recording to its writer process: {exc.strerror or exc}")
+        # anything else (Ctrl-C mid-write) leaves the rest in _pending: the next send ends it
+
+    def _reply(self) -> tuple[Any, ...]:
+        """The child's answer to a flush or close; raises its failure."""
+        try:
+            reply = pickle.load(self._replies)
+        except (EOFError, pickle.UnpicklingError, OSError):
+            self._child_ended()
+        if reply[0] == "error":
+            self._fail(reply[2], reply[1])
+        return tuple(reply)
+
+    def _child_ended(self) -> NoReturn:
+        """The child stopped early: raise its reason, or say how it ended."""
+        with contextlib.suppress(EOFError, pickle.UnpicklingError, OSError):
+            reply = pickle.load(self._replies)
+            if reply[0] == "error":
+                self._fail(reply[2], reply[1])
+        code = self._proc.wait()
+        self._fail(f"the recording's writer process ended unexpectedly (exit code {code})")
+
+    def _fail(self, problem: str, path: str | None = None) -> NoReturn:
+        if self._failure is None:
+            self._failure = RecordingError(path or self.path, problem)
+        raise self._failure
+
+
+def _spawn(file: BinaryIO) -> subprocess.Popen[bytes]:
+    try:
+        proc = subprocess.Popen(
+            [sys.executable, "-c", _CHILD, json.dumps(sys.path)],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            pass_fds=(file.fileno(),),
+            start_new_session=True,  # Ctrl-C is the flight's to handle, not the writer's
+            bufsize=0,
+        )
+    except OSError as exc:
+        raise RecordingError(
+            file.name, f"cannot start the recording's writer process: {exc.strerror or exc}"
+        ) from exc
+    assert proc.stdin is not None
+    with contextlib.suppress(OSError):  # a smaller pipe only makes the flight wait sooner
+        fcntl.fcntl(proc.stdin.fileno(), fcntl.F_SETPIPE_SZ, PIPE_BYTES)
+    return proc
+
+
+def _abandon(proc: subprocess.Popen[bytes]) -> None:
+    """End the pipe (the child then writes what it holds and exits) and reap the child."""
+    for stream in (proc.stdin, proc.stdout):
+        if stream is not None:
+            with contextlib.suppress(OSError):
+                stream.close()
+    proc.wait()
+
+
+# --- the child ----------------------------------------------------------------------------------
+
+
+def serve() -> None:
+    """The child's loop: an init tuple, then batches of calls on stdin; replies on stdout."""
+    replies = os.fdopen(os.dup(1), "wb", buffering=0)
+    sys.stdout = sys.stderr  # stdout carries replies only
+    source = sys.stdin.buffer
+
+    def reply(*answer: Any) -> None:
+        replies.write(pickle.dumps(answer, protocol=pickle.HIGHEST_PROTOCOL))
+
+    path, fd, metadata, dialect, interval_ns, budget, fsync = pickle.load(source)
+    try:
+        writer = RecordingWriter(
+            path,
+            metadata=metadata,
+            dialect=dialect,
+            chunk_interval_ns=interval_ns,
+            chunk_bytes=budget,
+            fsync=fsync,
+            file=os.fdopen(fd, "wb"),
+        )
+        _serve(writer, source, reply)
+    except RecordingError as exc:
+        reply("error", exc.path, exc.problem)
+    except Exception as exc:  # whatever it is, the flight must hear of it
+        reply("error", path, f"the recording's writer failed: {type(exc).__name__}: {exc}")
+
+
+def _serve(writer: Any, source: Any, reply: Any) -> None:
+    protobuf: dict[str, tuple[str, bytes]] = {}  # topic -> (schema name, schema)
+    write_mavlink, write_json, write_protobuf = (
+        writer.write_mavlink,
+        writer.write_json_bytes,
+        writer.write_protobuf,
+    )
+    inbound, outbound = Direction.IN, Direction.OUT
+    while True:
+        try:
+            batch = pickle.load(source)
+        except (EOFError, pickle.UnpicklingError, OSError):
+            # the flight's process ended without closing: keep what it sent, leave the file
+            # unfinished (uavtool info --recover reads it)
+            writer.flush()
+            return
+        for call in batch:
+            op = call[0]
+            if op <= _MAV_OUT:  # _MAV_IN or _MAV_OUT
+                direction = inbound if op == _MAV_IN else outbound
+                write_mavlink(
+                    call[1], direction=direction, log_time_ns=call[2], publish_time_ns=call[3]
+                )
+            elif op == _VEHICLE:
+                writer.write_vehicle(call[1], call[2], call[3], log_time_ns=call[4])
+            elif op == _PROTO:
+                name, schema = protobuf[call[1]]
+                write_protobuf(
+                    call[1],
+                    call[2],
+                    schema_name=name,
+                    schema=schema,
+                    log_time_ns=call[3],
+                    publish_time_ns=call[4],
+                )
+            elif op == _JSON:
+                write_json(call[1], call[2], log_time_ns=call[3], publish_time_ns=call[4])
+            elif op == _PROTO_TOPIC:
+                protobuf[call[1]] = (call[2], call[3])
+            elif op == _JSON_TOPIC:
+                writer.add_json_topic(call[1], schema_name=call[2], schema=call[3])
+            elif op == _METADATA:
+                writer.add_metadata(call[1], call[2])
+            elif op == _FLUSH:
+                writer.flush()
+                reply("flushed")
+            elif op == _CLOSE:
+                writer.close()
+                reply("closed", writer.message_count)
+                return
