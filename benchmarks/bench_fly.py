@@ -4,6 +4,9 @@ at the speed of the flight"), in one run, as ratios:
 
 - ``fly`` (records to ``recordings/``), goal <= 1.0 s;
 - ``fly --no-record``, and the recording's share of ``fly`` over it, goal <= 10 %;
+- ``fly`` with each writer forced (``uavtool fly`` picks one by the machine's load: a writer
+  process when a core is free, else the flight's own thread; the file is the same), today
+  only;
 - ``fly --no-record --rerun FILE.rrd`` (today at its default pace; the baseline needed
   ``--speedup max`` for that, and took the flight's vehicle time, ~229 s, without it);
 - ``replay --check recordings/golden/paper.mcap``, goal <= 0.5 s (the baseline replays its
@@ -41,11 +44,17 @@ import time
 from io import BytesIO
 from pathlib import Path
 
+from uavtool.recording.process import core_to_spare
 from uavtool.runner.fly import FlyConfig, fly
 
 ROOT = Path(__file__).resolve().parents[1]
 BASELINE = "675267c"
 GOLDEN = "recordings/golden/paper.mcap"
+# ``uavtool ARGS`` with fly's choice of writer forced (``spare``: whether a core is free)
+_FORCED = (
+    "import sys, uavtool.runner.fly as f; f.core_to_spare = lambda: {spare}; "
+    "from uavtool.cli import main; sys.argv[0] = 'uavtool'; main()"
+)
 
 
 def extract(commit: str, into: Path) -> Path:
@@ -68,13 +77,21 @@ def extract(commit: str, into: Path) -> Path:
     return into
 
 
+def uavtool(*args: str, spare: bool | None = None) -> list[str]:
+    """Python's arguments for ``uavtool ARGS``; ``spare``: force fly's choice of writer."""
+    if spare is None:
+        return ["-m", "uavtool", *args]
+    return ["-c", _FORCED.format(spare=spare), *args]
+
+
 def run(
     args: list[str], *, cwd: Path, pycache: Path, pythonpath: Path | None = None
 ) -> tuple[float, float, str | None]:
-    """(wall seconds, CPU seconds, None) of ``uavtool ARGS`` in a fresh process, or (nan,
-    nan, why) if it failed: the last line it wrote to stderr. CPU is user + system time of
-    the process and its threads, which other work on the machine changes much less than
-    the wall time. Bytecode is cached under ``pycache``."""
+    """(wall seconds, CPU seconds, None) of ``python ARGS`` (see `uavtool`) in a fresh
+    process, or (nan, nan, why) if it failed: the last line it wrote to stderr. CPU is user +
+    system time of the process, its threads and its children (the writer process), which
+    other work on the machine changes much less than the wall time. Bytecode is cached under
+    ``pycache``."""
     env = dict(os.environ)
     env.pop("PYTHONDONTWRITEBYTECODE", None)
     env["PYTHONPYCACHEPREFIX"] = str(pycache)
@@ -83,7 +100,7 @@ def run(
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     done = subprocess.run(
-        [sys.executable, "-m", "uavtool", *args],
+        [sys.executable, *args],
         check=False,
         capture_output=True,
         text=True,
@@ -120,6 +137,10 @@ def _commit(rev: str) -> str:
     return name
 
 
+def _writer(spare: bool) -> str:
+    return "a writer process" if spare else "the flight's thread"
+
+
 def _load() -> str:
     return ", ".join(f"{v:.2f}" for v in os.getloadavg())
 
@@ -140,41 +161,49 @@ def main() -> None:
         tmp = Path(tmp_text)
         base = extract(args.baseline, tmp / "baseline")
         rrd = str(tmp / "live.rrd")
-        commands = {
-            "fly": (["fly", "-q"], ["fly", "-q"]),
-            "fly --no-record": (["fly", "-q", "--no-record"], ["fly", "-q", "--no-record"]),
+        # name -> (today's arguments, the baseline's or None: not run there)
+        commands: dict[str, tuple[list[str], list[str] | None]] = {
+            "fly": (uavtool("fly", "-q"), uavtool("fly", "-q")),
+            "fly --no-record": (
+                uavtool("fly", "-q", "--no-record"),
+                uavtool("fly", "-q", "--no-record"),
+            ),
+            "fly, writer process": (uavtool("fly", "-q", spare=True), None),
+            "fly, writer in thread": (uavtool("fly", "-q", spare=False), None),
             "fly --rerun FILE.rrd": (
-                ["fly", "-q", "--no-record", "--rerun", rrd],
-                ["fly", "-q", "--no-record", "--rerun", rrd, "--speedup", "max"],
+                uavtool("fly", "-q", "--no-record", "--rerun", rrd),
+                uavtool("fly", "-q", "--no-record", "--rerun", rrd, "--speedup", "max"),
             ),
             "replay --check": (
-                ["replay", "--check", golden],
-                ["replay", "--check", str(base / GOLDEN)],
+                uavtool("replay", "--check", golden),
+                uavtool("replay", "--check", str(base / GOLDEN)),
             ),
-            "--version": (["--version"], ["--version"]),
+            "--version": (uavtool("--version"), uavtool("--version")),
         }
         today: dict[str, list[float]] = {k: [] for k in commands}
         then: dict[str, list[float]] = {k: [] for k in commands}
         today_cpu: dict[str, list[float]] = {k: [] for k in commands}
         then_cpu: dict[str, list[float]] = {k: [] for k in commands}
         failed: dict[str, str] = {}  # the baseline's failures (e.g. on a newer Python)
-        load_before = _load()
+        load_before, spare_before = _load(), core_to_spare()
         for i in range(n + 1):  # round 0 fills the bytecode caches: not counted
             for name, (now_args, base_args) in commands.items():
                 t, cpu, why = run(now_args, cwd=tmp, pycache=tmp / "pyc-today")
                 if why is not None:
                     raise SystemExit(f"uavtool {' '.join(now_args)} failed: {why}")
-                t_base, cpu_base, why = run(
-                    base_args, cwd=tmp, pycache=tmp / "pyc-base", pythonpath=base
-                )
-                if why is not None:
-                    failed[name] = why
+                t_base = cpu_base = math.nan
+                if base_args is not None:
+                    t_base, cpu_base, why = run(
+                        base_args, cwd=tmp, pycache=tmp / "pyc-base", pythonpath=base
+                    )
+                    if why is not None:
+                        failed[name] = why
                 if i:
                     today[name].append(t)
                     then[name].append(t_base)
                     today_cpu[name].append(cpu)
                     then_cpu[name].append(cpu_base)
-        load_after = _load()
+        load_after, spare_after = _load(), core_to_spare()
         size = max(p.stat().st_size for p in (tmp / "recordings").glob("*.mcap"))
         flights = []
         for i in range(n):  # the flight alone, in this process: no start-up, recording on
@@ -187,10 +216,18 @@ def main() -> None:
         f"  today {_commit('HEAD')}, baseline {_commit(args.baseline)}; Python {python}, "
         f"{os.cpu_count()} cores, load average {load_before} before, {load_after} after"
     )
+    print(
+        "  fly's writer by the load: "
+        + ", ".join(_writer(spare) for spare in (spare_before, spare_after))
+        + " (before, after)"
+    )
     for what, now_s, base_s in (("wall", today, then), ("CPU", today_cpu, then_cpu)):
         print(f"  {what:<22} {'today':>8} {args.baseline:>8} {'ratio':>7}   runs today | baseline")
         for name in commands:
             a, b = med(now_s[name]), med(base_s[name])
+            if math.isnan(b):  # not run on the baseline
+                print(f"  {name:<22} {a:7.2f}s {'-':>8} {'-':>7}   {_runs(now_s[name])}")
+                continue
             print(
                 f"  {name:<22} {a:7.2f}s {b:7.2f}s {a / b:6.3f}x   "
                 f"{_runs(now_s[name])} | {_runs(base_s[name])}"
@@ -198,20 +235,20 @@ def main() -> None:
     for name, why in failed.items():  # no ratio for it (nan): say why
         print(f"  {args.baseline} failed '{name}' on Python {python}: {why}")
     fly_s, bare_s = med(today["fly"]), med(today["fly --no-record"])
-    share = fly_s / bare_s - 1.0
     base_share = med(then["fly"]) / med(then["fly --no-record"]) - 1.0
+    base_cpu_share = med(then_cpu["fly"]) / med(then_cpu["fly --no-record"]) - 1.0
     check_s = med(today["replay --check"])
     print(f"  goal fly <= 1.0 s: {_goal(fly_s, 1.0)} ({fly_s:.2f} s)")
     print(
-        f"  recording's share of fly over --no-record: {share * 100:+.1f} % "
-        f"(baseline {base_share * 100:+.1f} %); goal <= 10 %: {_goal(share, 0.10)}; "
-        f"file {size / 1e6:.2f} MB"
+        f"  recording's share over --no-record (goal <= 10 %), wall and CPU: baseline "
+        f"{base_share * 100:+.1f} %, {base_cpu_share * 100:+.1f} %; file {size / 1e6:.2f} MB"
     )
-    cpu_share = med(today_cpu["fly"]) / med(today_cpu["fly --no-record"]) - 1.0
-    base_cpu_share = med(then_cpu["fly"]) / med(then_cpu["fly --no-record"]) - 1.0
-    print(
-        f"  the same in CPU time: {cpu_share * 100:+.1f} % (baseline {base_cpu_share * 100:+.1f} %)"
-    )
+    for name in ("fly", "fly, writer process", "fly, writer in thread"):
+        share = med(today[name]) / bare_s - 1.0
+        cpu_share = med(today_cpu[name]) / med(today_cpu["fly --no-record"]) - 1.0
+        print(
+            f"    {name:<22} {share * 100:+6.1f} %, {cpu_share * 100:+6.1f} %: {_goal(share, 0.10)}"
+        )
     print(f"  goal replay --check <= 0.5 s: {_goal(check_s, 0.5)} ({check_s:.2f} s)")
     rate, vehicle_s, wall_s = sorted(flights)[n // 2]
     print(
