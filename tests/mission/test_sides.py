@@ -4,8 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from uavtool.camera import Intrinsics
+from uavtool.camera import CameraPose, Intrinsics, project
 from uavtool.mission import Status
+from uavtool.mission.observations import Photo
+from uavtool.mission.sides import _in_line
+from uavtool.nav import Rect
 from uavtool.runner.fly import FlyConfig, fly
 from uavtool.vision import Shape
 from uavtool.vision.shapes import cut_edges
@@ -37,3 +40,26 @@ def test_a_stepped_tower_taller_than_its_outline_is_photographed_whole() -> None
     assert e.matched_building == "red" and o.model_built
     assert e.model_iou is not None and e.model_iou > 0.55
     assert summary.clearance_m is not None and summary.clearance_m > 4.0
+
+
+def test_a_tower_merged_with_one_behind_it_is_cut_back_to_where_it_stands() -> None:
+    """A camera looking down from 60 m, 40 m south of a 10 m square tower 30 m tall: the
+    tower stands in the box its footprint and height project to. A tower of its colour
+    behind it shows above it in the photo, merged into one outline cut by the frame's top.
+    With the height measured, the silhouette is cut back to the box and touches no edge
+    (no other building's top to chase); with the height only assumed, it stays as seen.
+    A neighbour of the colour beside the box, mostly out of it, is no part of it."""
+    rect = Rect((0.0, 0.0), 0.0, 10.0, 10.0)
+    pose = CameraPose((0.0, -45.0, 60.0), 0.0, -40.0)
+    photo = Photo(0, 0, "front", 0, pose, K, np.zeros((480, 640, 3), np.uint8))
+    box = project(np.array([(x, y, z) for z in (0.0, 30.0) for x, y in rect.corners()]), pose, K)
+    u0, v0 = box[:, 0].min(), box[:, 1].min()
+    u1, v1 = box[:, 0].max(), box[:, 1].max()
+    merged = _box(u0 + 5, 0, u1 - 5, v1 - 5)  # the tower and the one behind, up to the top
+    beside = _box(5, v0 + 10, u0 - 5, v1)
+    assert merged.cut_by_border
+    (kept,) = _in_line((merged, beside), rect, photo, 30.0)
+    assert kept is merged
+    (cut,) = _in_line((merged, beside), rect, photo, 30.0, clip=True)
+    assert not cut.cut_by_border and cut_edges((cut,), K) == set()
+    assert cut.polygon_px[:, 1].min() > v0 - 0.11 * max(u1 - u0, v1 - v0) - 1.0

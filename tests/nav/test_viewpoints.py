@@ -141,6 +141,22 @@ def test_blocked_square_on_the_camera_turns_around_the_building() -> None:
     assert min(point_polygon_distance(cam, w) for w in walls) >= P.safety_margin_m
 
 
+def test_a_right_camera_turned_round_looks_far_enough_from_the_front_one() -> None:
+    """Every side hidden square on: the front camera turns +25° (heading 335°); with the
+    right's +25° places taken, its first fit is turned -25°, 40° from the front's direction.
+    Asked for 60° apart (the model's least separation), it turns +45° instead (110°)."""
+    wall = [(-1.0, -12.0), (1.0, -12.0), (1.0, -11.0), (-1.0, -11.0)]
+    post = [(12.0, -1.0), (13.0, -1.0), (13.0, 1.0), (12.0, 1.0)]
+    walls = [wall, [(x, -y) for x, y in wall], post, [(-x, y) for x, y in post]]
+    taken = [square(16.3, 7.6, 2.0), square(-16.3, -7.6, 2.0)]
+    params = ViewpointParams(max_distance_m=40.0)
+    for apart, heading in ((0.0, 295.0), (60.0, 225.0)):
+        front, right = plan_viewpoints(BOX, walls + taken, K, params, None, apart)
+        assert isinstance(front, Viewpoint) and front.heading_deg == pytest.approx(335.0)
+        assert isinstance(right, Viewpoint), right
+        assert right.heading_deg == pytest.approx(heading)
+
+
 def test_obstacles_by_both_long_side_cameras_give_a_larger_distance() -> None:
     # 3 m east of each base camera position, outside the line of sight; clear at 1.25 × D0
     posts = [

@@ -70,7 +70,8 @@ def photograph_and_model(
     rect = min_area_rect(footprint)
     around = obstacles_around(m, seen, found.poi.shape_index)
     others = [f for f, _ in around]
-    front, right = plan_viewpoints(rect, others, k, vp_params, [h for _, h in around])
+    apart = m.params.model.min_view_separation_deg
+    front, right = plan_viewpoints(rect, others, k, vp_params, [h for _, h in around], apart)
     front_heading = (
         front.heading_deg if isinstance(front, Viewpoint) else (rect.long_axis_deg + 90.0) % 360.0
     )
@@ -113,7 +114,7 @@ def photograph_and_model(
         obj.polygon_px, top_photo.pose, top_photo.intrinsics, plane_z_m=found.roof_m
     )
     rect = min_area_rect(footprint)
-    front, right = plan_viewpoints(rect, obstacles, top_photo.intrinsics, vp_params, heights)
+    front, right = plan_viewpoints(rect, obstacles, top_photo.intrinsics, vp_params, heights, apart)
     m.viewpoints = Viewpoints(footprint, top, front, right)
     m.emit(m.viewpoints)
 
@@ -128,6 +129,7 @@ def photograph_and_model(
         vp_params,
         transit_m,
         heights=heights,
+        height_known=found.roof_measured,
     )
     views: dict[str, View] = {}
     taken: dict[str, Viewpoint] = {}

@@ -44,6 +44,8 @@ class Found:
     roof_m: float
     """The roof's height, measured again from the look (closer, so more precise) when it
     could be, else the point of interest's."""
+    roof_measured: bool = False
+    """Whether ``roof_m`` was measured (else it is the height assumed)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -150,7 +152,14 @@ def search(
             roof = roof_between(seen, overview, shape, look.photo)
             if roof is None or roof > p.assumed_roof_m:  # beyond the tallest expected: a
                 roof = yield from _measure_from_lower(m, k, poi, look, shape)  # mismatch
-            best = Found(poi, look.photo, shape, j.score, poi.roof_m if roof is None else roof)
+            best = Found(
+                poi,
+                look.photo,
+                shape,
+                j.score,
+                poi.roof_m if roof is None else roof,
+                roof is not None or poi.roof_measured,
+            )
             if not p.visit_all:
                 todo = _rivals(m, pois, todo, k)
     if best is None:
@@ -191,13 +200,23 @@ def _measure_from_lower(
 ) -> Wait[float | None]:
     """The matched roof's height when the overview could not tell it (cut by its border):
     one more photo straight below the look, ``overview_climb_m`` lower (never closer than
-    ``min_above_roof_m`` over the roof as assumed), compared with the look by size."""
+    ``min_above_roof_m`` over the roof as assumed, nor below the floor there), compared with
+    the look by size; straight above it instead (never above the ceiling) when the floor
+    there — the highest a roof of unknown height, this one too, may be — allows no lower
+    photo."""
     p = m.params.mission
     x, y, alt = look.photo.pose.pos_enu_m
     lower = max(alt - p.overview_climb_m, poi.roof_m + p.min_above_roof_m, m.floor_at(x, y))
-    if shape.cut_by_border or lower > alt - p.overview_climb_m / 2.0:
+    higher = min(alt + p.overview_climb_m, m.ceiling_m if m.ceiling_m is not None else alt)
+    if shape.cut_by_border:
         return None
-    yield from m.move((x, y, lower), None, f"point of interest {k}, measuring its roof")
+    if lower <= alt - p.overview_climb_m / 2.0:
+        there = lower
+    elif higher >= alt + p.overview_climb_m / 2.0:
+        there = higher
+    else:
+        return None
+    yield from m.move((x, y, there), None, f"point of interest {k}, measuring its roof")
     photo = yield from m.photo(f"poi-{k}-roof", -90.0)
     candidate = aimed_shape(m.params, photo_shapes(m, photo), photo.intrinsics, shape.colour_rgb)
     if candidate is None:
@@ -208,7 +227,8 @@ def _measure_from_lower(
         f"point of interest {k}: roof "
         + (f"{roof:.1f} m above home" if roof is not None else "height not measurable"),
     )
-    return roof if roof is not None and roof <= p.assumed_roof_m else None
+    # Taller than expected is believed (a tower): the side photos then stand further off.
+    return roof if roof is not None and roof < min(alt, there) - 1.0 else None
 
 
 def _look(

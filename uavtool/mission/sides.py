@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+import shapely
 
 from uavtool.camera import CameraPose, Intrinsics, project
 from uavtool.mission.observations import Photo
@@ -34,7 +35,7 @@ from uavtool.nav.geometry import point_polygon_distance
 from uavtool.nav.viewpoints import foot_hidden
 from uavtool.vision import Shape
 from uavtool.vision.model3d import View, same_colour
-from uavtool.vision.shapes import cut_edges
+from uavtool.vision.shapes import EDGE_PX, cut_edges
 
 if TYPE_CHECKING:
     from uavtool.mission.base import Wait
@@ -71,6 +72,9 @@ class SidePlan:
     heights: list[float] = dataclasses.field(default_factory=list)
     """Each of ``obstacles``' roof heights (``math.inf`` where not measured): a camera
     looking down may see the building's top over a lower one. Empty: as tall as any."""
+    height_known: bool = False
+    """The building's height was measured: no part of it stands above the height planned
+    for (``params.assumed_height_m``)."""
 
     def sight(self) -> tuple[list[Ring], list[float] | None]:
         """The footprints a camera must see past, with their heights (None: unknown)."""
@@ -151,6 +155,8 @@ def side_view(
             same_colour(shapes, colour_rgb, hue_tolerance_deg=SIDE_HUE_TOLERANCE_DEG),
             plan.rect,
             photo,
+            plan.params.assumed_height_m,
+            clip=plan.height_known,
         )
         edges = cut_edges(silhouette, photo.intrinsics)
         if not edges or attempt == p.max_looks:
@@ -183,22 +189,73 @@ def side_view(
     return View(silhouette, photo.pose, photo.intrinsics, foot_hidden=hidden), vp
 
 
-def _in_line(shapes: tuple[Shape, ...], rect: Rect, photo: Photo) -> tuple[Shape, ...]:
-    """The shapes across the image columns where the building stands (its footprint's corners
-    projected, a tenth of that span to spare): a building of a close colour beside or far
-    behind it is not part of its silhouette. All of them when none is there."""
-    corners = np.array([(x, y, photo.pose.pos_enu_m[2]) for x, y in rect.corners()])
+def _in_line(
+    shapes: tuple[Shape, ...], rect: Rect, photo: Photo, height_m: float, *, clip: bool = False
+) -> tuple[Shape, ...]:
+    """The shapes that overlap where the building stands in the photo: the outline, in the
+    image, of its footprint's box from the ground up to ``height_m`` (a camera looking down
+    sees the box's sides converge, so no span of columns tells), grown by a tenth each way:
+    those mostly inside it (``_IN_VIEW``). A building of a close colour beside or far behind
+    it is not part of its silhouette. All of them when none is, or the camera stands over
+    the footprint. With ``clip`` (the height is measured), a shape cut by the frame and
+    reaching out of the box is cut back to it: past it, the photo merged another building
+    of its colour with it (towers stand behind one another, seen from above)."""
+    corners = np.array(
+        [(x, y, z) for z in (0.0, height_m) for x, y in rect.corners()], dtype=np.float64
+    )
     uvz = project(corners, photo.pose, photo.intrinsics)
     if np.any(uvz[:, 2] <= 0.0):
-        return shapes  # the camera stands over the footprint: no columns to tell by
-    lo, hi = float(uvz[:, 0].min()), float(uvz[:, 0].max())
-    spare = 0.1 * (hi - lo)
-    kept = tuple(
-        s
-        for s in shapes
-        if s.polygon_px[:, 0].max() >= lo - spare and s.polygon_px[:, 0].min() <= hi + spare
-    )
-    return kept or shapes
+        return shapes
+    box = shapely.MultiPoint([(float(u), float(v)) for u, v, _ in uvz]).convex_hull
+    lo_u, lo_v, hi_u, hi_v = box.bounds
+    box = box.buffer(0.1 * max(hi_u - lo_u, hi_v - lo_v))
+    kept = tuple(s for s in shapes if _share_inside(s, box) >= _IN_VIEW) or shapes
+    if not clip:
+        return kept
+    return tuple(part for s in kept for part in _clipped(s, box, photo.intrinsics))
+
+
+def _clipped(shape: Shape, box: shapely.Polygon, k: Intrinsics) -> tuple[Shape, ...]:
+    """``shape`` cut back to ``box`` (image pixels) when it is cut by the frame and reaches
+    out of the box; else itself."""
+    if not shape.cut_by_border:
+        return (shape,)
+    outline = shapely.Polygon(shape.polygon_px, list(shape.holes_px)).buffer(0)
+    if outline.within(box):
+        return (shape,)
+    inside = outline.intersection(box)
+    parts = [g for g in getattr(inside, "geoms", [inside]) if isinstance(g, shapely.Polygon)]
+    out = []
+    for part in parts:
+        if part.area <= 0.0:
+            continue
+        ring = np.asarray(part.exterior.coords[:-1], dtype=np.float64)
+        lo, hi = ring.min(axis=0), ring.max(axis=0)
+        edge = EDGE_PX
+        cut = bool(
+            lo[0] <= edge
+            or lo[1] <= edge
+            or hi[0] >= k.width_px - 1 - edge
+            or hi[1] >= k.height_px - 1 - edge
+        )
+        holes = tuple(np.asarray(r.coords[:-1], dtype=np.float64) for r in part.interiors)
+        out.append(
+            Shape.from_rings(
+                colour_rgb=shape.colour_rgb, polygon_px=ring, holes_px=holes, cut_by_border=cut
+            )
+        )
+    return tuple(out) or (shape,)
+
+
+_IN_VIEW = 0.5
+"""The least share of a shape's outline's area inside where the building stands in the
+photo for the shape to be part of it: a neighbour of its colour merely touching that box
+(from above, towers overlap in the frame) is not."""
+
+
+def _share_inside(shape: Shape, box: shapely.Polygon) -> float:
+    outline = shapely.MultiPoint(shape.polygon_px).convex_hull
+    return float(outline.intersection(box).area / outline.area) if outline.area > 0.0 else 0.0
 
 
 def _taller_view(

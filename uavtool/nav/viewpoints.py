@@ -186,8 +186,12 @@ def _plan_one(
     intrinsics: Intrinsics,
     params: ViewpointParams,
     heights: Sequence[float] | None = None,
+    apart_from: tuple[float, float] | None = None,
 ) -> Viewpoint | ViewpointFailure:
-    """Try the first side, then the opposite one, at growing distances; first clear wins."""
+    """Try the first side, then the opposite one, at growing distances; first clear wins.
+    ``apart_from``: (heading, least separation), both degrees: a camera turned round the
+    building must look at least that far from the heading, or from its opposite (the
+    model needs two distinct directions)."""
     side_len = rect.length_m if first_side.startswith("long") else rect.width_m
     d0 = base_distance_m(side_len, intrinsics, params)
     tried: list[str] = []
@@ -229,6 +233,10 @@ def _plan_one(
     for offset in params.oblique_deg if tried else ():  # none fit at all: say so below
         for side in (first_side, _OPPOSITE[first_side]):
             found = _oblique(name, rect, side, offset, obstacles, intrinsics, params, heights)
+            if isinstance(found, Viewpoint) and apart_from is not None:
+                apart = _apart_deg(found.heading_deg, apart_from[0])
+                if apart < apart_from[1]:
+                    found = f"{side} turned {offset:+g}°: {apart:.0f}° from the other photo's"
             if isinstance(found, Viewpoint):
                 return found
             tried.append(found)
@@ -484,12 +492,19 @@ def _from_direction(
     return blocked or "beyond nav.max_distance_m"
 
 
+def _apart_deg(a_deg: float, b_deg: float) -> float:
+    """How far apart two viewing directions are, a direction and its opposite as one."""
+    d = abs((a_deg - b_deg + 180.0) % 360.0 - 180.0)
+    return min(d, 180.0 - d)
+
+
 def plan_viewpoints(
     target: Rect,
     obstacles: Sequence[Sequence[tuple[float, float]]] | Sequence[Any],
     intrinsics: Intrinsics,
     params: ViewpointParams | None = None,
     heights: Sequence[float] | None = None,
+    min_apart_deg: float = 0.0,
 ) -> tuple[Viewpoint | ViewpointFailure, Viewpoint | ViewpointFailure]:
     """The front and right viewpoints of ``target``, clear of ``obstacles``.
 
@@ -502,7 +517,9 @@ def plan_viewpoints(
     ``heights`` (each obstacle's, ``math.inf`` where unknown) a camera looking down may see
     the building's top over lower obstacles.
     When the front has no position, the right photo is planned against the first-choice
-    front heading.
+    front heading. A right camera turned round the building looks at least
+    ``min_apart_deg`` away from the front camera's direction (the model's
+    ``min_view_separation_deg``).
     """
     params = params or ViewpointParams()
     polys = [as_points(p, what=f"obstacles[{i}]") for i, p in enumerate(obstacles)]
@@ -511,7 +528,8 @@ def plan_viewpoints(
     # long-a looks along θ − 90, so its right camera looks along θ − 180: it faces short-a
     # (outward normal θ); symmetrically long-b → short-b.
     right_side = "short-a" if front_side == "long-a" else "short-b"
-    right = _plan_one("right", target, right_side, polys, intrinsics, params, heights)
+    apart = (front.heading_deg, min_apart_deg) if isinstance(front, Viewpoint) else None
+    right = _plan_one("right", target, right_side, polys, intrinsics, params, heights, apart)
     return front, right
 
 

@@ -100,7 +100,7 @@ def perimeter(ring: FloatArray) -> float:
     return math.fsum(np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]).tolist())
 
 
-_EDGE_PX = 1.0  # an outline this close to the frame's edge touches it
+EDGE_PX = 1.0  # an outline this close to the frame's edge touches it
 
 
 def cut_edges(silhouette: Sequence[Shape], k: Intrinsics) -> set[str]:
@@ -112,10 +112,10 @@ def cut_edges(silhouette: Sequence[Shape], k: Intrinsics) -> set[str]:
             continue
         us, vs = shape.polygon_px[:, 0], shape.polygon_px[:, 1]
         for edge, touches in (
-            ("left", float(us.min()) <= _EDGE_PX),
-            ("right", float(us.max()) >= k.width_px - 1 - _EDGE_PX),
-            ("top", float(vs.min()) <= _EDGE_PX),
-            ("bottom", float(vs.max()) >= k.height_px - 1 - _EDGE_PX),
+            ("left", float(us.min()) <= EDGE_PX),
+            ("right", float(us.max()) >= k.width_px - 1 - EDGE_PX),
+            ("top", float(vs.min()) <= EDGE_PX),
+            ("bottom", float(vs.max()) >= k.height_px - 1 - EDGE_PX),
         ):
             if touches:
                 edges.add(edge)
