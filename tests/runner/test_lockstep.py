@@ -38,12 +38,17 @@ def _fly(path: Path, **options: object) -> bytes:
 @pytest.fixture(scope="module")
 def paper(tmp_path_factory: pytest.TempPathFactory) -> Path:
     path = tmp_path_factory.mktemp("lockstep") / "paper.mcap"
-    _fly(path)
+    _fly(path, record_in_process=True)
     return path
 
 
 def test_same_inputs_give_the_same_bytes(paper: Path, tmp_path: Path) -> None:
     assert _fly(tmp_path / "again.mcap") == paper.read_bytes()
+
+
+def test_the_writer_process_writes_the_same_bytes(paper: Path, tmp_path: Path) -> None:
+    """fly picks the writer by the machine's load; the file must not tell which."""
+    assert _fly(tmp_path / "process.mcap", record_in_process=False) == paper.read_bytes()
 
 
 def test_a_different_input_gives_a_different_file(paper: Path, tmp_path: Path) -> None:
