@@ -40,7 +40,7 @@ from uavtool.recording.schemas import (
 )
 from uavtool.recording.sink import RecordingSink
 from uavtool.recording.topics import FIX, POSE
-from uavtool.recording.values import Direction, LocationFix, Pose, PosesInFrame
+from uavtool.recording.values import Direction, LocationFix, PosesInFrame
 
 if TYPE_CHECKING:
     from uavtool.recording.foxglove import FoxgloveValue
@@ -167,6 +167,7 @@ class RecordingWriter:
         self._topic_kind: dict[str, Any] = {}  # topic -> value type or JSON schema name
         self._json_topics: dict[str, int] = {}  # topic -> channel id
         self._protobuf_schema: dict[str, str] = {}  # topic -> its Protobuf schema's name
+        self._vehicle: Any = None  # foxglove.VehicleEncoder, once write_vehicle is called
         self._sequence: list[int] = [0]  # channel id -> its next sequence number
         tool = {"version": __version__, "dialect": dialect, "mavlink": "2.0"}
         self._sink = RecordingSink(
@@ -287,20 +288,8 @@ class RecordingWriter:
     ) -> None:
         """Write an image, calibration, transform, fix, poses, log entry or model (Foxglove)."""
         check_topic(topic)
-        kind = type(value)
-        foxglove = foxglove_module()
-        data = foxglove.encode(value, log_time_ns)
-        with self._lock:
-            self._check_open()
-            channel_id = self._channels.get(topic)
-            if channel_id is None:
-                name, schema = foxglove.schema_name(kind), foxglove.schema_data(kind)
-                channel_id = self._protobuf_channel(topic, kind, name, schema)
-            elif (known := self._topic_kind.get(topic)) is not kind and (
-                known != foxglove.schema_name(kind)  # write_protobuf opened it: its schema
-            ):
-                raise ValueError(f"topic {topic!r} carries {known!r}, not {kind}")
-            self._add(channel_id, log_time_ns, publish_time_ns, data)
+        data = foxglove_module().encode(value, log_time_ns)
+        self._write_foxglove(topic, type(value), data, log_time_ns, publish_time_ns)
 
     def write_vehicle(
         self,
@@ -312,12 +301,15 @@ class RecordingWriter:
     ) -> None:
         """The vehicle's pose on ``/vehicle/pose`` and, when the local frame's ``origin`` is
         known, its WGS-84 fix on ``/vehicle/fix`` (one of each per telemetry sample)."""
-        pose = Pose.from_enu_heading(pos_enu_m, heading_deg)
-        self.write(POSE, PosesInFrame((pose,)), log_time_ns=log_time_ns)
+        encoder = self._vehicle
+        if encoder is None:
+            encoder = self._vehicle = foxglove_module().VehicleEncoder()
+        data = encoder.pose(pos_enu_m, heading_deg, log_time_ns)
+        self._write_foxglove(POSE, PosesInFrame, data, log_time_ns, None)
         if origin is not None:
             geo = geo_from_enu(origin, *pos_enu_m)
-            fix = LocationFix(geo.lat_deg, geo.lon_deg, geo.alt_amsl_m)
-            self.write(FIX, fix, log_time_ns=log_time_ns)
+            data = encoder.fix(geo.lat_deg, geo.lon_deg, geo.alt_amsl_m, log_time_ns)
+            self._write_foxglove(FIX, LocationFix, data, log_time_ns, None)
 
     def write_protobuf(
         self,
@@ -397,6 +389,23 @@ class RecordingWriter:
         meta = {"dialect": self.dialect}
         self._raw_id = self._channel(MAVLINK_RAW, MAVLINK_RAW, PROTOBUF_ENCODING, schema_id, meta)
         return self._raw_id
+
+    def _write_foxglove(
+        self, topic: str, kind: type, data: bytes, log_time_ns: int, publish_time_ns: int | None
+    ) -> None:
+        """Write ``data``, a value of type ``kind`` encoded by `foxglove.encode`."""
+        with self._lock:
+            self._check_open()
+            channel_id = self._channels.get(topic)
+            if channel_id is None:
+                foxglove = foxglove_module()
+                name, schema = foxglove.schema_name(kind), foxglove.schema_data(kind)
+                channel_id = self._protobuf_channel(topic, kind, name, schema)
+            elif (known := self._topic_kind.get(topic)) is not kind and (
+                known != foxglove_module().schema_name(kind)  # opened by write_protobuf
+            ):
+                raise ValueError(f"topic {topic!r} carries {known!r}, not {kind}")
+            self._add(channel_id, log_time_ns, publish_time_ns, data)
 
     def _protobuf_channel(self, topic: str, kind: Any, name: str, schema: bytes) -> int:
         schema_id = self._schema(name, PROTOBUF_ENCODING, schema)
