@@ -18,11 +18,11 @@ from uavtool.mission import Status
 from uavtool.mission.analysis import NOT_FLAT_M, nadir_shapes, not_flat, roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.params import Params
-from uavtool.mission.survey import anywhere, unknown_roof
+from uavtool.mission.survey import anywhere, unknown_place, unknown_roof
 from uavtool.nav.heights import higher_part_m
 from uavtool.runner.fly import FlyConfig, fly
 from uavtool.vision import Shape
-from uavtool.vision.vectorize import inner_walls
+from uavtool.vision.vectorize import inner_walls, not_ground_regions
 from uavtool.world import Scene, load_scene, render, scene_from_dict, scene_to_dict
 
 DATA = Path(__file__).parent / "data"
@@ -199,3 +199,32 @@ def test_the_highest_a_roof_of_unknown_height_may_be() -> None:
     assert unknown_roof(shape, home, 111.0).upper_m == 111.0
     upper = unknown_roof(shape, home, 111.0, (over,)).upper_m
     assert 40.0 <= upper <= 60.0  # 56 m here: the 2 m planes up to 54 m are left
+
+
+def test_a_roof_whose_building_reaches_past_the_frame_may_be_as_high_as_any() -> None:
+    """A 14 m block with a 50 m tower rising from it, 45 m east of home: from 117 m over
+    home the block's roof is whole in the photo, the tower's top beyond the frame, its walls
+    joining the block's roof to the frame's edge. A photo over the wing sees the ground where the
+    wing's roof would put a taller building, so the roof alone is bounded low; but what
+    stands around it reaches past the frame, where a higher roof may be: the building is
+    as high as anything below the camera may be. (Bounded by its roof alone, a look at the
+    tower's wing once passed 0.08 m from the tower.)"""
+    building = {
+        "name": "tower",
+        "color": [54, 160, 217],
+        "blocks": [
+            _block([(41.0, -6.0), (49.0, -6.0), (49.0, 0.0), (41.0, 0.0)], 0.0, 14.0),
+            _block(_square(46.5, -2.0, 2.0), 14.0, 50.0),
+        ],
+    }
+    data = scene_to_dict(_scene())
+    data["buildings"] = [building]
+    data["target"] = "tower"
+    scene = scene_from_dict(data)
+    home = _photo(scene, 0.0, 0.0, 117.0, 0)
+    over = _photo(scene, 45.0, -3.0, 117.0, 1)
+    wing = _shape(home, (54, 160, 217))
+    assert not wing.cut_by_border
+    regions = not_ground_regions(home.image_rgb)
+    assert unknown_roof(wing, home, 111.0, (over,)).upper_m < 50.0
+    assert unknown_place(wing, home, 111.0, (over,), regions).upper_m == 111.0
