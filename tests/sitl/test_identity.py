@@ -28,7 +28,9 @@ def test_heartbeat_is_1hz_in_sim_time(client: Client) -> None:
         lambda c: c.latest["SYSTEM_TIME"].time_boot_ms >= start + 10_000, what="10 s of sim time"
     )
     n = sum(1 for m in client.received if m.get_type() == "HEARTBEAT") - n0
-    assert 9 <= n <= 11
+    # SYSTEM_TIME comes once a second too, so each end of the window may be up to a second
+    # late: 10 s of a 1 Hz heartbeat is 8 to 12 of them (2 Hz would be 20, 0.5 Hz 5).
+    assert 8 <= n <= 12
 
 
 def test_armed_heartbeat_is_active_with_safety_armed(client: Client) -> None:
