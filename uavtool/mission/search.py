@@ -139,7 +139,7 @@ def search(
                 f"point of interest {k}: {why}; looking again from above its roof at "
                 f"{pos[2]:.1f} m",
             )
-            yield from m.move(pos, None, f"point of interest {k}, look {n}")
+            yield from _shift(m, pos, f"point of interest {k}, look {n}")
             looks.append((yield from _look(m, k, n, pos[2], poi.colour_rgb)))
         top = max(look.judgement.score for look in looks)
         if top > best_score:
@@ -302,6 +302,20 @@ def _farthest_pair(
         key=lambda ab: math.dist(*ab),
         default=((0.0, 0.0), (0.0, 0.0)),
     )
+
+
+def _shift(m: SearchMission, pos: Vec3, what: str) -> Wait[None]:
+    """A short move to ``pos``, a look's re-centring, no lower than the altitude that clears
+    every roof, known or not, there and halfway (the look's own altitude was cleared only
+    where it was taken); straight up first when that is above the vehicle."""
+    here = m.last.pos_enu_m if m.last is not None else pos
+    x, y, z = pos
+    mid = ((here[0] + x) / 2.0, (here[1] + y) / 2.0)
+    need = max(m.floor_at(x, y), m.floor_at(*mid))
+    z = max(z, need)
+    if need > here[2]:
+        yield from m.move((here[0], here[1], z), None, f"{what}: up to {z:.1f} m")
+    yield from m.move((x, y, z), None, what)
 
 
 def _look_again(

@@ -220,24 +220,32 @@ def footprint_at(shape: Shape, photo: Photo, roof_m: float) -> tuple[tuple[float
 
 
 def same_building(m: SearchMission, seen: Survey, target: int) -> frozenset[int]:
-    """``target`` and the survey's other shapes of its colour that touch it, within the
-    safety margin: the roofs of one stepped building, split in the overview by the walls
-    between its tiers, are not obstacles to photographing it."""
-    margin_m = m.params.viewpoints.safety_margin_m
+    """``target`` and the survey's other measured roofs of its colour that touch it: the
+    roofs of one stepped building, split in the overview by the walls between its tiers,
+    are not obstacles to photographing it. Touching is within ``_TOUCHING_M``: another
+    building of the colour in a dense block stands further off, and must stay an obstacle
+    (one 2.7 m away, taken for a tier, once had a side photo planned into it); so must a
+    roof of unknown height, which may stand anywhere along its rays."""
     own = seen.footprints[target]
     colour = seen.shapes[target].colour_rgb
     parts = {target}
     for i, shape in enumerate(seen.shapes):
-        if i == target or not same_colour(m, shape.colour_rgb, colour):
+        if i == target or not seen.measured[i] or not same_colour(m, shape.colour_rgb, colour):
             continue
         other = seen.footprints[i]
         gap = min(
             *(point_polygon_distance(q, own) for q in other),
             *(point_polygon_distance(q, other) for q in own),
         )
-        if gap <= margin_m:
+        if gap <= _TOUCHING_M:
             parts.add(i)
     return frozenset(parts)
+
+
+_TOUCHING_M = 1.0
+"""How far apart two roofs' footprints may be for the roofs to be one building's: tiers
+meet (their footprints, each at its own measured height, touch but for the error of the
+measurement)."""
 
 
 def building_top_m(seen: Survey, parts: frozenset[int]) -> float:
