@@ -152,12 +152,9 @@ def test_a_courtyard_whose_ground_is_hidden_is_still_one_flat_roof() -> None:
     assert summary.evaluation.matched_building == "b05" == summary.evaluation.target_building
 
 
-def test_where_a_roof_of_unknown_height_may_stand() -> None:
-    """A 40 m tower 30 m east of home, its roof unmeasured: from 117 m over home its outline
-    could be a roof anywhere from the ground up to just below the camera, so its building
-    anywhere from 30 m out to nearly over home (a 25 m guess left out where it stands). A
-    photo over the tower, from the same altitude, sees the ground where the taller and the
-    lower roofs would stand: what remains holds the tower and no longer reaches home."""
+def _tower_photos() -> tuple[Photo, Photo, Shape]:
+    """A 40 m tower 30 m east of home, photographed from 117 m over home and over it, and
+    its roof in the photo over home."""
     tower = {
         "name": "tower",
         "color": [54, 160, 217],
@@ -168,8 +165,16 @@ def test_where_a_roof_of_unknown_height_may_stand() -> None:
     data["target"] = "tower"
     scene = scene_from_dict(data)
     home = _photo(scene, 0.0, 0.0, 117.0, 0)
-    over = _photo(scene, 30.0, 0.0, 117.0, 1)
-    shape = _shape(home, (54, 160, 217))
+    return home, _photo(scene, 30.0, 0.0, 117.0, 1), _shape(home, (54, 160, 217))
+
+
+def test_where_a_roof_of_unknown_height_may_stand() -> None:
+    """A 40 m tower 30 m east of home, its roof unmeasured: from 117 m over home its outline
+    could be a roof anywhere from the ground up to just below the camera, so its building
+    anywhere from 30 m out to nearly over home (a 25 m guess left out where it stands). A
+    photo over the tower, from the same altitude, sees the ground where the taller and the
+    lower roofs would stand: what remains holds the tower and no longer reaches home."""
+    home, over, shape = _tower_photos()
     wide = Polygon(anywhere(shape, home, 111.0))
     narrow = Polygon(anywhere(shape, home, 111.0, (over,)))
     true = Polygon(_square(30.0, 0.0, 4.0))
@@ -184,18 +189,7 @@ def test_the_highest_a_roof_of_unknown_height_may_be() -> None:
     to just below the camera; the photo over it sees the ground where the taller roofs'
     buildings would stand, so what is left is bounded — above the true 40 m (a bound that
     cuts a real roof would fly into it), and well below the camera."""
-    tower = {
-        "name": "tower",
-        "color": [54, 160, 217],
-        "blocks": [_block(_square(30.0, 0.0, 4.0), 0.0, 40.0)],
-    }
-    data = scene_to_dict(_scene())
-    data["buildings"] = [tower]
-    data["target"] = "tower"
-    scene = scene_from_dict(data)
-    home = _photo(scene, 0.0, 0.0, 117.0, 0)
-    over = _photo(scene, 30.0, 0.0, 117.0, 1)
-    shape = _shape(home, (54, 160, 217))
+    home, over, shape = _tower_photos()
     assert unknown_roof(shape, home, 111.0).upper_m == 111.0
     upper = unknown_roof(shape, home, 111.0, (over,)).upper_m
     assert 40.0 <= upper <= 60.0  # 56 m here: the 2 m planes up to 54 m are left
