@@ -18,7 +18,7 @@ from uavtool.mission import Status
 from uavtool.mission.analysis import NOT_FLAT_M, nadir_shapes, not_flat, roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.params import Params
-from uavtool.mission.survey import anywhere, unknown_place, unknown_roof
+from uavtool.mission.survey import unknown_place, unknown_roof
 from uavtool.nav.heights import higher_part_m
 from uavtool.runner.fly import FlyConfig, fly
 from uavtool.vision import Shape
@@ -175,11 +175,12 @@ def test_where_a_roof_of_unknown_height_may_stand() -> None:
     photo over the tower, from the same altitude, sees the ground where the taller and the
     lower roofs would stand: what remains holds the tower and no longer reaches home."""
     home, over, shape = _tower_photos()
-    wide = Polygon(anywhere(shape, home, 111.0))
-    narrow = Polygon(anywhere(shape, home, 111.0, (over,)))
+    wide = Polygon(unknown_roof(shape, home, 111.0).footprint)
+    narrow = Polygon(unknown_roof(shape, home, 111.0, (over,)).footprint)
     true = Polygon(_square(30.0, 0.0, 4.0))
     assert wide.distance(Point(0.0, 0.0)) < 3.0  # up to 111 m: nearly over home
-    assert Polygon(anywhere(shape, home, 25.0)).intersection(true).area < 0.5 * true.area
+    low = Polygon(unknown_roof(shape, home, 25.0).footprint)
+    assert low.intersection(true).area < 0.5 * true.area
     assert narrow.intersection(true).area > 0.9 * true.area  # the tower stays in
     assert narrow.distance(Point(0.0, 0.0)) > 15.0  # but home is clear of it
 

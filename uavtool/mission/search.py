@@ -151,7 +151,7 @@ def search(
             seen = overview_shapes[poi.shape_index]
             roof = roof_between(seen, overview, shape, look.photo)
             if roof is None or roof > p.assumed_roof_m:  # beyond the tallest expected: a
-                roof = yield from _measure_from_lower(m, k, poi, look, shape)  # mismatch
+                roof = yield from _measure_from_another_altitude(m, k, poi, look, shape)  # mismatch
             best = Found(
                 poi,
                 look.photo,
@@ -195,7 +195,7 @@ def _rivals(
     return rivals
 
 
-def _measure_from_lower(
+def _measure_from_another_altitude(
     m: SearchMission, k: int, poi: PointOfInterest, look: _Look, shape: Shape
 ) -> Wait[float | None]:
     """The matched roof's height when the overview could not tell it (cut by its border):

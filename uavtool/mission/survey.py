@@ -378,13 +378,6 @@ def _region_of(shape: Shape, regions: Sequence[Shape]) -> Shape | None:
     return best if best is not None and inside(best) > len(points) // 2 else None
 
 
-def anywhere(
-    shape: Shape, photo: Photo, tallest_m: float, others: Sequence[Photo] = ()
-) -> tuple[tuple[float, float], ...]:
-    """Where a building of unknown height may stand (:func:`unknown_roof`)."""
-    return unknown_roof(shape, photo, tallest_m, others).footprint
-
-
 def unknown_roof(
     shape: Shape, photo: Photo, tallest_m: float, others: Sequence[Photo] = ()
 ) -> Unknown:

@@ -93,6 +93,12 @@ def _check_time(t: Any, what: str = "log_time_ns") -> None:
         raise ValueError(f"{what} must be a positive int that fits 64 bits, got {t!r}")
 
 
+def _check_times(log_time_ns: Any, publish_time_ns: Any) -> None:
+    _check_time(log_time_ns)
+    if publish_time_ns is not None:
+        _check_time(publish_time_ns, "publish_time_ns")
+
+
 class ProcessWriter:
     """`RecordingWriter`'s writes, made by a child process (the module docstring says how).
     Arguments as `RecordingWriter`'s; the file is created here, so a path that cannot be
@@ -243,16 +249,12 @@ class ProcessWriter:
         log_time_ns: int,
         publish_time_ns: int | None = None,
     ) -> None:
-        _check_time(log_time_ns)
-        if publish_time_ns is not None:
-            _check_time(publish_time_ns, "publish_time_ns")
+        _check_times(log_time_ns, publish_time_ns)
         with self._lock:
             self._check_open()
             if topic not in self._json_topics:
                 raise ValueError(f"topic {topic!r} is not a JSON topic: call add_json_topic first")
-            self._batch.append((_JSON, topic, data, log_time_ns, publish_time_ns))
-            if log_time_ns >= self._ship_at or len(self._batch) >= BATCH_CALLS:
-                self._ship(log_time_ns)
+            self._queue((_JSON, topic, data, log_time_ns, publish_time_ns), log_time_ns)
 
     def write(
         self,
@@ -263,9 +265,7 @@ class ProcessWriter:
         publish_time_ns: int | None = None,
     ) -> None:
         check_topic(topic)
-        _check_time(log_time_ns)
-        if publish_time_ns is not None:
-            _check_time(publish_time_ns, "publish_time_ns")
+        _check_times(log_time_ns, publish_time_ns)
         kind = type(value)
         foxglove = foxglove_module()
         data = foxglove.encode(value, log_time_ns)
@@ -278,9 +278,7 @@ class ProcessWriter:
                 self._batch.append((_PROTO_TOPIC, topic, *schema))
             elif self._topic_kind[topic] is not kind:
                 raise ValueError(f"topic {topic!r} carries {self._topic_kind[topic]!r}, not {kind}")
-            self._batch.append((_PROTO, topic, data, log_time_ns, publish_time_ns))
-            if log_time_ns >= self._ship_at or len(self._batch) >= BATCH_CALLS:
-                self._ship(log_time_ns)
+            self._queue((_PROTO, topic, data, log_time_ns, publish_time_ns), log_time_ns)
 
     def write_mavlink(
         self,
@@ -324,9 +322,7 @@ class ProcessWriter:
                 self._vehicle = True
                 self._check_kind(POSE, PosesInFrame)
                 self._check_kind(FIX, LocationFix)
-            self._batch.append((_VEHICLE, pos_enu_m, heading_deg, origin, log_time_ns))
-            if log_time_ns >= self._ship_at or len(self._batch) >= BATCH_CALLS:
-                self._ship(log_time_ns)
+            self._queue((_VEHICLE, pos_enu_m, heading_deg, origin, log_time_ns), log_time_ns)
 
     # --- internals (called with the lock held) -----------------------------------------------
 
@@ -341,6 +337,13 @@ class ProcessWriter:
             raise self._failure
         if self._closed:
             raise ValueError(f"{self.path}: the recording is closed")
+
+    def _queue(self, item: tuple[Any, ...], log_time_ns: int) -> None:
+        """Add one call to the batch; ship the batch once a batch's log time or size is
+        reached."""
+        self._batch.append(item)
+        if log_time_ns >= self._ship_at or len(self._batch) >= BATCH_CALLS:
+            self._ship(log_time_ns)
 
     def _ship(self, log_time_ns: int) -> None:
         """Send the batch down the pipe (waiting if the pipe is full); a child that ended
