@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from importlib import metadata
 
+import uavtool
+
 
 def _owners(path: str) -> list[str]:
     return sorted(
@@ -20,3 +22,10 @@ def test_one_opencv_owns_cv2() -> None:
     owners = _owners("cv2/__init__.py")
     assert len(owners) == 1, f"cv2 is installed by {owners}"
     assert owners[0].endswith("-headless"), f"cv2 comes from {owners[0]}, not a headless build"
+
+
+def test_the_version_uavtool_reports_is_the_installed_one() -> None:
+    # uavtool.__version__ is a literal that pyproject.toml reads at build time (importing
+    # importlib.metadata at start-up costs ~25 ms): an install made before a version change
+    # would disagree.
+    assert uavtool.__version__ == metadata.version("uavtool")

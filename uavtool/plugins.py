@@ -14,7 +14,6 @@ replay, re-fly and sweep find the same class again from it.
 from __future__ import annotations
 
 import importlib
-import importlib.metadata
 import re
 import sys
 import traceback
@@ -77,6 +76,8 @@ class MissionInfo:
 def registered() -> dict[str, tuple[str, str]]:
     """Every mission name → (``module:Class``, origin): built-in first, then installed
     packages' (a package cannot take a built-in name)."""
+    import importlib.metadata  # noqa: PLC0415 - ~25 ms: not for a built-in mission's flight
+
     found = {name: (target, "uavtool") for name, target in BUILTIN.items()}
     for ep in importlib.metadata.entry_points(group=GROUP):
         if ep.name not in found:
@@ -89,8 +90,8 @@ def resolve(spec: str) -> tuple[type[FlightMission], MissionRef]:
     """The mission class that ``spec`` names (a registered name or ``module:Class``), and how
     a recording refers to it. Raises PluginError (one line, naming ``spec``)."""
     spec = spec.strip()
-    known = registered()
-    if spec in known:
+    known = {spec: (BUILTIN[spec], "uavtool")} if spec in BUILTIN else registered()
+    if spec in known:  # a built-in name is never a package's (see `registered`)
         name, target = spec, known[spec][0]
     elif _TARGET.match(spec):
         target = spec
@@ -146,7 +147,7 @@ def for_recording(
     of its choosing; ``override`` (``--mission`` on the command line) names one explicitly."""
     if override is not None:
         return resolve(override)
-    known = registered()
+    known = {ref.name: (BUILTIN[ref.name], "uavtool")} if ref.name in BUILTIN else registered()
     if ref.name in known and known[ref.name][0] == ref.target:
         return load(ref.target, what=f"{source}: mission {ref.name!r}"), ref
     hint = (
@@ -207,6 +208,8 @@ def _version_of(target: str) -> str:
     top = target.split(":", 1)[0].split(".", 1)[0]
     if top == "uavtool":
         return __version__
+    import importlib.metadata  # noqa: PLC0415
+
     dists = importlib.metadata.packages_distributions().get(top, [])
     for dist in dists:
         try:
