@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import struct
 from pathlib import Path
+from typing import Any, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -33,7 +34,7 @@ def png_encode(rgb: U8Array) -> bytes:
     import cv2  # noqa: PLC0415 - keep importing uavtool light
 
     params = [cv2.IMWRITE_PNG_COMPRESSION, 3, cv2.IMWRITE_PNG_FILTER, cv2.IMWRITE_PNG_FILTER_SUB]
-    ok, buf = cv2.imencode(".png", np.ascontiguousarray(rgb[:, :, ::-1]), params)
+    ok, buf = cv2.imencode(".png", _swap_red_blue(rgb), params)
     if not ok:
         raise ValueError("PNG encoding failed")
     return bytes(buf)
@@ -62,7 +63,17 @@ def png_decode(data: bytes, *, where: str = "image") -> U8Array:
     if bgr is None:
         raise InputError(f"{where}: not a decodable image ({len(data)} bytes)")
     _check_size(bgr.shape[1], bgr.shape[0], where=where)
-    return np.ascontiguousarray(bgr[:, :, ::-1])
+    return _swap_red_blue(bgr)
+
+
+def _swap_red_blue(image: npt.NDArray[Any]) -> U8Array:
+    """RGB <-> BGR, a new contiguous array. OpenCV's swap takes ~0.03 ms for a 640x480 frame,
+    numpy's copy of a reversed view ~2 ms; the pixels are the same."""
+    import cv2  # noqa: PLC0415
+
+    if image.ndim == 3 and image.shape[2] == 3 and image.dtype == np.uint8:
+        return cast("U8Array", cv2.cvtColor(image, cv2.COLOR_RGB2BGR))
+    return np.ascontiguousarray(image[:, :, ::-1])
 
 
 def read_image(path: Path, *, where: str | None = None) -> U8Array:
