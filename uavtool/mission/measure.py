@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import cv2
 import numpy as np
@@ -27,13 +27,11 @@ from uavtool.mission.search import photo_shapes
 from uavtool.mission.survey import (
     Obstacle,
     Survey,
-    Unknown,
     below_camera_m,
-    footprint_at,
     points_of_interest,
     same_colour,
-    unknown_place,
 )
+from uavtool.mission.unknown import Unknown, footprint_at, pixels, unexplained, unknown_place
 from uavtool.nav import NavError, ground_point
 from uavtool.nav.heights import roof_from_cut_outline
 from uavtool.vision import Shape
@@ -58,7 +56,13 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     m.ceiling_m = ceiling_m
     below_m = ceiling_m - 1.0
     others = _unclassified(m, seen)  # obstacles of no building colour
-    if all(seen.measured) and not others:
+    if (
+        all(seen.measured)
+        and not others
+        and not unexplained(
+            seen.photo, seen.shapes, seen.roofs_m, seen.measured, seen.regions, m.params.vectorize
+        )
+    ):
         m.roofs = tuple(zip(seen.footprints, seen.roofs_m, strict=True))
         return seen
     others_m: list[float | None] = [None] * len(others)
@@ -104,6 +108,13 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
             ]
     assumed_m = m.params.mission.assumed_roof_m
     tallest_m = below_camera_m(m, seen.photo)
+    # What the roofs as measured do not explain (a taller part of a building, a neighbour
+    # of a darker shade merged with it in the photo) is not measured: it may be as high as
+    # its region allows.
+    others += unexplained(
+        seen.photo, seen.shapes, roofs, measured, seen.regions, m.params.vectorize
+    )
+    others_m += [None] * (len(others) - len(others_m))
     obstacles = tuple(
         Obstacle(o, assumed_m, False, *unknown_place(o, seen.photo, tallest_m, views, seen.regions))
         if h is None
@@ -113,7 +124,8 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     if obstacles:
         m.event(
             Level.INFO,
-            f"{len(obstacles)} obstacles of no building colour (grey, or a darker shade): roofs "
+            f"{len(obstacles)} obstacles no roof of a building colour explains (grey, a darker "
+            "shade, a taller part): roofs "
             + ", ".join(f"{o.roof_m:.1f} m" if o.measured else "unknown" for o in obstacles),
         )
     places = [  # for the roofs still unknown, the tour's photos rule out more
@@ -171,20 +183,16 @@ def _unclassified(m: SearchMission, seen: Survey) -> list[Shape]:
     building the vectorizer found (a coloured roof and its walls are one region)."""
     k = seen.photo.intrinsics
     found = np.zeros((k.height_px, k.width_px), np.uint8)
-    cv2.fillPoly(found, [_pixels(s.polygon_px) for s in seen.shapes], 255)
+    cv2.fillPoly(found, [pixels(s.polygon_px) for s in seen.shapes], 255)
     out: list[Shape] = []
     for region in non_ground(seen.photo.image_rgb, m.params.vectorize):
         if region.area_px < m.params.vectorize.min_area_px:
             continue
         own = np.zeros_like(found)
-        cv2.fillPoly(own, [_pixels(region.polygon_px)], 255)
+        cv2.fillPoly(own, [pixels(region.polygon_px)], 255)
         if cv2.countNonZero(cv2.bitwise_and(own, found)) == 0:
             out.append(region)
     return out
-
-
-def _pixels(polygon_px: Any) -> Any:
-    return np.round(np.asarray(polygon_px)).astype(np.int32).reshape(-1, 1, 2)
 
 
 def measure_roof(

@@ -9,24 +9,21 @@ A building whose height could not be measured is assumed as tall as
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING
 
-import cv2
-import numpy as np
-
-from uavtool.camera import Intrinsics, project
+from uavtool.camera import Intrinsics
 from uavtool.mission.analysis import roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
 from uavtool.mission.params import MissionParams
 from uavtool.mission.search import photo_shapes
-from uavtool.nav import NavError, ground_point, ground_polygon, min_area_rect
+from uavtool.mission.unknown import Unknown, footprint_at, unknown_place
+from uavtool.nav import ground_point, min_area_rect
 from uavtool.nav.geometry import convex_hull, point_polygon_distance
 from uavtool.vision import Shape
 from uavtool.vision.shapes import cut_edges
-from uavtool.vision.vectorize import ground_mask, hue_distance_deg, not_ground_regions
+from uavtool.vision.vectorize import hue_distance_deg, not_ground_regions
 
 if TYPE_CHECKING:
     from uavtool.mission.base import Wait
@@ -78,13 +75,6 @@ class Obstacle:
     def height_m(self) -> float:
         """Its height as an obstacle: the highest its roof may be."""
         return self.roof_m if self.measured else self.upper_m
-
-
-class Unknown(NamedTuple):
-    """Where a building of unknown height may stand, and the highest its roof may be."""
-
-    footprint: tuple[tuple[float, float], ...]
-    upper_m: float
 
 
 def survey(m: SearchMission) -> Wait[Survey]:
@@ -212,13 +202,6 @@ def same_colour(m: SearchMission, a_rgb: tuple[int, int, int], b_rgb: tuple[int,
     return all(abs(a - b) <= tol for a, b in zip(a_rgb, b_rgb, strict=True))
 
 
-def footprint_at(shape: Shape, photo: Photo, roof_m: float) -> tuple[tuple[float, float], ...]:
-    try:
-        return ground_polygon(shape.polygon_px, photo.pose, photo.intrinsics, plane_z_m=roof_m)
-    except NavError:  # a roof assumed above the camera: place it on the ground instead
-        return ground_polygon(shape.polygon_px, photo.pose, photo.intrinsics, plane_z_m=0.0)
-
-
 def same_building(m: SearchMission, seen: Survey, target: int) -> frozenset[int]:
     """``target`` and the survey's other measured roofs of its colour that touch it: the
     roofs of one stepped building, split in the overview by the walls between its tiers,
@@ -340,99 +323,6 @@ def below_camera_m(m: SearchMission, photo: Photo) -> float:
     is a guess, and a tower may stand taller (a roof's outline seen from above lies nearer
     the camera's nadir the taller it is)."""
     return photo.pose.pos_enu_m[2] - m.params.mission.min_above_roof_m
-
-
-def unknown_place(
-    shape: Shape,
-    photo: Photo,
-    tallest_m: float,
-    others: Sequence[Photo],
-    regions: Sequence[Shape],
-) -> Unknown:
-    """Where the building whose roof is ``shape`` (unmeasured) may stand, and the highest it
-    may be: :func:`unknown_roof` of the roof, and of everything not ground around it in the
-    photo (``regions``; its walls, a part of another colour, a neighbour touching it in the
-    photo). A region cut by the frame may hold a higher roof beyond it: up to ``tallest_m``."""
-    place = unknown_roof(shape, photo, tallest_m, others)
-    region = _region_of(shape, regions)
-    if region is None:
-        return place
-    if region.cut_by_border:
-        return Unknown(place.footprint, tallest_m)
-    whole = unknown_roof(region, photo, tallest_m, others)
-    return Unknown(
-        tuple(convex_hull([*place.footprint, *whole.footprint])),
-        max(place.upper_m, whole.upper_m),
-    )
-
-
-def _region_of(shape: Shape, regions: Sequence[Shape]) -> Shape | None:
-    """The region holding most of ``shape``'s corners and its centroid (None: none does)."""
-    points = [(float(u), float(v)) for u, v in shape.polygon_px] + [shape.centroid_px]
-
-    def inside(region: Shape) -> int:
-        ring = np.asarray(region.polygon_px, np.float32).reshape(-1, 1, 2)
-        return sum(cv2.pointPolygonTest(ring, p, False) >= 0 for p in points)
-
-    best = max(regions, key=inside, default=None)
-    return best if best is not None and inside(best) > len(points) // 2 else None
-
-
-def unknown_roof(
-    shape: Shape, photo: Photo, tallest_m: float, others: Sequence[Photo] = ()
-) -> Unknown:
-    """Where a building of unknown height (up to ``tallest_m``) may stand: its roof's outline
-    projected on every roof plane it may be at, from the ground up, and everything between;
-    and the highest its roof may be. A height is ruled out where one of ``others`` (other
-    nadir photos) sees, whole, the ground that the building would stand on at that height:
-    no building stands where a camera sees the ground. The roof may be up to a plane's step
-    above the highest plane left (it was not tried)."""
-    heights = [0.0]
-    step_m = _HEIGHT_STEP_M
-    while heights[-1] + step_m < tallest_m:
-        heights.append(heights[-1] + step_m)
-    heights.append(tallest_m)
-    feet = [footprint_at(shape, photo, h) for h in heights]
-    if others:
-        # Where a building stands, no camera above it sees the ground: neither on its base
-        # nor where its roof would show.
-        grounds = [(o, ground_mask(o.image_rgb)) for o in others]
-        kept = [
-            (f, h)
-            for f, h in zip(feet, heights, strict=True)
-            if not any(_ground_there(f, 0.0, o, g) or _ground_there(f, h, o, g) for o, g in grounds)
-        ]
-        if kept:  # every height ruled out: the photos disagree, keep them all
-            feet, heights = [f for f, _ in kept], [h for _, h in kept]
-    upper = min(max(heights) + _HEIGHT_STEP_M, tallest_m)
-    return Unknown(tuple(convex_hull([p for f in feet for p in f])), upper)
-
-
-_HEIGHT_STEP_M = 2.0
-"""The roof planes a building of unknown height is placed on, this far apart."""
-_GROUND_SEEN = 0.9
-"""The share of a footprint's pixels in the other photo that must be ground to rule it out."""
-
-
-def _ground_there(
-    footprint: tuple[tuple[float, float], ...], z_m: float, photo: Photo, ground: Any
-) -> bool:
-    """Whether ``photo`` sees ``footprint`` (at height ``z_m``) whole, and as ground."""
-    k = photo.intrinsics
-    if not z_m < photo.pose.pos_enu_m[2]:
-        return False
-    uvz = project(np.array([(x, y, z_m) for x, y in footprint]), photo.pose, k)
-    if not bool(np.all(uvz[:, 2] > 0.0)):
-        return False
-    us, vs = uvz[:, 0], uvz[:, 1]
-    if us.min() < 0.0 or vs.min() < 0.0 or us.max() > k.width_px - 1 or vs.max() > k.height_px - 1:
-        return False
-    inside = np.zeros(ground.shape, np.uint8)
-    cv2.fillPoly(inside, [np.round(uvz[:, :2]).astype(np.int32).reshape(-1, 1, 2)], 255)
-    area = cv2.countNonZero(inside)
-    if area == 0:
-        return False
-    return cv2.countNonZero(cv2.bitwise_and(inside, ground)) >= _GROUND_SEEN * area
 
 
 def _extent_m(footprint: tuple[tuple[float, float], ...]) -> float:

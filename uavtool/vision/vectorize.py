@@ -112,7 +112,11 @@ def _traced(
 
 
 def non_ground(
-    frame_rgb: U8Array, params: VectorizeParams | None = None, *, tolerance_dn: int = 15
+    frame_rgb: U8Array,
+    params: VectorizeParams | None = None,
+    *,
+    tolerance_dn: int = 15,
+    within: CvArray | None = None,
 ) -> tuple[Shape, ...]:
     """The roofs of everything in an RGB frame that is not the ground, whatever its colour,
     largest first. Not ground: pixels differing from the ground's colour (the frame's most
@@ -120,10 +124,13 @@ def non_ground(
     of such a region in its brightest colour that covers a tenth of it (walls are shaded
     darker from above in daylight).
     This is what the obstacle map is made of: grey, white or black roofs, and a darker shade
-    of a colour, which :func:`vectorize` leaves out, are here."""
+    of a colour, which :func:`vectorize` leaves out, are here. ``within`` (a mask of the
+    frame's size, non-zero where to look) keeps only what lies in it."""
     p = params if params is not None else VectorizeParams()
     frame = _check_frame(frame_rgb)
     mask = _not_ground_mask(frame, p, tolerance_dn)
+    if within is not None:
+        mask = cv2.bitwise_and(mask, cv2.threshold(within, 0, 255, cv2.THRESH_BINARY)[1])
     regions = _regions(mask, mask, (0, 0), frame.shape[:2], 1, p)
     roofs: list[_Region] = []
     for r in regions:
