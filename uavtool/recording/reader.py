@@ -32,7 +32,6 @@ from uavtool.recording.records import (
     NotMcap,
     Op,
     Schema,
-    iter_records,
     parse_channel,
     parse_schema,
 )
@@ -44,6 +43,8 @@ from uavtool.recording.schemas import (
 from uavtool.recording.values import Direction, Entry, JsonDocument, MavlinkFrame, Value
 
 _MSG = struct.Struct("<HIQQ")
+_CID = struct.Struct("<H")  # a message's channel id
+_REC = struct.Struct("<BQ")  # a record's opcode and length
 
 
 @dataclass(frozen=True, slots=True)
@@ -322,11 +323,21 @@ class RecordingReader:
         self, buf: Any, *, wanted: set[int] | None, lo: int, hi: int
     ) -> Iterator[Message]:
         channels, schemas = self._layout.channels, self._layout.schemas
-        unpack_msg = _MSG.unpack_from
-        for op, s, e in iter_records(buf, 0, len(buf)):
-            if op == Op.MESSAGE:
+        # `iter_records` inlined, and a message's channel read before the rest of it: most
+        # records are skipped here (replay wants ~2.4k of a paper flight's 32.5k messages)
+        unpack_rec, unpack_cid, unpack_msg = _REC.unpack_from, _CID.unpack_from, _MSG.unpack_from
+        message, off, end = int(Op.MESSAGE), 0, len(buf)
+        while off + 9 <= end:
+            op, n = unpack_rec(buf, off)
+            s = off + 9
+            e = off = s + n
+            if e > end:
+                return
+            if op == message:
+                if wanted is not None and unpack_cid(buf, s)[0] not in wanted:
+                    continue
                 cid, seq, log_t, pub_t = unpack_msg(buf, s)
-                if (wanted is None or cid in wanted) and lo <= log_t < hi:
+                if lo <= log_t < hi:
                     channel = channels.get(cid)
                     if channel is None:
                         if self._skip_damaged:  # its channel was defined in a damaged chunk
