@@ -202,35 +202,6 @@ def test_the_highest_a_roof_of_unknown_height_may_be() -> None:
     assert 40.0 <= upper <= 60.0  # 56 m here: the 2 m planes up to 54 m are left
 
 
-def test_a_roof_whose_building_reaches_past_the_frame_may_be_as_high_as_any() -> None:
-    """A 14 m block with a 50 m tower rising from it, 45 m east of home: from 117 m over
-    home the block's roof is whole in the photo, the tower's top beyond the frame, its walls
-    joining the block's roof to the frame's edge. A photo over the wing sees the ground where the
-    wing's roof would put a taller building, so the roof alone is bounded low; but what
-    stands around it reaches past the frame, where a higher roof may be: the building is
-    as high as anything below the camera may be. (Bounded by its roof alone, a look at the
-    tower's wing once passed 0.08 m from the tower.)"""
-    building = {
-        "name": "tower",
-        "color": [54, 160, 217],
-        "blocks": [
-            _block([(41.0, -6.0), (49.0, -6.0), (49.0, 0.0), (41.0, 0.0)], 0.0, 14.0),
-            _block(_square(46.5, -2.0, 2.0), 14.0, 50.0),
-        ],
-    }
-    data = scene_to_dict(_scene())
-    data["buildings"] = [building]
-    data["target"] = "tower"
-    scene = scene_from_dict(data)
-    home = _photo(scene, 0.0, 0.0, 117.0, 0)
-    over = _photo(scene, 45.0, -3.0, 117.0, 1)
-    wing = _shape(home, (54, 160, 217))
-    assert not wing.cut_by_border
-    regions = not_ground_regions(home.image_rgb)
-    assert unknown_roof(wing, home, 111.0, (over,)).upper_m < 50.0
-    assert unknown_place(wing, home, 111.0, (over,), regions).upper_m == 111.0
-
-
 def _tower_on_a_wing() -> Scene:
     """A 14 m wing with a 50 m tower rising from it, 45 m east of home."""
     building = {
@@ -245,6 +216,24 @@ def _tower_on_a_wing() -> Scene:
     data["buildings"] = [building]
     data["target"] = "tower"
     return scene_from_dict(data)
+
+
+def test_a_roof_whose_building_reaches_past_the_frame_may_be_as_high_as_any() -> None:
+    """A 14 m block with a 50 m tower rising from it, 45 m east of home: from 117 m over
+    home the block's roof is whole in the photo, the tower's top beyond the frame, its walls
+    joining the block's roof to the frame's edge. A photo over the wing sees the ground where the
+    wing's roof would put a taller building, so the roof alone is bounded low; but what
+    stands around it reaches past the frame, where a higher roof may be: the building is
+    as high as anything below the camera may be. (Bounded by its roof alone, a look at the
+    tower's wing once passed 0.08 m from the tower.)"""
+    scene = _tower_on_a_wing()
+    home = _photo(scene, 0.0, 0.0, 117.0, 0)
+    over = _photo(scene, 45.0, -3.0, 117.0, 1)
+    wing = _shape(home, (54, 160, 217))
+    assert not wing.cut_by_border
+    regions = not_ground_regions(home.image_rgb)
+    assert unknown_roof(wing, home, 111.0, (over,)).upper_m < 50.0
+    assert unknown_place(wing, home, 111.0, (over,), regions).upper_m == 111.0
 
 
 def test_a_taller_part_whose_roof_is_beyond_the_frame_is_not_explained_by_the_wing() -> None:
