@@ -19,10 +19,11 @@ import importlib
 import json
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 from functools import cache
-from operator import attrgetter
+from operator import attrgetter, itemgetter
 from types import ModuleType
-from typing import Any
+from typing import Any, cast
 
 from uavtool.recording.values import Direction
 
@@ -186,14 +187,27 @@ def _json_floats(values: Any) -> str:
     return "[" + ",".join(map(repr, values)) + "]"
 
 
-@cache
 def _json_writer(dialect: str, msgid: int) -> Callable[[Any], bytes]:
     """A function giving ``dumps(payload)`` of `MavlinkDecoder.view`'s payload of a message
     of this type, byte for byte, without building the dict: one ``%`` template of the whole
     object, filled from one `attrgetter` call. A float is written by ``repr``, as `json`
     writes it, an integer by ``str``; when any float is not finite (their sum is not), each
-    field is written or left out on its own (`NULL_RULE`). Generated source, as pymavlink's
-    own: it names only local variables (``v0``, ``v1`` …) and helpers; field names reach it
+    field is written or left out on its own (`NULL_RULE`)."""
+    return _json_writers(dialect, msgid)[0]
+
+
+def _json_values_writer(
+    dialect: str, msgid: int
+) -> Callable[[int, int, int, tuple[Any, ...]], bytes]:
+    """`_json_writer`'s function taking the header's ``(sysid, compid, seq)`` and the fields'
+    values in declaration order instead of a message (`MavlinkDecoder.decode_json`)."""
+    return _json_writers(dialect, msgid)[1]
+
+
+@cache
+def _json_writers(dialect: str, msgid: int) -> tuple[Callable[..., bytes], Callable[..., bytes]]:
+    """`_json_writer` and `_json_values_writer`: one body, generated source as pymavlink's
+    own; it names only local variables (``v0``, ``v1`` …) and helpers; field names reach it
     as data, never as code."""
     cls = dialect_module(dialect).mavlink_map[msgid]
     fields = _fields(cls)
@@ -220,21 +234,30 @@ def _json_writer(dialect: str, msgid: int) -> Callable[[Any], bytes]:
             template.append(keys[i].replace("%", "%%") + "%s")
             values.append(v if one_int else f"text({v})")
             each.append(f"    out.append(K[{i}] + str({values[-1]}))")
-    header = "m.get_srcSystem(), m.get_srcComponent(), m.get_seq()"
+    header = "sysid, compid, seq"
     whole = f"(T % ({', '.join([header, *values])},)).encode()"
-    lines = ["def write(m):"]
+    body = []
+    if finite:
+        body.append(f"    if fin({' + '.join(finite)}):")
+        body.append(f"        return {whole}")
+        body.append(f"    out = [H % ({header})]")
+        body.extend(each)
+        body.append('    return ("".join(out) + "}").encode()')
+    else:
+        body.append(f"    return {whole}")
+    names = ", ".join(f"v{i}" for i in range(len(fields)))
+    lines = [
+        "def write(m):",
+        "    sysid, compid, seq = m.get_srcSystem(), m.get_srcComponent(), m.get_seq()",
+    ]
     if len(fields) == 1:
         lines.append("    v0 = get(m)")
     elif fields:
-        lines.append(f"    {', '.join(f'v{i}' for i in range(len(fields)))} = get(m)")
-    if finite:
-        lines.append(f"    if fin({' + '.join(finite)}):")
-        lines.append(f"        return {whole}")
-        lines.append(f"    out = [H % ({header})]")
-        lines.extend(each)
-        lines.append('    return ("".join(out) + "}").encode()')
-    else:
-        lines.append(f"    return {whole}")
+        lines.append(f"    {names} = get(m)")
+    lines += [*body, "def write_values(sysid, compid, seq, values):"]
+    if fields:
+        lines.append(f"    {names}, = values")
+    lines += body
     space: dict[str, Any] = {
         "T": "".join(template) + "}",
         "H": head,
@@ -245,8 +268,54 @@ def _json_writer(dialect: str, msgid: int) -> Callable[[Any], bytes]:
         "text": _json_text,
     }
     exec("\n".join(lines), space)
-    write: Callable[[Any], bytes] = space["write"]
-    return write
+    return space["write"], space["write_values"]
+
+
+_STX_V2 = 0xFD
+_UNSURE = object()  # `MavlinkDecoder._fast_json`: pymavlink must decide
+
+
+@dataclass(frozen=True, slots=True)
+class _Plan:
+    """How pymavlink's ``decode`` takes apart the payload of one message type whose fields
+    are all numbers or arrays of numbers (`_plan`)."""
+
+    name: str
+    crc_extra: bytes
+    size: int
+    unpack: Callable[[bytes], tuple[Any, ...]]
+    fields: tuple[tuple[int, int | None], ...]
+    """Each field in declaration order: ``(tip, None)`` for the item ``t[tip]`` of the
+    unpacked tuple, ``(tip, end)`` for the list ``t[tip:end]``."""
+    pick: Callable[[tuple[Any, ...]], tuple[Any, ...]] | None
+    """The values from the unpacked tuple when every field is one number (most messages)."""
+    write: Callable[[int, int, int, tuple[Any, ...]], bytes]
+
+
+def _plan(dialect: str, msgid: int) -> _Plan | None:
+    """pymavlink's ``MAVLink.decode`` of one message type (its ``orders``, ``lengths`` and
+    ``unpacker``) worked out once: where each field's value is in the unpacked payload. None
+    for a type with a char field: pymavlink's message turns those into text its own way
+    (which has changed between its versions)."""
+    cls = dialect_module(dialect).mavlink_map[msgid]
+    if any(ftype == "char" for ftype in cls.fieldtypes):
+        return None
+    lengths = cls.lengths
+    fields = []
+    for order in cls.orders:
+        tip = sum(lengths[:order])
+        fields.append((tip, None if lengths[order] == 1 else tip + lengths[order]))
+    # itemgetter of one index gives no tuple: one field or none goes the general way
+    single = len(fields) > 1 and all(end is None for _, end in fields)
+    return _Plan(
+        cls.msgname,
+        bytes((cls.crc_extra,)),
+        cls.unpacker.size,
+        cls.unpacker.unpack,
+        tuple(fields),
+        itemgetter(*(tip for tip, _ in fields)) if single else None,
+        _json_values_writer(dialect, msgid),
+    )
 
 
 class MavlinkDecoder:
@@ -255,9 +324,17 @@ class MavlinkDecoder:
     def __init__(self, dialect: str = DEFAULT_DIALECT) -> None:
         self.dialect = dialect
         module = dialect_module(dialect)
+        self._module = module
         self._known = module.mavlink_map
         self._mav = module.MAVLink(None)
         self._error = module.MAVError
+        self._plans: dict[int, _Plan | None] = {}  # None: pymavlink decodes the type
+        fast_crc = getattr(module, "mcrf4xx", None)  # fastcrc's, when pymavlink found it
+        self._crc: Callable[[bytes], int] = (
+            (lambda data: fast_crc(data, 0xFFFF))
+            if fast_crc is not None
+            else (lambda data: module.x25crc(data).crc)
+        )
 
     def decode(self, frame: bytes) -> tuple[int, str, dict[str, Any]] | None:
         """``(msgid, MSGNAME, payload)`` of a frame, or None if it is unknown or corrupt."""
@@ -304,11 +381,45 @@ class MavlinkDecoder:
     def decode_json(self, frame: bytes) -> tuple[int, str, bytes] | None:
         """``(msgid, MSGNAME, JSON)`` of a frame (`decode`'s payload as `dumps` writes it),
         or None if it is unknown or corrupt."""
+        fast = self._fast_json(frame)
+        if fast is not _UNSURE:
+            return cast("tuple[int, str, bytes] | None", fast)
         try:
             msg = self._mav.decode(bytearray(frame))
         except (self._error, IndexError, ValueError):
             return None
         return self.json(msg)
+
+    def _fast_json(self, frame: bytes) -> object:
+        """`decode_json` of an unsigned MAVLink 2 frame of a message of numbers: the very
+        bytes pymavlink's decoding leads to, without building its message (its ``decode`` is
+        most of the cost, and a writer process decodes every frame of a flight again);
+        `_UNSURE` for any other frame (signed, MAVLink 1, a length that does not add up, an
+        unknown id, a message with text, CRC checks turned off), which pymavlink then
+        decodes. The CRC is checked as pymavlink checks it: None when it fails."""
+        n = len(frame)
+        if n < 12 or frame[0] != _STX_V2 or frame[2] or frame[1] != n - 12:
+            return _UNSURE
+        msgid = frame[7] | frame[8] << 8 | frame[9] << 16
+        try:
+            plan = self._plans[msgid]
+        except KeyError:
+            known = msgid in self._known
+            plan = self._plans[msgid] = _plan(self.dialect, msgid) if known else None
+        if plan is None:
+            return _UNSURE
+        if frame[-2] | frame[-1] << 8 != self._crc(frame[1:-2] + plan.crc_extra):
+            return _UNSURE if self._module.MAVLINK_IGNORE_CRC else None
+        payload = frame[10:-2]
+        if len(payload) < plan.size:  # MAVLink 2 leaves out the payload's trailing zeros
+            payload += bytes(plan.size - len(payload))
+        t = plan.unpack(payload[: plan.size])
+        values = (
+            plan.pick(t)
+            if plan.pick is not None
+            else tuple(t[tip] if end is None else list(t[tip:end]) for tip, end in plan.fields)
+        )
+        return msgid, plan.name, plan.write(frame[5], frame[6], frame[4], values)
 
     def json(self, msg: Any) -> tuple[int, str, bytes] | None:
         """``(msgid, MSGNAME, JSON)``: `view`'s payload as `dumps` writes it, byte for byte,
