@@ -334,3 +334,44 @@ def test_diagonal_blocked_goes_behind_both_cameras() -> None:
     )
     assert isinstance(failure, ViewpointFailure)
     assert failure.reason.startswith("diagonal: between the front and right cameras: ")
+
+
+def _clear(
+    eye: tuple[float, float, float], point: tuple[float, float, float], walls, heights
+) -> bool:
+    """Whether the straight line from ``eye`` to ``point`` passes over every wall (sampled
+    every 5 cm: an independent check of the planner's own crossing test)."""
+    n = int(math.dist(eye, point) / 0.05) + 1
+    for i in range(n + 1):
+        t = i / n
+        x, y, z = (e + (p - e) * t for e, p in zip(eye, point, strict=True))
+        for wall, h in zip(walls, heights, strict=True):
+            xs, ys = [q[0] for q in wall], [q[1] for q in wall]
+            if min(xs) < x < max(xs) and min(ys) < y < max(ys) and z < h:
+                return False
+    return True
+
+
+def test_walls_round_a_building_are_seen_over_from_as_high_as_needed() -> None:
+    """The 12 m box inside a ring of 9 m walls 8 m out from its sides, 2 m thick: no level
+    camera sees it, and the lowest camera that holds the box looking down sees only the top
+    of its walls over them. The camera rises until it sees every corner of its side from
+    the top down to half the box's height (the silhouette the model is carved from), never
+    steeper than ``max_pitch_down_deg``, and keeps the safety margin from the walls."""
+    walls = [
+        [(-15.0, -14.0), (15.0, -14.0), (15.0, -12.0), (-15.0, -12.0)],
+        [(-15.0, 12.0), (15.0, 12.0), (15.0, 14.0), (-15.0, 14.0)],
+        [(-15.0, -12.0), (-13.0, -12.0), (-13.0, 12.0), (-15.0, 12.0)],
+        [(13.0, -12.0), (15.0, -12.0), (15.0, 12.0), (13.0, 12.0)],
+    ]
+    heights = [9.0] * 4
+    front, right = plan_viewpoints(BOX, walls, K, P, heights)
+    for vp in (front, right):
+        assert isinstance(vp, Viewpoint), vp
+        assert -P.max_pitch_down_deg <= vp.pitch_deg < 0.0
+        x, y, z = vp.pos_enu_m
+        assert all(point_polygon_distance((x, y), w) >= P.safety_margin_m for w in walls)
+        near = [c for c in BOX.corners() if math.dist(c, (x, y)) < math.dist(BOX.center_en, (x, y))]
+        for cx, cy in near:
+            for at in (P.assumed_height_m, P.assumed_height_m / 2.0):
+                assert _clear((x, y, z), (cx, cy, at), walls, heights)

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -149,14 +149,14 @@ def base_distance_m(side_length_m: float, intrinsics: Intrinsics, params: Viewpo
     return max(d_h, d_v, params.safety_margin_m)
 
 
-def tilted_camera(
+def tilted_cameras(
     distance_m: float, depth_m: float, intrinsics: Intrinsics, params: ViewpointParams
-) -> tuple[float, float] | None:
-    """``(altitude, pitch)`` of a camera ``distance_m`` out from a building's near wall that
-    looks down at it (pitch ≤ 0) and sees it whole, with the margin, from the ground at the
-    near wall up to the top of its far side ``depth_m`` further (``assumed_height_m``
-    tall): the lowest such altitude from ``camera_alt_m`` up, in half-metre steps. None when
-    no pitch within ``max_pitch_down_deg`` does it."""
+) -> Iterator[tuple[float, float]]:
+    """Each ``(altitude, pitch)`` of a camera ``distance_m`` out from a building's near wall
+    that looks down at it (pitch ≤ 0) and sees it whole, with the margin, from the ground at
+    the near wall up to the top of its far side ``depth_m`` further (``assumed_height_m``
+    tall), from ``camera_alt_m`` up in half-metre steps, as long as a pitch within
+    ``max_pitch_down_deg`` does it: the lowest first, the higher ones see over more."""
     limit = math.radians(params.max_pitch_down_deg)
     half = math.atan((intrinsics.height_px / 2.0) / intrinsics.fy_px / (1.0 + params.margin))
     tall = params.assumed_height_m
@@ -166,11 +166,11 @@ def tilted_camera(
         top = math.atan2(z - tall, distance_m + depth_m if z > tall else distance_m)
         low = below_base - half  # the least pitch down that holds the foot
         if low > limit:
-            return None  # higher only looks steeper
+            return  # higher only looks steeper
         least, most = max(low, 0.0), min(top + half, limit)  # pitches down that hold both
         if least <= most:
             pitch = min(max((below_base + top) / 2.0, least), most)
-            return z, -math.degrees(pitch)
+            yield z, -math.degrees(pitch)
         z += 0.5
 
 
@@ -230,42 +230,50 @@ def _plan_one(
             tried.append(f"{side} at {distance:.1f} m: " + " and ".join(why))
         rounds += 1
         factor *= params.distance_step
-    for offset in params.oblique_deg if tried else ():  # none fit at all: say so below
-        for side in (first_side, _OPPOSITE[first_side]):
-            found = _oblique(name, rect, side, offset, obstacles, intrinsics, params, heights)
-            if isinstance(found, Viewpoint) and apart_from is not None:
-                apart = _apart_deg(found.heading_deg, apart_from[0])
-                if apart < apart_from[1]:
-                    found = f"{side} turned {offset:+g}°: {apart:.0f}° from the other photo's"
-            if isinstance(found, Viewpoint):
-                return found
-            tried.append(found)
-    if not tried:
-        tried.append(
-            f"the base distance {d0:.1f} m exceeds nav.max_distance_m {params.max_distance_m:g} m"
-        )
-    if params.max_pitch_down_deg > 0.0:
-        for side in (first_side, _OPPOSITE[first_side]):
-            end1, end2, normal = _side_geometry(rect, side)
-            depth = rect.width_m if side.startswith("long") else rect.length_m
-            mid = ((end1[0] + end2[0]) / 2.0, (end1[1] + end2[1]) / 2.0)
-            ends = (end1, end2)
-            found = _looking_down(
-                name,
-                side,
-                mid,
-                ends,
-                normal,
-                depth,
-                side_len,
-                obstacles,
-                intrinsics,
-                params,
-                heights,
+    base_too_far = not tried
+    # Every camera turned round or looking down at its lowest first; only then one that
+    # rises higher to see over lower neighbours (steeper, it sees less of the walls).
+    for rise in (False, True) if heights is not None else (False,):
+        for offset in params.oblique_deg if not base_too_far else ():  # none fit: say so below
+            for side in (first_side, _OPPOSITE[first_side]):
+                found = _oblique(
+                    name, rect, side, offset, obstacles, intrinsics, params, heights, rise=rise
+                )
+                if isinstance(found, Viewpoint) and apart_from is not None:
+                    apart = _apart_deg(found.heading_deg, apart_from[0])
+                    if apart < apart_from[1]:
+                        found = f"{side} turned {offset:+g}°: {apart:.0f}° from the other photo's"
+                if isinstance(found, Viewpoint):
+                    return found
+                if not rise:
+                    tried.append(found)
+        if base_too_far and not rise:
+            tried.append(
+                f"the base distance {d0:.1f} m exceeds nav.max_distance_m "
+                f"{params.max_distance_m:g} m"
             )
-            if isinstance(found, Viewpoint):
-                return found
-            tried.append(found)
+        if params.max_pitch_down_deg > 0.0:
+            for side in (first_side, _OPPOSITE[first_side]):
+                end1, end2, normal = _side_geometry(rect, side)
+                depth = rect.width_m if side.startswith("long") else rect.length_m
+                mid = ((end1[0] + end2[0]) / 2.0, (end1[1] + end2[1]) / 2.0)
+                found = _looking_down(
+                    name,
+                    side,
+                    mid,
+                    (end1, end2),
+                    normal,
+                    depth,
+                    side_len,
+                    obstacles,
+                    intrinsics,
+                    params,
+                    heights,
+                    rise=rise,
+                )
+                if isinstance(found, Viewpoint):
+                    return found
+                tried.append(found)
     return ViewpointFailure(
         name, f"{name}: " + "; ".join(tried) + f" (tried up to {params.max_distance_m:g} m)"
     )
@@ -283,14 +291,18 @@ def _looking_down(
     intrinsics: Intrinsics,
     params: ViewpointParams,
     heights: Sequence[float] | None = None,
+    *,
+    rise: bool = False,
 ) -> Viewpoint | str:
     """A camera out along ``normal`` from ``mid`` (the middle of the near wall) that rises
-    and looks down (:func:`tilted_camera`), at the first distance from the horizontal need
+    and looks down (:func:`tilted_cameras`), at the first distance from the horizontal need
     (``across_m`` wide) or the safety margin, growing, where it keeps the margin and sees
-    the points ``seen`` (the wall's ends, or every corner) past the obstacles; else what
-    stopped it. Without ``heights`` the obstacles are as tall as any (a level camera's
-    rule); with them (``math.inf``: unknown), the camera may see the building's top over a
-    lower obstacle, its lower part hidden (:func:`foot_hidden` says so)."""
+    the points ``seen`` (the wall's ends, or every corner; with ``heights``, from their tops
+    down to half their height) past the obstacles, at its lowest altitude (with ``rise``, at
+    the lowest altitude that does); else what stopped it. Without ``heights`` the obstacles
+    are as tall as any (a level camera's rule); with them (``math.inf``: unknown), the
+    camera may see the building's top over a lower obstacle, its lower part hidden
+    (:func:`foot_hidden` says so)."""
     tan_h = (intrinsics.width_px / 2.0) / intrinsics.fx_px
     distance = max((1.0 + params.margin) * (across_m / 2.0) / tan_h, params.safety_margin_m)
     why = "too close to look down at steeply enough"
@@ -299,12 +311,12 @@ def _looking_down(
         distances.append(distance)
         distance *= params.distance_step
     for distance in (*distances, params.max_distance_m):  # the farthest allowed last
-        found = tilted_camera(distance, depth_m, intrinsics, params)
         cam = (mid[0] + distance * normal[0], mid[1] + distance * normal[1])
-        if found is not None:
-            near = any(
-                point_polygon_distance(cam, poly) < params.safety_margin_m for poly in obstacles
-            )
+        near = any(point_polygon_distance(cam, poly) < params.safety_margin_m for poly in obstacles)
+        for z, pitch in tilted_cameras(distance, depth_m, intrinsics, params):
+            if near:
+                why = "no room"
+                break
             if heights is None:
                 hidden = any(
                     triangle_hits_polygon((cam, a, b), poly)
@@ -313,15 +325,16 @@ def _looking_down(
                     for b in seen[i + 1 :]
                 )
             else:
-                top = params.assumed_height_m
-                eye = (cam[0], cam[1], found[0])
+                # The upper half of the walls, whose silhouette the model is carved from: a
+                # photo that sees only their tops shows a sliver.
+                tall = params.assumed_height_m
                 hidden = any(
-                    _sight_blocked(eye, (q[0], q[1], top), poly, h)
+                    _sight_blocked((cam[0], cam[1], z), (q[0], q[1], at), poly, h)
                     for poly, h in zip(obstacles, heights, strict=True)
                     for q in seen
+                    for at in (tall, tall / 2.0)
                 )
-            if not near and not hidden:
-                z, pitch = found
+            if not hidden:
                 return Viewpoint(
                     name=name,
                     pos_enu_m=(cam[0], cam[1], z),
@@ -336,8 +349,10 @@ def _looking_down(
                     ),
                     pitch_deg=pitch,
                 )
-            why = "no line of sight" if hidden else "no room"
-    return f"{side} looking down: {why}"
+            why = "no line of sight"
+            if heights is None or not rise:
+                break  # the lowest only (obstacles as tall as any: none sees over them)
+    return f"{side} looking down{', rising' if rise else ''}: {why}"
 
 
 def _sight_blocked(
@@ -394,6 +409,8 @@ def _oblique(
     intrinsics: Intrinsics,
     params: ViewpointParams,
     heights: Sequence[float] | None = None,
+    *,
+    rise: bool = False,
 ) -> Viewpoint | str:
     """A camera on ``side``'s normal turned ``offset_deg`` around the building's centre, at
     the first distance (growing as square-on ones do) where it keeps the safety margin and
@@ -415,6 +432,7 @@ def _oblique(
         intrinsics,
         params,
         heights,
+        rise=rise,
     )
     if isinstance(found, Viewpoint):
         return found
@@ -431,6 +449,8 @@ def _from_direction(
     intrinsics: Intrinsics,
     params: ViewpointParams,
     heights: Sequence[float] | None = None,
+    *,
+    rise: bool = False,
 ) -> Viewpoint | str:
     """A camera out from the rectangle's centre along the unit vector ``u``, looking back at
     it, at the first distance (growing as square-on ones do) where it keeps the safety
@@ -486,6 +506,7 @@ def _from_direction(
         intrinsics,
         params,
         heights,
+        rise=rise,
     )
     if isinstance(down, Viewpoint):
         return dataclasses.replace(down, fallback=f"{label}, {down.fallback}")
