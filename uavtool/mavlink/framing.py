@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from uavtool.mavlink.dialect import mavlink
+from uavtool.mavlink.payload import frame_crc, layout, values
 
 _STX_V1 = 0xFE
 _STX_V2 = 0xFD
@@ -91,15 +92,52 @@ class FrameParser:
     def _decode(self, raw: bytes) -> Frame | None:
         if raw[0] == _STX_V2 and raw[2] & ~_SIGNED:
             return None  # unknown incompatibility flag: must not be parsed
-        try:
-            msg = self._mav.decode(bytearray(raw))
-        except (mavlink.MAVError, ValueError, IndexError, TypeError):
+        msg = self._decode_unsigned(raw)
+        if msg is _UNSURE:
+            try:
+                msg = self._mav.decode(bytearray(raw))
+            except (mavlink.MAVError, ValueError, IndexError, TypeError):
+                return None
+        elif msg is None:
             return None
         if isinstance(msg, mavlink.MAVLink_unknown):
             self.unknown_ids += 1
             return None
         self.frames_ok += 1
         return Frame(msg, raw, bool(getattr(msg, "_signed", False)))
+
+    def _decode_unsigned(self, raw: bytes) -> Any:
+        """The message pymavlink's ``decode`` makes of an unsigned MAVLink 2 frame of a known
+        type, built as it builds it (the type's constructor, then the same attributes), at
+        half its cost (`payload`); None for a bad CRC, which pymavlink refuses; `_UNSURE`
+        for every other frame (signed, MAVLink 1, a parser with a signing key, CRC checks
+        turned off, a length that does not add up), which pymavlink then decodes."""
+        n = len(raw)
+        if raw[0] != _STX_V2 or raw[2] or raw[1] != n - 12 or self._mav.signing.secret_key:
+            return _UNSURE
+        msgid = raw[7] | raw[8] << 8 | raw[9] << 16
+        cls = mavlink.mavlink_map.get(msgid)
+        if cls is None:
+            return _UNSURE
+        lay = layout(cls)
+        crc = raw[-2] | raw[-1] << 8
+        if crc != _crc16(raw[1:-2] + lay.crc_extra):
+            return _UNSURE if mavlink.MAVLINK_IGNORE_CRC else None
+        try:
+            msg = cls(*values(lay, raw[10:-2]))
+        except Exception:  # whatever it is, pymavlink's decode says what
+            return _UNSURE
+        buf = bytearray(raw)
+        msg._signed = False
+        msg._msgbuf = buf
+        msg._payload = buf[6:-2]
+        msg._crc = crc
+        msg._header = mavlink.MAVLink_header(msgid, 0, raw[3], raw[1], raw[4], raw[5], raw[6])
+        return msg
+
+
+_UNSURE = object()  # FrameParser._decode_unsigned: pymavlink decides
+_crc16 = frame_crc(mavlink)
 
 
 def _next_stx(buf: bytearray, start: int) -> int:

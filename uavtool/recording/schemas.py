@@ -21,7 +21,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
-from operator import attrgetter, itemgetter
+from operator import attrgetter
 from types import ModuleType
 from typing import Any, cast
 
@@ -277,45 +277,26 @@ _UNSURE = object()  # `MavlinkDecoder._fast_json`: pymavlink must decide
 
 @dataclass(frozen=True, slots=True)
 class _Plan:
-    """How pymavlink's ``decode`` takes apart the payload of one message type whose fields
-    are all numbers or arrays of numbers (`_plan`)."""
+    """How `MavlinkDecoder.decode_json` makes the JSON view of one message type's frames."""
 
     name: str
-    crc_extra: bytes
-    size: int
-    unpack: Callable[[bytes], tuple[Any, ...]]
-    fields: tuple[tuple[int, int | None], ...]
-    """Each field in declaration order: ``(tip, None)`` for the item ``t[tip]`` of the
-    unpacked tuple, ``(tip, end)`` for the list ``t[tip:end]``."""
-    pick: Callable[[tuple[Any, ...]], tuple[Any, ...]] | None
-    """The values from the unpacked tuple when every field is one number (most messages)."""
+    layout: Any  # uavtool.mavlink.payload.Layout: where pymavlink's decode finds each field
+    values: Callable[[Any, bytes], tuple[Any, ...]]  # uavtool.mavlink.payload.values
+    crc: Callable[[bytes], int]  # the dialect's frame CRC
     write: Callable[[int, int, int, tuple[Any, ...]], bytes]
 
 
 def _plan(dialect: str, msgid: int) -> _Plan | None:
-    """pymavlink's ``MAVLink.decode`` of one message type (its ``orders``, ``lengths`` and
-    ``unpacker``) worked out once: where each field's value is in the unpacked payload. None
-    for a type with a char field: pymavlink's message turns those into text its own way
-    (which has changed between its versions)."""
-    cls = dialect_module(dialect).mavlink_map[msgid]
-    if any(ftype == "char" for ftype in cls.fieldtypes):
+    """The `_Plan` of a message type, or None for one with a char field: pymavlink's message
+    turns those into text its own way (which has changed between its versions)."""
+    from uavtool.mavlink.payload import frame_crc, layout, values  # noqa: PLC0415
+
+    module = dialect_module(dialect)
+    cls = module.mavlink_map[msgid]
+    lay = layout(cls)
+    if lay.has_text:
         return None
-    lengths = cls.lengths
-    fields = []
-    for order in cls.orders:
-        tip = sum(lengths[:order])
-        fields.append((tip, None if lengths[order] == 1 else tip + lengths[order]))
-    # itemgetter of one index gives no tuple: one field or none goes the general way
-    single = len(fields) > 1 and all(end is None for _, end in fields)
-    return _Plan(
-        cls.msgname,
-        bytes((cls.crc_extra,)),
-        cls.unpacker.size,
-        cls.unpacker.unpack,
-        tuple(fields),
-        itemgetter(*(tip for tip, _ in fields)) if single else None,
-        _json_values_writer(dialect, msgid),
-    )
+    return _Plan(cls.msgname, lay, values, frame_crc(module), _json_values_writer(dialect, msgid))
 
 
 class MavlinkDecoder:
@@ -329,12 +310,6 @@ class MavlinkDecoder:
         self._mav = module.MAVLink(None)
         self._error = module.MAVError
         self._plans: dict[int, _Plan | None] = {}  # None: pymavlink decodes the type
-        fast_crc = getattr(module, "mcrf4xx", None)  # fastcrc's, when pymavlink found it
-        self._crc: Callable[[bytes], int] = (
-            (lambda data: fast_crc(data, 0xFFFF))
-            if fast_crc is not None
-            else (lambda data: module.x25crc(data).crc)
-        )
 
     def decode(self, frame: bytes) -> tuple[int, str, dict[str, Any]] | None:
         """``(msgid, MSGNAME, payload)`` of a frame, or None if it is unknown or corrupt."""
@@ -408,17 +383,10 @@ class MavlinkDecoder:
             plan = self._plans[msgid] = _plan(self.dialect, msgid) if known else None
         if plan is None:
             return _UNSURE
-        if frame[-2] | frame[-1] << 8 != self._crc(frame[1:-2] + plan.crc_extra):
+        lay = plan.layout
+        if frame[-2] | frame[-1] << 8 != plan.crc(frame[1:-2] + lay.crc_extra):
             return _UNSURE if self._module.MAVLINK_IGNORE_CRC else None
-        payload = frame[10:-2]
-        if len(payload) < plan.size:  # MAVLink 2 leaves out the payload's trailing zeros
-            payload += bytes(plan.size - len(payload))
-        t = plan.unpack(payload[: plan.size])
-        values = (
-            plan.pick(t)
-            if plan.pick is not None
-            else tuple(t[tip] if end is None else list(t[tip:end]) for tip, end in plan.fields)
-        )
+        values = plan.values(lay, frame[10:-2])
         return msgid, plan.name, plan.write(frame[5], frame[6], frame[4], values)
 
     def json(self, msg: Any) -> tuple[int, str, bytes] | None:
