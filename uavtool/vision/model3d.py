@@ -38,6 +38,9 @@ from uavtool.vision.shapes import FloatArray, Shape, cut_edges
 # Depth range of the side viewing cones, metres along the optical axis.
 _NEAR_M = 0.25
 _FAR_M = 2000.0
+_BEYOND_M = 1.0
+"""How far above what the top view sees the side views' solid may reach and still be the
+same top (their outlines differ by a pixel or two; in metres at the roof, centimetres)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -97,7 +100,19 @@ def build_model(
             "the front and right silhouettes do not overlap in space: check the poses and "
             "that both photos show the same building"
         )
-    rings = _footprint(top, side, p.ground_z_m, p)
+    # Only what the top photo sees of the side views' solid is the building: two views
+    # whose foot is hidden (filled down past the frame) meet far off too, high up.
+    seen = side ^ _cone(top)
+    if seen.is_empty():
+        raise ModelInputError(
+            "the top silhouette does not overlap the front and right ones: check the poses "
+            "and that each photo shows the same building"
+        )
+    h_start = float(side.bounding_box()[5])
+    h_seen = float(seen.bounding_box()[5])
+    if h_start > h_seen + _BEYOND_M:
+        h_start = h_seen
+    rings = _footprint(top, side, p.ground_z_m, p, h_start)
     solid = side ^ _prism(rings, p.ground_z_m, _FAR_M)
     if solid.is_empty():
         raise ModelInputError(
@@ -243,19 +258,21 @@ def _world_from_camera_3x4(pose: CameraPose) -> list[list[float]]:
     return [[float(r[i, 0]), float(r[i, 1]), float(r[i, 2]), float(t[i])] for i in range(3)]
 
 
-def _footprint(top: View, side: Any, ground_z_m: float, p: ModelParams) -> list[FloatArray]:
+def _footprint(
+    top: View, side: Any, ground_z_m: float, p: ModelParams, h_start: float
+) -> list[FloatArray]:
     """The top silhouette's rings as an ENU footprint ``(n, 2)`` each.
 
     An outline pixel sees a roof edge at some height ``h``: its ray cut at ``z = h`` gives
     the footprint corner, and the model's height there (the top of the side views' solid)
-    must be ``h`` again. Each corner iterates that to a fixed point, so a lower wing is put
+    must be ``h`` again, starting from ``h_start`` (the top of what the top view sees of the
+    side views' solid). Each corner iterates that to a fixed point, so a lower wing is put
     at its own roof height instead of being shrunk onto the highest roof's plane. Where two
     roofs meet, the outline belongs to the higher one, so the height is the highest within
     two pixels' ground distance of the corner.
     """
     r = top.pose.world_from_camera()
     ox, oy, oz = top.pose.pos_enu_m
-    h_start = float(side.bounding_box()[5])
     fx = top.intrinsics.fx_px
     if h_start >= oz:
         raise ModelInputError(
