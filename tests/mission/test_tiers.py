@@ -19,7 +19,14 @@ from uavtool.mission import Status
 from uavtool.mission.analysis import NOT_FLAT_M, nadir_shapes, not_flat, roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.params import Params
-from uavtool.mission.unknown import region_of, unexplained, unknown_place, unknown_roof
+from uavtool.mission.unknown import (
+    Known,
+    evidence,
+    region_of,
+    unexplained,
+    unknown_place,
+    unknown_roof,
+)
 from uavtool.nav.heights import higher_part_m
 from uavtool.recording import JsonDocument, RecordingReader
 from uavtool.recording.topics import OBSERVATIONS
@@ -294,3 +301,37 @@ def test_a_look_keeps_clear_of_a_taller_tier_beyond_the_frame(tmp_path: Path) ->
     scene = load_scene(DATA / "town-9854.yaml")
     clearance, name = closest_clearance(route, scene, body_radius_m=SitlConfig().body_radius_m)
     assert clearance >= Params().viewpoints.safety_margin_m, name
+
+
+def test_a_lower_roof_seen_beneath_rules_heights_out() -> None:
+    """A 10 m block of unknown height 57 m out from home, photographed from 117 m over home
+    and over a 12 m block measured between them: from home, taller and taller roofs of the
+    first block's outline would stand nearer home, over the 12 m block, where the other
+    photo sees no ground (the 12 m roof covers it), so those heights stood (92 m). But it
+    sees the 12 m roof, of another colour, in their place: nothing taller stands there.
+    With that evidence the bound comes down (44 m) and stays above the true 10 m. A known
+    roof of the block's own colour could be a lower tier of it: it is no evidence."""
+    data = scene_to_dict(_scene())
+    data["buildings"] = [
+        {
+            "name": "low",
+            "color": [54, 125, 217],
+            "blocks": [_block(_square(20.0, 20.0, 10.0), 0.0, 12.0)],
+        },
+        {
+            "name": "out",
+            "color": [217, 125, 54],
+            "blocks": [_block(_square(40.0, 40.0, 4.0), 0.0, 10.0)],
+        },
+    ]
+    data["target"] = "out"
+    scene = scene_from_dict(data)
+    home, over = _photo(scene, 0.0, 0.0, 117.0, 0), _photo(scene, 10.0, 10.0, 117.0, 1)
+    shape = _shape(home, (217, 125, 54))
+    low = Known(tuple(_square(20.0, 20.0, 10.0)), 12.0, _shape(home, (54, 125, 217)).colour_rgb)
+    alone = unknown_roof(shape, home, 111.0, (over,)).upper_m
+    seen = evidence(over, (low,), tolerance_dn=10.0)
+    upper = unknown_roof(shape, home, 111.0, (seen,), hue_tolerance_deg=12.0).upper_m
+    assert 10.0 <= upper < alone - 10.0
+    own = evidence(over, (low._replace(colour_rgb=shape.colour_rgb),), tolerance_dn=10.0)
+    assert unknown_roof(shape, home, 111.0, (own,), hue_tolerance_deg=12.0).upper_m == alone

@@ -31,7 +31,15 @@ from uavtool.mission.survey import (
     points_of_interest,
     same_colour,
 )
-from uavtool.mission.unknown import Unknown, footprint_at, pixels, unexplained, unknown_place
+from uavtool.mission.unknown import (
+    Known,
+    Unknown,
+    evidence,
+    footprint_at,
+    pixels,
+    unexplained,
+    unknown_place,
+)
 from uavtool.nav import NavError, ground_point
 from uavtool.nav.heights import roof_from_cut_outline
 from uavtool.vision import Shape
@@ -79,7 +87,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         (f"point of interest {k}", f"measure-{k}", seen.pois[k], -1) for k in order
     ]
     stops += [(f"obstacle {j}", f"measure-obstacle-{j}", None, j) for j in range(len(others))]
-    views = [] if seen.lower is None else [seen.lower]  # nadir photos that show the ground
+    photos = [] if seen.lower is None else [seen.lower]  # nadir photos that show the ground
     for what, tag, poi, j in stops:
         if poi is not None:
             if measured[poi.shape_index]:
@@ -91,7 +99,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
             x, y = ground_point(*others[j].centroid_px, seen.photo.pose, seen.photo.intrinsics)
         yield from m.move((x, y, ceiling_m), seen.photo.pose.heading_deg, f"over {what}, measuring")
         photo = yield from m.photo(tag, -90.0)
-        views.append(photo)
+        photos.append(photo)
         shapes = photo_shapes(m, photo)
         for i, shape in enumerate(seen.shapes):
             if not measured[i]:
@@ -115,8 +123,22 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         seen.photo, seen.shapes, roofs, measured, seen.regions, m.params.vectorize
     )
     others_m += [None] * (len(others) - len(others_m))
+    # Each photo is evidence of where nothing stands: the ground it sees, and the roofs of
+    # known height (measured whole) it sees in their places.
+    known = [
+        Known(footprint_at(s, seen.photo, roofs[i]), roofs[i], s.colour_rgb)
+        for i, s in enumerate(seen.shapes)
+        if measured[i] and not s.cut_by_border
+    ]
+    tol = m.params.mission.roof_colour_tolerance_dn
+    views = [evidence(v, known, tolerance_dn=tol) for v in photos]
+    hue = m.params.vectorize.hue_tolerance_deg
+
+    def place_of(o: Shape) -> Unknown:
+        return unknown_place(o, seen.photo, tallest_m, views, seen.regions, hue_tolerance_deg=hue)
+
     obstacles = tuple(
-        Obstacle(o, assumed_m, False, *unknown_place(o, seen.photo, tallest_m, views, seen.regions))
+        Obstacle(o, assumed_m, False, *place_of(o))
         if h is None
         else Obstacle(o, h, True, footprint_at(o, seen.photo, h), h)
         for o, h in zip(others, others_m, strict=True)
@@ -133,7 +155,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         if measured[i] and not seen.measured[i]
         else Unknown(fp, roofs[i])
         if measured[i]
-        else unknown_place(s, seen.photo, tallest_m, views, seen.regions)
+        else place_of(s)
         for i, (s, fp) in enumerate(zip(seen.shapes, seen.footprints, strict=True))
     ]
     footprints = tuple(place.footprint for place in places)
@@ -159,7 +181,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     # as high as its region allows (one cut by the frame: as high as anything may be).
     m.unknown.update(
         {
-            i: unknown_place(s, seen.photo, tallest_m, views, seen.regions)
+            i: place_of(s)
             for i, (s, ok) in enumerate(zip(seen.shapes, measured, strict=True))
             if ok and s.cut_by_border and not seen.measured[i]
         }

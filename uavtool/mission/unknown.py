@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 import cv2
@@ -24,7 +25,7 @@ from uavtool.nav import NavError, ground_polygon
 from uavtool.nav.geometry import convex_hull
 from uavtool.vision import Shape
 from uavtool.vision.params import VectorizeParams
-from uavtool.vision.vectorize import ground_mask, non_ground
+from uavtool.vision.vectorize import ground_mask, hue_distance_deg, non_ground
 
 
 class Unknown(NamedTuple):
@@ -47,20 +48,25 @@ def unknown_place(
     shape: Shape,
     photo: Photo,
     tallest_m: float,
-    others: Sequence[Photo],
+    others: Sequence[Photo | Evidence],
     regions: Sequence[Shape],
+    *,
+    hue_tolerance_deg: float = 0.0,
 ) -> Unknown:
     """Where the building whose roof is ``shape`` (unmeasured) may stand, and the highest it
     may be: :func:`unknown_roof` of the roof, and of everything not ground around it in the
     photo (``regions``; its walls, a part of another colour, a neighbour touching it in the
     photo). A region cut by the frame may hold a higher roof beyond it: up to ``tallest_m``."""
-    place = unknown_roof(shape, photo, tallest_m, others)
+    tol = hue_tolerance_deg
+    place = unknown_roof(shape, photo, tallest_m, others, hue_tolerance_deg=tol)
     region = region_of(shape, regions)
     if region is None:
         return place
     if region.cut_by_border:
         return Unknown(place.footprint, tallest_m)
-    whole = unknown_roof(region, photo, tallest_m, others)
+    whole = unknown_roof(
+        region, photo, tallest_m, others, hue_tolerance_deg=tol, own_rgb=shape.colour_rgb
+    )
     return Unknown(
         tuple(convex_hull([*place.footprint, *whole.footprint])),
         max(place.upper_m, whole.upper_m),
@@ -88,15 +94,69 @@ def region_of(shape: Shape, regions: Sequence[Shape]) -> Shape | None:
     return best if area > 0 and 2 * best_n >= area else None
 
 
+class Known(NamedTuple):
+    """A roof of measured height: where it stands (ENU metres), how high, and its colour."""
+
+    footprint: tuple[tuple[float, float], ...]
+    roof_m: float
+    colour_rgb: tuple[int, int, int]
+
+
+@dataclass(frozen=True, slots=True)
+class Evidence:
+    """A nadir photo as evidence of free space: where it sees the ground, and where it sees
+    a roof of known height (:func:`evidence`)."""
+
+    photo: Photo
+    ground: Any
+    roofs: tuple[tuple[float, tuple[int, int, int], Any, tuple[int, int, int, int]], ...]
+    """Per roof of known height: its height, its colour, the mask of the pixels showing it
+    (in its place for that height, and of its colour) and their box (x0, y0, x1, y1)."""
+
+
+def evidence(photo: Photo, known: Sequence[Known] = (), *, tolerance_dn: float = 0.0) -> Evidence:
+    """What ``photo`` (from above) shows of the ground, and of each roof of ``known``: the
+    pixels in that roof's place at its height, within ``tolerance_dn`` of its colour in every
+    channel."""
+    k = photo.intrinsics
+    ground = ground_mask(photo.image_rgb)
+    roofs = []
+    for footprint, roof_m, rgb in known:
+        ring = _ring_px(footprint, roof_m, photo)
+        if ring is None:
+            continue
+        x0, y0 = np.maximum(ring.min(axis=0), 0)
+        x1, y1 = np.minimum(ring.max(axis=0) + 1, (k.width_px, k.height_px))
+        if x0 >= x1 or y0 >= y1:
+            continue
+        place = np.zeros(ground.shape, np.uint8)
+        cv2.fillPoly(place, [ring.reshape(-1, 1, 2)], 255)
+        lo = np.clip(np.array(rgb) - tolerance_dn, 0, 255).astype(np.uint8)
+        hi = np.clip(np.array(rgb) + tolerance_dn, 0, 255).astype(np.uint8)
+        mask = cv2.bitwise_and(place, cv2.inRange(photo.image_rgb, lo, hi))
+        roofs.append((roof_m, rgb, mask, (int(x0), int(y0), int(x1), int(y1))))
+    return Evidence(photo, ground, tuple(roofs))
+
+
 def unknown_roof(
-    shape: Shape, photo: Photo, tallest_m: float, others: Sequence[Photo] = ()
+    shape: Shape,
+    photo: Photo,
+    tallest_m: float,
+    others: Sequence[Photo | Evidence] = (),
+    *,
+    hue_tolerance_deg: float = 0.0,
+    own_rgb: tuple[int, int, int] | None = None,
 ) -> Unknown:
     """Where a building of unknown height (up to ``tallest_m``) may stand: its roof's outline
     projected on every roof plane it may be at, from the ground up, and everything between;
     and the highest its roof may be. A height is ruled out where one of ``others`` (other
-    nadir photos) sees, whole, the ground that the building would stand on at that height:
-    no building stands where a camera sees the ground. The roof may be up to a plane's step
-    above the highest plane left (it was not tried)."""
+    nadir photos) sees what the building would stand on at that height: no building stands
+    where a camera sees, whole, the ground beneath it, or its roof's place as ground. Nor
+    where a camera sees, under it, a lower roof of known height (:func:`evidence`) of
+    another colour than its own (``own_rgb``, else ``shape``'s; more than
+    ``hue_tolerance_deg`` apart: one of its own colour may be a lower tier of the same
+    building, its own roof in the photo). The roof
+    may be up to a plane's step above the highest plane left (it was not tried)."""
     heights = [0.0]
     step_m = _HEIGHT_STEP_M
     while heights[-1] + step_m < tallest_m:
@@ -104,13 +164,17 @@ def unknown_roof(
     heights.append(tallest_m)
     feet = [footprint_at(shape, photo, h) for h in heights]
     if others:
-        # Where a building stands, no camera above it sees the ground: neither on its base
-        # nor where its roof would show.
-        grounds = [(o, ground_mask(o.image_rgb)) for o in others]
+        hue = shape.colour_rgb if own_rgb is None else own_rgb
+        views = [
+            _other_colours(o if isinstance(o, Evidence) else evidence(o), hue, hue_tolerance_deg)
+            for o in others
+        ]
         kept = [
             (f, h)
             for f, h in zip(feet, heights, strict=True)
-            if not any(_ground_there(f, 0.0, o, g) or _ground_there(f, h, o, g) for o, g in grounds)
+            if not any(
+                _seen_beneath(f, h, v) or _ground_there(f, h, v.photo, v.ground) for v in views
+            )
         ]
         if kept:  # every height ruled out: the photos disagree, keep them all
             feet, heights = [f for f, _ in kept], [h for _, h in kept]
@@ -121,7 +185,63 @@ def unknown_roof(
 _HEIGHT_STEP_M = 2.0
 """The roof planes a building of unknown height is placed on, this far apart."""
 _GROUND_SEEN = 0.9
-"""The share of a footprint's pixels in the other photo that must be ground to rule it out."""
+"""The share of a footprint's pixels in the other photo that must show what is beneath it
+(or ground) to rule it out."""
+
+
+def _other_colours(view: Evidence, rgb: tuple[int, int, int], tolerance_deg: float) -> Evidence:
+    """``view`` with only the known roofs whose hue is more than ``tolerance_deg`` from
+    ``rgb``'s."""
+    roofs = tuple(r for r in view.roofs if hue_distance_deg(r[1], rgb) > tolerance_deg)
+    return Evidence(view.photo, view.ground, roofs)
+
+
+def _ring_px(footprint: Sequence[tuple[float, float]], z_m: float, photo: Photo) -> Any:
+    """``footprint`` at height ``z_m`` in ``photo``'s pixels (int32 (n, 2)), None when a
+    corner is not in front of the camera."""
+    if not z_m < photo.pose.pos_enu_m[2]:
+        return None
+    uvz = project(np.array([(x, y, z_m) for x, y in footprint]), photo.pose, photo.intrinsics)
+    if not bool(np.all(uvz[:, 2] > 0.0)):
+        return None
+    return np.round(uvz[:, :2]).astype(np.int32)
+
+
+def _seen_beneath(footprint: tuple[tuple[float, float], ...], h_m: float, view: Evidence) -> bool:
+    """Whether ``view`` sees, whole and over most of it, what lies beneath a building of
+    ``footprint`` standing ``h_m`` tall: the ground at its base, or a roof lower than
+    ``h_m`` where it would stand. What the camera sees lies in front of any building."""
+    k = view.photo.intrinsics
+    base = _ring_px(footprint, 0.0, view.photo)
+    if base is None:
+        return False
+    if base.min() < 0 or base[:, 0].max() > k.width_px - 1 or base[:, 1].max() > k.height_px - 1:
+        return False
+    planes = [(base, view.ground)]
+    for roof_m, _rgb, mask, (rx0, ry0, rx1, ry1) in view.roofs:
+        if not roof_m < h_m:
+            continue
+        ring = _ring_px(footprint, roof_m, view.photo)
+        if ring is None:
+            continue
+        (x0, y0), (x1, y1) = ring.min(axis=0), ring.max(axis=0) + 1
+        if x1 > rx0 and rx1 > x0 and y1 > ry0 and ry1 > y0:
+            planes.append((ring, mask))
+    rings = np.concatenate([ring for ring, _ in planes])
+    x0, y0 = np.maximum(rings.min(axis=0), 0)
+    x1, y1 = np.minimum(rings.max(axis=0) + 1, (k.width_px, k.height_px))
+    shape = (int(y1 - y0), int(x1 - x0))
+    inside = np.zeros(shape, np.uint8)
+    cv2.fillPoly(inside, [(base - (x0, y0)).reshape(-1, 1, 2)], 255)
+    area = cv2.countNonZero(inside)
+    if area == 0:
+        return False
+    seen: Any = np.zeros(shape, np.uint8)
+    for ring, mask in planes:
+        there = np.zeros(shape, np.uint8)
+        cv2.fillPoly(there, [(ring - (x0, y0)).reshape(-1, 1, 2)], 255)
+        seen = cv2.bitwise_or(seen, cv2.bitwise_and(there, mask[y0:y1, x0:x1]))
+    return bool(cv2.countNonZero(seen) >= _GROUND_SEEN * area)
 
 
 def _ground_there(
@@ -129,20 +249,18 @@ def _ground_there(
 ) -> bool:
     """Whether ``photo`` sees ``footprint`` (at height ``z_m``) whole, and as ground."""
     k = photo.intrinsics
-    if not z_m < photo.pose.pos_enu_m[2]:
+    ring = _ring_px(footprint, z_m, photo)
+    if ring is None:
         return False
-    uvz = project(np.array([(x, y, z_m) for x, y in footprint]), photo.pose, k)
-    if not bool(np.all(uvz[:, 2] > 0.0)):
+    if ring.min() < 0 or ring[:, 0].max() > k.width_px - 1 or ring[:, 1].max() > k.height_px - 1:
         return False
-    us, vs = uvz[:, 0], uvz[:, 1]
-    if us.min() < 0.0 or vs.min() < 0.0 or us.max() > k.width_px - 1 or vs.max() > k.height_px - 1:
-        return False
-    inside = np.zeros(ground.shape, np.uint8)
-    cv2.fillPoly(inside, [np.round(uvz[:, :2]).astype(np.int32).reshape(-1, 1, 2)], 255)
+    (x0, y0), (x1, y1) = ring.min(axis=0), ring.max(axis=0) + 1
+    inside = np.zeros((int(y1 - y0), int(x1 - x0)), np.uint8)
+    cv2.fillPoly(inside, [(ring - (x0, y0)).reshape(-1, 1, 2)], 255)
     area = cv2.countNonZero(inside)
     if area == 0:
         return False
-    return cv2.countNonZero(cv2.bitwise_and(inside, ground)) >= _GROUND_SEEN * area
+    return cv2.countNonZero(cv2.bitwise_and(inside, ground[y0:y1, x0:x1])) >= _GROUND_SEEN * area
 
 
 def unexplained(
