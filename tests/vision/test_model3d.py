@@ -199,3 +199,20 @@ def test_side_views_whose_foot_is_hidden_are_cut_to_what_the_top_view_sees() -> 
     model = build_model(v["top"], front, right)
     assert model.height_m == pytest.approx(_paper_model().height_m, abs=1.0)
     assert model.mesh.bounds[0, 2] == pytest.approx(0.0, abs=1e-6)
+
+
+def test_a_side_photo_that_sees_only_part_of_the_building_builds_no_model() -> None:
+    """A front photo whose right half is hidden (as behind a neighbour, taken for the
+    ground): carved by it, the model leaves out what the top photo shows of the building's
+    eastern part. A model of part of the building is refused, saying how much it leaves
+    out; the whole photo builds it."""
+    scene = load_scene("paper")
+    red = scene.building("red").color_rgb
+    image = render(scene, POSES["front"], K, noise_seed=7)
+    half = image.copy()
+    half[:, 330:] = scene.ground_rgb  # east of the building's middle, seen from the south
+    hidden = View(same_colour(vectorize(half), red, hue_tolerance_deg=15), POSES["front"], K)
+    v = _views(POSES)
+    with pytest.raises(ModelInputError, match=r"the side photos leave out \d+% of what the top"):
+        build_model(v["top"], hidden, v["right"])
+    assert build_model(v["top"], v["front"], v["right"]).mesh.is_watertight

@@ -566,14 +566,21 @@ def plan_towards(
 ) -> Viewpoint | ViewpointFailure:
     """A camera out from ``target``'s centre along ``direction_en`` (east, north; any
     length), looking back at it, at the first distance where it keeps the safety margin and
-    sees every corner past the obstacles (``label`` becomes its ``fallback`` note)."""
+    sees every corner past the obstacles (``label`` becomes its ``fallback`` note); with
+    ``heights``, last one that rises higher to see over lower ones."""
     n = math.hypot(*direction_en)
     if not n > 0.0:
         return ViewpointFailure(name, f"{name}: no direction to look from")
     polys = [as_points(p, what=f"obstacles[{i}]") for i, p in enumerate(obstacles)]
     u = (direction_en[0] / n, direction_en[1] / n)
-    found = _from_direction(name, target, u, name, label, polys, intrinsics, params, heights)
-    return found if isinstance(found, Viewpoint) else ViewpointFailure(name, f"{name}: {found}")
+    found: Viewpoint | str = ""
+    for rise in (False, True) if heights is not None else (False,):
+        found = _from_direction(
+            name, target, u, name, label, polys, intrinsics, params, heights, rise=rise
+        )
+        if isinstance(found, Viewpoint):
+            return found
+    return ViewpointFailure(name, f"{name}: {found}")
 
 
 def plan_diagonal(

@@ -38,6 +38,13 @@ from uavtool.vision.shapes import FloatArray, Shape, cut_edges
 # Depth range of the side viewing cones, metres along the optical axis.
 _NEAR_M = 0.25
 _FAR_M = 2000.0
+_COVERED = 0.5
+"""The least share of the top view's footprint a model must cover seen from above. Carved
+from whole silhouettes, a model shows in every photo as its silhouette there (measured:
+0.999-1.0). Side photos that saw only part of the building (its top over its neighbours)
+carve away more: a stepped tower seen so covered 0.67 (IoU 0.82), but a model leaving out
+most of what the top photo shows is a model of something else (town scenes: 0.05 and 0.45,
+IoU 0.05 and 0.41)."""
 _BEYOND_M = 1.0
 """How far above what the top view sees the side views' solid may reach and still be the
 same top (their outlines differ by a pixel or two; in metres at the roof, centimetres)."""
@@ -119,8 +126,25 @@ def build_model(
             "the top silhouette does not overlap the front and right ones: check the poses "
             "and that each photo shows the same building"
         )
+    covered = _covered(solid, rings)
+    if covered < _COVERED:
+        raise ModelInputError(
+            f"the side photos leave out {1.0 - covered:.0%} of what the top photo shows of the "
+            "building: they saw only part of it (hidden behind its neighbours, or only its top)"
+        )
     mesh = _to_trimesh(solid)
     return Model(mesh, float(mesh.bounds[1][2]) - p.ground_z_m, rings[0])
+
+
+def _covered(solid: Any, rings: list[FloatArray]) -> float:
+    """The share of the top view's footprint that the model covers seen from above."""
+    import manifold3d  # noqa: PLC0415
+
+    footprint = manifold3d.CrossSection([r.tolist() for r in rings], manifold3d.FillRule.EvenOdd)
+    area = float(footprint.area())
+    if area <= 0.0:
+        return 0.0
+    return float((solid.project() ^ footprint).area()) / area
 
 
 def open_beneath(model: Model, *, ground_z_m: float = 0.0, above_m: float = 0.5) -> float:
