@@ -111,3 +111,13 @@ def test_golden_frames_and_their_variants_decode_as_pymavlink_decodes_them(path:
             assert _same(_decoded(variant), _by_pymavlink(variant)), variant
             checked += 1
     assert len(one_of_each) > 20 and checked > 1200
+
+
+def test_a_parser_with_a_signing_key_leaves_unsigned_frames_to_pymavlink() -> None:
+    """pymavlink counts the unsigned frames a signing link accepts; so does the parser."""
+    frame = bytes(mavlink.MAVLink(None).heartbeat_encode(2, 3, 0, 0, 4).pack(mavlink.MAVLink(None)))
+    for key in (bytes(32), b""):
+        parser = FrameParser(signing_key=key)
+        got = parser._decode(frame)
+        assert got is not None and not got.signed
+        assert parser._mav.signing.unsigned_count == 1

@@ -113,7 +113,9 @@ class FrameParser:
         for every other frame (signed, MAVLink 1, a parser with a signing key, CRC checks
         turned off, a length that does not add up), which pymavlink then decodes."""
         n = len(raw)
-        if raw[0] != _STX_V2 or raw[2] or raw[1] != n - 12 or self._mav.signing.secret_key:
+        if raw[0] != _STX_V2 or raw[2] or raw[1] != n - 12:
+            return _UNSURE
+        if self._mav.signing.secret_key is not None:  # pymavlink counts unsigned frames
             return _UNSURE
         msgid = raw[7] | raw[8] << 8 | raw[9] << 16
         cls = mavlink.mavlink_map.get(msgid)
