@@ -238,7 +238,9 @@ def test_a_building_of_no_building_colour_is_an_obstacle(
     scene.write_text(json.dumps(data))
     result = CliRunner().invoke(cli, ["fly", "--scene", str(scene), "--no-record"])
     assert result.exit_code == 0, result.output
-    found = re.search(r"1 obstacles of no building colour .*: roofs ([\d.]+) m", result.output)
+    found = re.search(
+        r"1 obstacles no roof of a building colour explains .*: roofs ([\d.]+) m", result.output
+    )
     assert found is not None and float(found.group(1)) == pytest.approx(14.0, abs=0.5), name
     # the safety margin is 4 m; the roof measured up to half a metre low may take from it
     clearance = re.search(r"clearance +(-?[\d.]+) m from building", result.output)
