@@ -6,21 +6,17 @@ golden frame, and frames signed, in MAVLink 1, cut, lengthened or with any byte 
 from __future__ import annotations
 
 import random
-import struct
 from pathlib import Path
 from typing import Any
 
 import pytest
 
+from tests.mavlink.values import value
 from uavtool.mavlink import FrameParser, mavlink
 from uavtool.recording import RecordingReader, rawframe
 from uavtool.recording.schemas import MAVLINK_RAW
 
 GOLDEN = sorted((Path(__file__).parents[2] / "recordings" / "golden").glob("*.mcap"))
-_FLOATS = [0.0, -0.0, 1.5, 3.4e38, float("nan"), float("inf"), -1e-45]
-_TEXT = b'ab"\\%\x01\x7f\xc3\xa9\xff\x00'
-_BITS = {"int8_t": 8, "int16_t": 16, "int32_t": 32, "int64_t": 64}
-_BITS |= {"uint8_t": 8, "uint16_t": 16, "uint32_t": 32, "uint64_t": 64}
 
 
 def _by_pymavlink(frame: bytes) -> Any:
@@ -53,20 +49,6 @@ def _decoded(frame: bytes) -> Any:
     return None if got is None else got.msg
 
 
-def _value(rng: random.Random, ftype: str, length: int) -> object:
-    if ftype == "char":
-        return bytes(rng.choice(_TEXT) for _ in range(rng.randint(0, length or 1)))
-    if ftype in ("float", "double"):
-        pick = lambda: rng.choice(  # noqa: E731
-            [*_FLOATS, struct.unpack("<f", struct.pack("<f", rng.uniform(-1e4, 1e4)))[0]]
-        )
-        return [pick() for _ in range(length)] if length else pick()
-    bits, signed = _BITS[ftype], ftype[0] == "i"
-    lo, hi = (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if signed else (0, (1 << bits) - 1)
-    pick_int = lambda: rng.choice([lo, hi, 0, 0, rng.randint(lo, hi)])  # noqa: E731
-    return [pick_int() for _ in range(length)] if length else pick_int()
-
-
 def test_every_message_type_is_pymavlinks_message() -> None:
     sender = mavlink.MAVLink(None, srcSystem=7, srcComponent=42)
     rng = random.Random(26)
@@ -75,7 +57,7 @@ def test_every_message_type_is_pymavlinks_message() -> None:
         for cls in mavlink.mavlink_map.values():
             lengths = dict(zip(cls.ordered_fieldnames, cls.array_lengths, strict=True))
             args = [
-                _value(rng, ftype, lengths[name])
+                value(rng, ftype, lengths[name], awkward=True)
                 for name, ftype in zip(cls.fieldnames, cls.fieldtypes, strict=True)
             ]
             frame = bytes(cls(*args).pack(sender))

@@ -7,19 +7,15 @@ whose sum overflows, quotes, backslashes, '%' and control characters in text).""
 from __future__ import annotations
 
 import random
-import struct
 from pathlib import Path
 
 import pytest
 
+from tests.mavlink.values import value
 from uavtool.recording import RecordingReader, rawframe
 from uavtool.recording.schemas import MAVLINK_RAW, MavlinkDecoder, dialect_module, dumps
 
 GOLDEN = sorted((Path(__file__).parents[2] / "recordings" / "golden").glob("*.mcap"))
-_FLOATS = [0.0, -0.0, 1.5, -2.25e-5, 3.4e38, -3.4e38, 1e16, float("nan"), float("inf"), -1e-45]
-_TEXT = b'a"b\\c%d%%s\x01\x1fe\x7f\xc3\xa9\xff'
-_INTS = {"int8_t": 8, "uint8_t": 8, "int16_t": 16, "uint16_t": 16}
-_INTS |= {"int32_t": 32, "uint32_t": 32, "int64_t": 64, "uint64_t": 64}
 
 
 def _reference(decoder: MavlinkDecoder, msg: object) -> bytes | None:
@@ -43,23 +39,6 @@ def test_every_golden_frame(path: Path) -> None:
     assert n > 10_000
 
 
-def _value(rng: random.Random, ftype: str, length: int, awkward: bool) -> object:
-    if ftype == "char":
-        return bytes(rng.choice(_TEXT) for _ in range(rng.randint(0, length)))
-    if ftype in ("float", "double"):
-        pick = (
-            (lambda: rng.choice(_FLOATS))
-            if awkward
-            else (lambda: struct.unpack("<f", struct.pack("<f", rng.uniform(-1e4, 1e4)))[0])
-        )
-        return [pick() for _ in range(length)] if length else pick()
-    bits = _INTS[ftype]
-    signed = ftype[0] == "i"
-    lo, hi = (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if signed else (0, (1 << bits) - 1)
-    pick_int = lambda: rng.choice([lo, hi, 0, rng.randint(lo, hi)])  # noqa: E731
-    return [pick_int() for _ in range(length)] if length else pick_int()
-
-
 @pytest.mark.parametrize("awkward", [False, True])
 def test_every_message_type(awkward: bool) -> None:
     decoder = MavlinkDecoder()
@@ -71,7 +50,7 @@ def test_every_message_type(awkward: bool) -> None:
         for cls in module.mavlink_map.values():
             lengths = dict(zip(cls.ordered_fieldnames, cls.array_lengths, strict=True))
             args = [
-                _value(rng, ftype, lengths[name], awkward)
+                value(rng, ftype, lengths[name], awkward=awkward)
                 for name, ftype in zip(cls.fieldnames, cls.fieldtypes, strict=True)
             ]
             frame = bytes(cls(*args).pack(mav))
