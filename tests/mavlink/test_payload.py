@@ -11,7 +11,7 @@ from typing import Any
 
 import pytest
 
-from tests.mavlink.values import value
+from tests.mavlink.values import every_message, variants
 from uavtool.mavlink import FrameParser, mavlink
 from uavtool.recording import RecordingReader, rawframe
 from uavtool.recording.schemas import MAVLINK_RAW
@@ -50,20 +50,11 @@ def _decoded(frame: bytes) -> Any:
 
 
 def test_every_message_type_is_pymavlinks_message() -> None:
-    sender = mavlink.MAVLink(None, srcSystem=7, srcComponent=42)
-    rng = random.Random(26)
     checked = 0
-    for _ in range(4):
-        for cls in mavlink.mavlink_map.values():
-            lengths = dict(zip(cls.ordered_fieldnames, cls.array_lengths, strict=True))
-            args = [
-                value(rng, ftype, lengths[name], awkward=True)
-                for name, ftype in zip(cls.fieldnames, cls.fieldtypes, strict=True)
-            ]
-            frame = bytes(cls(*args).pack(sender))
-            ours, theirs = _decoded(frame), _by_pymavlink(frame)
-            assert theirs is not None and _same(ours, theirs), cls.msgname
-            checked += 1
+    for cls, frame in every_message(mavlink, random.Random(26), 4, awkward=True):
+        ours, theirs = _decoded(frame), _by_pymavlink(frame)
+        assert theirs is not None and _same(ours, theirs), cls.msgname
+        checked += 1
     assert checked > 800
 
 
@@ -82,14 +73,7 @@ def test_golden_frames_and_their_variants_decode_as_pymavlink_decodes_them(path:
             one_of_each.setdefault(int.from_bytes(frame[7:10], "little"), frame)
     checked = 0
     for frame in one_of_each.values():
-        msg = _by_pymavlink(frame)
-        variants = [frame[:-3], frame + b"\x00", bytes(msg.pack(signer))]
-        if msg.get_msgId() < 256:
-            variants.append(bytes(msg.pack(v1, force_mavlink1=True)))
-        for _ in range(60):
-            i = rng.randrange(len(frame))
-            variants.append(frame[:i] + bytes([rng.randrange(256)]) + frame[i + 1 :])
-        for variant in variants:
+        for variant in variants(frame, _by_pymavlink(frame), signer, v1, rng):
             assert _same(_decoded(variant), _by_pymavlink(variant)), variant
             checked += 1
     assert len(one_of_each) > 20 and checked > 1200

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.mavlink.values import value
+from tests.mavlink.values import every_message, variants
 from uavtool.recording import RecordingReader, rawframe
 from uavtool.recording.schemas import MAVLINK_RAW, MavlinkDecoder, dialect_module, dumps
 
@@ -43,22 +43,13 @@ def test_every_golden_frame(path: Path) -> None:
 def test_every_message_type(awkward: bool) -> None:
     decoder = MavlinkDecoder()
     module = dialect_module("ardupilotmega")
-    mav = module.MAVLink(None, srcSystem=7, srcComponent=42)
-    rng = random.Random(29)
     checked = 0
-    for _ in range(3):
-        for cls in module.mavlink_map.values():
-            lengths = dict(zip(cls.ordered_fieldnames, cls.array_lengths, strict=True))
-            args = [
-                value(rng, ftype, lengths[name], awkward=awkward)
-                for name, ftype in zip(cls.fieldnames, cls.fieldtypes, strict=True)
-            ]
-            frame = bytes(cls(*args).pack(mav))
-            msg = decoder._mav.decode(bytearray(frame))
-            made = decoder.json(msg)
-            assert made is not None and made[2] == _reference(decoder, msg), cls.msgname
-            assert decoder.decode_json(frame) == made, cls.msgname  # without pymavlink's
-            checked += 1
+    for cls, frame in every_message(module, random.Random(29), 3, awkward=awkward):
+        msg = decoder._mav.decode(bytearray(frame))
+        made = decoder.json(msg)
+        assert made is not None and made[2] == _reference(decoder, msg), cls.msgname
+        assert decoder.decode_json(frame) == made, cls.msgname  # without pymavlink's
+        checked += 1
     assert checked > 600
 
 
@@ -93,13 +84,7 @@ def test_frames_decoded_without_pymavlink_are_as_pymavlink_decodes_them() -> Non
     checked = 0
     for frame in frames.values():
         msg = decoder._mav.decode(bytearray(frame))
-        variants = [frame, frame[:-3], frame + b"\x00", bytes(msg.pack(signer))]
-        if msg.get_msgId() < 256:
-            variants.append(bytes(msg.pack(v1, force_mavlink1=True)))
-        for _ in range(60):
-            i = rng.randrange(len(frame))
-            variants.append(frame[:i] + bytes([rng.randrange(256)]) + frame[i + 1 :])
-        for variant in variants:
+        for variant in [frame, *variants(frame, msg, signer, v1, rng)]:
             assert decoder.decode_json(variant) == _by_pymavlink(decoder, variant), variant
             checked += 1
     assert len(frames) > 20 and checked > 1000
