@@ -1,7 +1,8 @@
 """Random field values for every MAVLink field type, for tests that fill every message type
 of the dialect: text with quotes, backslashes, '%', control and non-ASCII bytes; floats
 either plain float32 values or awkward ones too (NaN, infinities, -0.0, extremes); integers
-at their limits, zero and anywhere between."""
+at their limits, zero and anywhere between; each message type filled so and sent, and a
+frame's damaged variants."""
 
 from __future__ import annotations
 
