@@ -17,7 +17,7 @@ from uavtool.camera import CameraPose
 from uavtool.cli import cli
 from uavtool.mission import Params, Status
 from uavtool.mission.params import with_overrides
-from uavtool.recording import RecordingReader
+from uavtool.recording import RecordingReader, summarize
 from uavtool.runner.camera import SimCamera
 from uavtool.runner.fly import FlyConfig, fly
 from uavtool.sitl.lockstep import SIM_EPOCH_NS, LockstepTransport
@@ -49,6 +49,45 @@ def test_same_inputs_give_the_same_bytes(paper: Path, tmp_path: Path) -> None:
 def test_the_writer_process_writes_the_same_bytes(paper: Path, tmp_path: Path) -> None:
     """fly picks the writer by the machine's load; the file must not tell which."""
     assert _fly(tmp_path / "process.mcap", record_in_process=False) == paper.read_bytes()
+
+
+@pytest.mark.parametrize(
+    ("choice", "spare", "used"),
+    [
+        ("process", False, "ProcessWriter"),
+        ("thread", True, "RecordingWriter"),
+        ("auto", True, "ProcessWriter"),
+        ("auto", False, "RecordingWriter"),
+    ],
+)
+def test_fly_writes_where_it_is_told(
+    choice: str, spare: bool, used: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``uavtool fly --writer process|thread`` takes that writer whatever the load; ``auto``
+    asks whether a core is free. The files are the same (above)."""
+    import uavtool.runner.fly as runner
+
+    made: list[str] = []
+    for name in ("ProcessWriter", "RecordingWriter"):
+        real = getattr(runner, name)
+
+        def spy(*args: object, _real: type = real, _name: str = name, **kw: object) -> object:
+            made.append(_name)
+            return _real(*args, **kw)
+
+        monkeypatch.setattr(runner, name, spy)
+    monkeypatch.setattr(runner, "core_to_spare", lambda: spare)
+    out = tmp_path / "f.mcap"
+    result = CliRunner().invoke(cli, ["fly", "--writer", choice, "-o", str(out), "-q"])
+    assert result.exit_code == 0, result.output
+    assert made == [used]
+    assert summarize(out).whole
+
+
+def test_no_recording_has_no_writer_to_choose() -> None:
+    result = CliRunner().invoke(cli, ["fly", "--no-record", "--writer", "process"])
+    assert result.exit_code == 2
+    assert "--writer process: there is no recording to write (--no-record)" in result.output
 
 
 def test_a_different_input_gives_a_different_file(paper: Path, tmp_path: Path) -> None:

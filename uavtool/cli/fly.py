@@ -27,6 +27,8 @@ EXIT_CODES: dict[str, int] = {
 _SECONDS = Range(0.0, 86_400.0, lo_open=True)
 _WIND = Numbers(",", (("SPEED", Range(0.0, 50.0)), ("DIR", Range(-360.0, 360.0))), example="5,270")
 _OUTAGE = Numbers(":", (("START", NON_NEGATIVE), ("DURATION", POSITIVE)), example="60:10")
+# --writer: FlyConfig.record_in_process for each choice
+_WRITERS: dict[str, bool | None] = {"auto": None, "process": False, "thread": True}
 
 
 @click.command(cls=Command, old_spellings=(OldSpelling("--record", "--output", "-o/--output"),))
@@ -65,6 +67,15 @@ _OUTAGE = Numbers(":", (("START", NON_NEGATIVE), ("DURATION", POSITIVE)), exampl
     help="The recording to write (MCAP).  [default: recordings/<UTC time>.mcap]",
 )
 @click.option("--no-record", is_flag=True, help="Do not write a recording.")
+@click.option(
+    "--writer",
+    type=click.Choice(_WRITERS),
+    default="auto",
+    show_default=True,
+    help="Where the recording is written: in a process of its own (off the flight's path, "
+    "more work in all), on the flight's thread, or auto: in its own process when a core is "
+    "free for it. The file is the same either way.",
+)
 @click.option(
     "--mission",
     "mission",
@@ -168,6 +179,7 @@ def fly(
     speedup: str | None,
     record: Path | None,
     no_record: bool,
+    writer: str,
     mission: str,
     visit_all: bool,
     vehicle_params: tuple[str, ...],
@@ -211,6 +223,8 @@ def fly(
 
     if record is not None and no_record:
         raise InputError("-o/--output and --no-record exclude each other")
+    if no_record and writer != "auto":
+        raise InputError(f"--writer {writer}: there is no recording to write (--no-record)")
     rerun_target = _rerun_target(rerun_target)
     ports = {"--web-port": web_port, "--grpc-port": grpc_port}
     check_web_ports(ports, web=rerun_target == "web", needs="--rerun web")
@@ -230,6 +244,7 @@ def fly(
         speedup=_speedup(speedup, live=rerun_target in _LIVE_VIEWERS),
         record=record,
         no_record=no_record,
+        record_in_process=_WRITERS[writer],
         params=params,
         vehicle_params=tuple(parse_param(p) for p in vehicle_params),
         seed=seed,
