@@ -205,7 +205,8 @@ def _unclassified(m: SearchMission, seen: Survey) -> list[Shape]:
     building the vectorizer found (a coloured roof and its walls are one region)."""
     k = seen.photo.intrinsics
     found = np.zeros((k.height_px, k.width_px), np.uint8)
-    cv2.fillPoly(found, [pixels(s.polygon_px) for s in seen.shapes], 255)
+    for s in seen.shapes:  # one by one: where two overlap, one call leaves the overlap empty
+        cv2.fillPoly(found, [pixels(s.polygon_px)], 255)
     out: list[Shape] = []
     for region in non_ground(seen.photo.image_rgb, m.params.vectorize):
         if region.area_px < m.params.vectorize.min_area_px:

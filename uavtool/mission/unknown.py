@@ -102,6 +102,17 @@ class Known(NamedTuple):
     colour_rgb: tuple[int, int, int]
 
 
+class SeenRoof(NamedTuple):
+    """A roof of known height as a photo shows it: its height, its colour, the mask of the
+    pixels showing it (in its place for that height, and of its colour) and their box."""
+
+    roof_m: float
+    colour_rgb: tuple[int, int, int]
+    mask: Any
+    box: tuple[int, int, int, int]
+    """x0, y0, x1, y1 (exclusive)."""
+
+
 @dataclass(frozen=True, slots=True)
 class Evidence:
     """A nadir photo as evidence of free space: where it sees the ground, and where it sees
@@ -109,9 +120,7 @@ class Evidence:
 
     photo: Photo
     ground: Any
-    roofs: tuple[tuple[float, tuple[int, int, int], Any, tuple[int, int, int, int]], ...]
-    """Per roof of known height: its height, its colour, the mask of the pixels showing it
-    (in its place for that height, and of its colour) and their box (x0, y0, x1, y1)."""
+    roofs: tuple[SeenRoof, ...]
 
 
 def evidence(photo: Photo, known: Sequence[Known] = (), *, tolerance_dn: float = 0.0) -> Evidence:
@@ -134,7 +143,7 @@ def evidence(photo: Photo, known: Sequence[Known] = (), *, tolerance_dn: float =
         lo = np.clip(np.array(rgb) - tolerance_dn, 0, 255).astype(np.uint8)
         hi = np.clip(np.array(rgb) + tolerance_dn, 0, 255).astype(np.uint8)
         mask = cv2.bitwise_and(place, cv2.inRange(photo.image_rgb, lo, hi))
-        roofs.append((roof_m, rgb, mask, (int(x0), int(y0), int(x1), int(y1))))
+        roofs.append(SeenRoof(roof_m, rgb, mask, (int(x0), int(y0), int(x1), int(y1))))
     return Evidence(photo, ground, tuple(roofs))
 
 
@@ -155,8 +164,8 @@ def unknown_roof(
     where a camera sees, under it, a lower roof of known height (:func:`evidence`) of
     another colour than its own (``own_rgb``, else ``shape``'s; more than
     ``hue_tolerance_deg`` apart: one of its own colour may be a lower tier of the same
-    building, its own roof in the photo). The roof
-    may be up to a plane's step above the highest plane left (it was not tried)."""
+    building, its own roof in the photo). The roof may be up to a plane's step above the
+    highest plane left (it was not tried)."""
     heights = [0.0]
     step_m = _HEIGHT_STEP_M
     while heights[-1] + step_m < tallest_m:
@@ -192,7 +201,7 @@ _GROUND_SEEN = 0.9
 def _other_colours(view: Evidence, rgb: tuple[int, int, int], tolerance_deg: float) -> Evidence:
     """``view`` with only the known roofs whose hue is more than ``tolerance_deg`` from
     ``rgb``'s."""
-    roofs = tuple(r for r in view.roofs if hue_distance_deg(r[1], rgb) > tolerance_deg)
+    roofs = tuple(r for r in view.roofs if hue_distance_deg(r.colour_rgb, rgb) > tolerance_deg)
     return Evidence(view.photo, view.ground, roofs)
 
 
@@ -207,39 +216,54 @@ def _ring_px(footprint: Sequence[tuple[float, float]], z_m: float, photo: Photo)
     return np.round(uvz[:, :2]).astype(np.int32)
 
 
+def _whole(ring: Any, photo: Photo) -> bool:
+    """Whether a pixel ring (:func:`_ring_px`) lies whole in ``photo``'s frame."""
+    k = photo.intrinsics
+    return bool(
+        ring is not None
+        and ring.min() >= 0
+        and ring[:, 0].max() <= k.width_px - 1
+        and ring[:, 1].max() <= k.height_px - 1
+    )
+
+
+def _filled(ring: Any, x0: int, y0: int, shape: tuple[int, int]) -> Any:
+    """A mask of ``shape`` (rows, columns) whose pixel (0, 0) is the photo's (x0, y0), 255
+    inside ``ring``."""
+    mask = np.zeros(shape, np.uint8)
+    cv2.fillPoly(mask, [(ring - (x0, y0)).reshape(-1, 1, 2)], 255)
+    return mask
+
+
 def _seen_beneath(footprint: tuple[tuple[float, float], ...], h_m: float, view: Evidence) -> bool:
     """Whether ``view`` sees, whole and over most of it, what lies beneath a building of
     ``footprint`` standing ``h_m`` tall: the ground at its base, or a roof lower than
     ``h_m`` where it would stand. What the camera sees lies in front of any building."""
     k = view.photo.intrinsics
     base = _ring_px(footprint, 0.0, view.photo)
-    if base is None:
-        return False
-    if base.min() < 0 or base[:, 0].max() > k.width_px - 1 or base[:, 1].max() > k.height_px - 1:
+    if not _whole(base, view.photo):
         return False
     planes = [(base, view.ground)]
-    for roof_m, _rgb, mask, (rx0, ry0, rx1, ry1) in view.roofs:
-        if not roof_m < h_m:
+    for roof in view.roofs:
+        if not roof.roof_m < h_m:
             continue
-        ring = _ring_px(footprint, roof_m, view.photo)
+        ring = _ring_px(footprint, roof.roof_m, view.photo)
         if ring is None:
             continue
         (x0, y0), (x1, y1) = ring.min(axis=0), ring.max(axis=0) + 1
+        rx0, ry0, rx1, ry1 = roof.box
         if x1 > rx0 and rx1 > x0 and y1 > ry0 and ry1 > y0:
-            planes.append((ring, mask))
+            planes.append((ring, roof.mask))
     rings = np.concatenate([ring for ring, _ in planes])
     x0, y0 = np.maximum(rings.min(axis=0), 0)
     x1, y1 = np.minimum(rings.max(axis=0) + 1, (k.width_px, k.height_px))
     shape = (int(y1 - y0), int(x1 - x0))
-    inside = np.zeros(shape, np.uint8)
-    cv2.fillPoly(inside, [(base - (x0, y0)).reshape(-1, 1, 2)], 255)
-    area = cv2.countNonZero(inside)
+    area = cv2.countNonZero(_filled(base, x0, y0, shape))
     if area == 0:
         return False
     seen: Any = np.zeros(shape, np.uint8)
     for ring, mask in planes:
-        there = np.zeros(shape, np.uint8)
-        cv2.fillPoly(there, [(ring - (x0, y0)).reshape(-1, 1, 2)], 255)
+        there = _filled(ring, x0, y0, shape)
         seen = cv2.bitwise_or(seen, cv2.bitwise_and(there, mask[y0:y1, x0:x1]))
     return bool(cv2.countNonZero(seen) >= _GROUND_SEEN * area)
 
@@ -248,15 +272,11 @@ def _ground_there(
     footprint: tuple[tuple[float, float], ...], z_m: float, photo: Photo, ground: Any
 ) -> bool:
     """Whether ``photo`` sees ``footprint`` (at height ``z_m``) whole, and as ground."""
-    k = photo.intrinsics
     ring = _ring_px(footprint, z_m, photo)
-    if ring is None:
-        return False
-    if ring.min() < 0 or ring[:, 0].max() > k.width_px - 1 or ring[:, 1].max() > k.height_px - 1:
+    if not _whole(ring, photo):
         return False
     (x0, y0), (x1, y1) = ring.min(axis=0), ring.max(axis=0) + 1
-    inside = np.zeros((int(y1 - y0), int(x1 - x0)), np.uint8)
-    cv2.fillPoly(inside, [(ring - (x0, y0)).reshape(-1, 1, 2)], 255)
+    inside = _filled(ring, x0, y0, (int(y1 - y0), int(x1 - x0)))
     area = cv2.countNonZero(inside)
     if area == 0:
         return False
