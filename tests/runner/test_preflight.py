@@ -3,21 +3,24 @@ and the vehicle's refusals in the terminal and the summary (issue 18)."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
 
+from uavtool.autopilot.ardupilot import ArduPilot
 from uavtool.cli import cli
 from uavtool.geo import geo_from_enu
+from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mission import Params, SearchMission, Status
 from uavtool.mission.params import with_overrides
 from uavtool.mission.scenario import NO_GIMBAL_REASON
 from uavtool.plugins import ref_of
 from uavtool.runner.fly import FlyConfig, describe, fly
 from uavtool.runner.placement import place_scene
-from uavtool.runner.preflight import PreflightError
+from uavtool.runner.preflight import ANSWER_S, UNHEARD_S, PreflightError, check_gimbal
 from uavtool.runner.summary import format_summary
 from uavtool.world import load_scene
 
@@ -139,3 +142,66 @@ def test_the_metadata_says_which_origin() -> None:
     assert origin[None, "vehicle"] == "scene"  # the built-in vehicle boots at the scene's home
     assert origin["tcp:127.0.0.1:5760", "vehicle"] == "vehicle-home"
     assert origin["tcp:127.0.0.1:5760", "scene"] == "scene"
+
+
+class _SilentForAWhile:
+    """A link to a vehicle whose ACKs and answers are all lost until ``heard_from_s`` (on a
+    clock that each poll moves on), and which answers a gimbal request with ``answer``."""
+
+    name = "lossy"
+    target_system = 1
+    target_component = 1
+
+    def __init__(self, heard_from_s: float, answer: object | None) -> None:
+        self.heard_from_s = heard_from_s
+        self.answer = answer
+        self.now = 0.0
+        self.asked: list[float] = []
+        self._out: list[object] = []
+
+    def clock(self) -> float:
+        return self.now
+
+    def command_long(self, command: int, *_params: float) -> None:
+        self.asked.append(self.now)
+        if self.now >= self.heard_from_s:
+            self._out.append(M.MAVLink_command_ack_message(command, M.MAV_RESULT_ACCEPTED))
+            if self.answer is not None:
+                self._out.append(self.answer)
+
+    def send(self, _msg: object) -> None:  # parameter reads: never answered here
+        pass
+
+    def poll(self, timeout_s: float) -> list[object]:
+        self.now += timeout_s
+        out, self._out = self._out, []
+        return out
+
+
+def _gimbal(pitch_min_deg: float = -90.0) -> object:
+    return M.MAVLink_gimbal_manager_information_message(
+        0, 0, 1, 0.0, 0.0, math.radians(pitch_min_deg), 0.0, -math.pi, math.pi
+    )
+
+
+def test_a_gimbal_question_lost_for_longer_than_the_answer_window_is_asked_again() -> None:
+    """A link that loses everything for 5 s (longer than ANSWER_S) is not a vehicle without
+    a gimbal: the CI run that lost six questions in a row at 20 % loss said it was."""
+    link = _SilentForAWhile(heard_from_s=5.0, answer=_gimbal())
+    assert check_gimbal(link, ArduPilot()) == pytest.approx((-90.0, 0.0))  # type: ignore[arg-type]
+    assert len(link.asked) >= 10 and link.asked[-1] >= 5.0
+
+
+def test_a_vehicle_that_hears_and_sends_no_gimbal_has_none_after_the_answer_window() -> None:
+    link = _SilentForAWhile(heard_from_s=1.0, answer=None)
+    with pytest.raises(PreflightError, match="no gimbal"):
+        check_gimbal(link, ArduPilot())  # type: ignore[arg-type]
+    # ANSWER_S of gimbal requests after the first ACK, then ANSWER_S of unanswered MNT1_TYPE
+    assert link.now == pytest.approx(1.0 + 2 * ANSWER_S, abs=0.2)
+
+
+def test_a_vehicle_that_acknowledges_no_request_is_asked_for_longer_then_has_no_gimbal() -> None:
+    link = _SilentForAWhile(heard_from_s=math.inf, answer=None)
+    with pytest.raises(PreflightError, match="no gimbal"):
+        check_gimbal(link, ArduPilot())  # type: ignore[arg-type]
+    assert link.now == pytest.approx(UNHEARD_S + ANSWER_S, abs=0.2)

@@ -26,6 +26,9 @@ ANSWER_S = 3.0
 """How long the vehicle has to answer each question."""
 RETRY_S = 0.5
 """How often an unanswered question is asked again."""
+UNHEARD_S = 15.0
+"""How long a command that the vehicle never acknowledges is asked again: on a lossy link
+silence is not an answer, so :data:`ANSWER_S` only counts once the vehicle has shown it heard."""
 
 
 class PreflightError(InputError):
@@ -63,6 +66,7 @@ def check_gimbal(
         ),
         "GIMBAL_MANAGER_INFORMATION",
         on_wait,
+        acked_by=M.MAV_CMD_REQUEST_MESSAGE,
     )
     if info is not None:
         low, high = math.degrees(info.pitch_min), math.degrees(info.pitch_max)
@@ -152,11 +156,18 @@ def _ask(
     kind: str,
     on_wait: Callable[[], None] | None,
     wanted: Callable[[Any], bool] = lambda _msg: True,
+    *,
+    acked_by: int | None = None,
 ) -> Any:
     """The first ``kind`` message after ``request`` that is ``wanted`` (a parameter's value,
     not another one's), asked again every :data:`RETRY_S` (a lossy link may drop the
-    question or the answer); None after :data:`ANSWER_S`."""
-    deadline = link.clock() + ANSWER_S
+    question or the answer); None after :data:`ANSWER_S`.
+
+    A request that is a command (``acked_by``, its id) waits :data:`ANSWER_S` from the first
+    COMMAND_ACK for it: a vehicle that has heard the question and sends nothing has nothing
+    to send. One that acknowledges none is asked for :data:`UNHEARD_S` (dozens of questions,
+    more than a lossy link loses in a row) and is then taken not to know the command."""
+    deadline = link.clock() + (ANSWER_S if acked_by is None else UNHEARD_S)
     asked = -math.inf
     while link.clock() < deadline:
         if link.clock() - asked >= RETRY_S:
@@ -165,6 +176,9 @@ def _ask(
         for msg in link.poll(0.05):
             if msg.get_type() == kind and wanted(msg):
                 return msg
+            if acked_by is not None and msg.get_type() == "COMMAND_ACK" and msg.command == acked_by:
+                deadline = min(deadline, link.clock() + ANSWER_S)
+                acked_by = None  # heard: from now on the answer's own time
         if on_wait is not None:
             on_wait()
     return None
