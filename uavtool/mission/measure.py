@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from functools import partial
 from typing import TYPE_CHECKING
 
 import cv2
@@ -103,7 +104,9 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         shapes = photo_shapes(m, photo)
         for i, shape in enumerate(seen.shapes):
             if not measured[i]:
-                roof = measure_roof(m, shape, seen.photo, photo, shapes, below_m=below_m)
+                roof = measure_roof(
+                    m, shape, seen.photo, photo, shapes, below_m=below_m, cut_plans_only=True
+                )
                 if roof is not None:
                     roofs[i], measured[i] = roof, True
         if None in others_m:
@@ -226,11 +229,17 @@ def measure_roof(
     others: tuple[Shape, ...],
     *,
     below_m: float,
+    cut_plans_only: bool = False,
 ) -> float | None:
     """The height of the roof ``shape`` (in nadir ``photo``) from the same roof in another
     nadir photo (its ``others`` shapes): of its colour, and placed by both photos in one spot
     at the height found. Whole in both: triangulated; whole in one: fitted by the edges the
-    other shows. None when no shape of the other photo agrees, or both are cut."""
+    other shows. None when no shape of the other photo agrees, or both are cut.
+
+    ``cut_plans_only``: the caller takes the height of a roof cut in ``photo`` only to plan
+    views, never as clearance; it may then come from the looser fit (the whole outline's
+    edges on the cut one's), which finds the outline's height, a stepped tower's lowest
+    tier."""
     k = photo.intrinsics
     best: tuple[float, float] | None = None  # (disagreement px, height)
     for cand in others:
@@ -244,14 +253,22 @@ def measure_roof(
             whole, whole_photo, cut, cut_photo = (
                 (shape, photo, cand, other) if cand.cut_by_border else (cand, other, shape, photo)
             )
-            roof = roof_from_cut_outline(
+            fit = partial(
+                roof_from_cut_outline,
                 whole_ring_px=whole.polygon_px.tolist(),
                 whole_pose=whole_photo.pose,
                 cut_ring_px=cut.polygon_px.tolist(),
                 cut_pose=cut_photo.pose,
                 intrinsics=k,
                 max_m=below_m,
+                whole_holes_px=[h.tolist() for h in whole.holes_px],
+                cut_holes_px=[h.tolist() for h in cut.holes_px],
             )
+            roof = fit()
+            if roof is None and shape.cut_by_border and cut_plans_only:
+                # a courtyard the border cuts open, walls one camera sees: edges the whole
+                # outline lacks
+                roof = fit(whole_on_cut=True)
         if roof is None or not 0.0 <= roof <= below_m:
             continue
         miss = _disagreement_px(shape, photo, cand, other, roof)

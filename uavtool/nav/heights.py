@@ -18,7 +18,7 @@ home, as the altitudes.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -127,10 +127,20 @@ def roof_from_cut_outline(
     intrinsics: Intrinsics,
     max_m: float,
     border_px: float = 3.0,
+    whole_holes_px: Sequence[Sequence[tuple[float, float]]] = (),
+    cut_holes_px: Sequence[Sequence[tuple[float, float]]] = (),
+    whole_on_cut: bool = False,
 ) -> float | None:
     """The height of a roof seen whole in one photo and cut by the other's border: the height
     at which the whole outline, placed on that plane and seen from the other camera, lies on
     the edges the cut outline shows inside the frame (its own border edges say nothing).
+    A courtyard's edges (``*_holes_px``) are edges of the roof too.
+
+    With ``whole_on_cut`` the fit is the other way round: every edge of the whole outline
+    that falls inside the cut photo's frame must lie on the cut outline. The cut outline may
+    hold edges the whole one lacks (a courtyard the border cuts open, walls one camera sees
+    and the other does not) that no height puts on the whole outline; the whole outline's
+    own edges still meet the cut one's at the roof's height.
 
     Scans 0..``max_m`` (below both cameras) in metre steps, then refines to a centimetre. None
     when fewer than three metres of edge show inside the frame, when no height puts the edges
@@ -138,19 +148,47 @@ def roof_from_cut_outline(
     roof straight below both cameras: no parallax).
     """
     k = intrinsics
-    samples = _inner_edge_points(cut_ring_px, k, border_px)
+    samples = [
+        p for ring in (cut_ring_px, *cut_holes_px) for p in _inner_edge_points(ring, k, border_px)
+    ]
     if len(samples) < 3:
         return None
     top_m = min(max_m, whole_pose.pos_enu_m[2] - 1.0, cut_pose.pos_enu_m[2] - 1.0)
     if top_m <= 0.0:
         return None
 
-    def cost(h_m: float) -> float:
-        ring = _reprojected(whole_ring_px, whole_pose, cut_pose, k, h_m)
-        if ring is None:
-            return math.inf
-        return _rms_to_edges(samples, _ring_edges(ring))
+    cut_edges = [e for ring in (cut_ring_px, *cut_holes_px) for e in _ring_edges(ring)]
+    whole_rings = (whole_ring_px, *whole_holes_px)
 
+    def carried(h_m: float) -> list[list[tuple[float, float]]] | None:
+        rings = [_reprojected(w, whole_pose, cut_pose, k, h_m) for w in whole_rings]
+        return None if any(r is None for r in rings) else [r for r in rings if r is not None]
+
+    def cut_on_whole(h_m: float) -> float:  # pixels
+        rings = carried(h_m)
+        if rings is None:
+            return math.inf
+        return _rms_to_edges(samples, [e for ring in rings for e in _ring_edges(ring)])
+
+    def whole_on_cut_px(h_m: float) -> float:
+        rings = carried(h_m)
+        if rings is None:
+            return math.inf
+        inside = [p for ring in rings for p in _inner_edge_points(ring, k, border_px)]
+        everywhere = sum(_ring_length(ring) for ring in rings) / 2.0  # points every 2 px
+        if len(inside) < max(3.0, _INSIDE_SHARE * everywhere):
+            return math.inf
+        return _rms_to_edges(inside, cut_edges)
+
+    return _fit_height(
+        whole_on_cut_px if whole_on_cut else cut_on_whole, top_m, cut_pose.pos_enu_m[2]
+    )
+
+
+def _fit_height(cost: Callable[[float], float], top_m: float, camera_m: float) -> float | None:
+    """The height in 0..``top_m`` where ``cost`` (pixels) is least: scanned in metre steps,
+    refined to a centimetre; None unless it is within `CUT_FIT_TOLERANCE_PX` and clearly the
+    only one (heights 10 % of the way up to the camera, ``camera_m``, fit clearly worse)."""
     steps = int(top_m)
     coarse = [(cost(float(i)), float(i)) for i in range(steps + 1)]
     _, h0 = min(coarse)
@@ -168,12 +206,20 @@ def roof_from_cut_outline(
     best = cost(h)
     if not best <= CUT_FIT_TOLERANCE_PX:
         return None
-    # identifiable: a height 10 % of the camera's distance away must fit clearly worse
-    away_m = 0.1 * (cut_pose.pos_enu_m[2] - h)
+    away_m = 0.1 * (camera_m - h)
     rivals = [cost(x) for x in (h - away_m, h + away_m) if 0.0 <= x <= top_m]
     if rivals and min(rivals) < best + CUT_FIT_TOLERANCE_PX:
         return None
     return h
+
+
+_INSIDE_SHARE = 1.0 / 3.0
+"""The share of the whole outline (carried to the cut photo) that must lie inside its frame
+for its edges to be compared with the cut outline's."""
+
+
+def _ring_length(ring: Sequence[tuple[float, float]]) -> float:
+    return sum(math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in _ring_edges(ring))
 
 
 def outline_residual_px(
