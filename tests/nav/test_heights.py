@@ -252,9 +252,10 @@ def test_whole_on_cut_needs_the_whole_outline_in_the_frame() -> None:
     cut_pose = CameraPose((-14.0, 0.0, 117.4), 0.0, -90.0)
     frame = shapely.box(0.0, 0.0, K.width_px - 1.0, K.height_px - 1.0)
     seen = shapely.Polygon(_pixels(cut_pose, outer, h_m)).intersection(frame)
-    assert isinstance(seen, shapely.Polygon) and seen.area < 0.3 * shapely.Polygon(
-        _pixels(cut_pose, outer, h_m)
-    ).area
+    assert (
+        isinstance(seen, shapely.Polygon)
+        and seen.area < 0.3 * shapely.Polygon(_pixels(cut_pose, outer, h_m)).area
+    )
     h = roof_from_cut_outline(
         whole_ring_px=_pixels(whole_pose, outer, h_m),
         whole_pose=whole_pose,
