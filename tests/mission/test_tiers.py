@@ -335,15 +335,3 @@ def test_a_lower_roof_seen_beneath_rules_heights_out() -> None:
     assert 10.0 <= upper < alone - 10.0
     own = evidence(over, (low._replace(colour_rgb=shape.colour_rgb),), tolerance_dn=10.0)
     assert unknown_roof(shape, home, 111.0, (own,), hue_tolerance_deg=12.0).upper_m == alone
-
-
-def test_a_courtyard_tower_cut_by_the_overview_is_measured_and_modelled() -> None:
-    """Town scene 10245: the target, a 48.9 m courtyard L, is cut by the overview's border,
-    its courtyard cut open with it. Its height was never measured (the cut outline's
-    courtyard edges fit no height of the whole outline), so its side views were planned
-    for 25 m and cut its top. The whole outline's edges on the cut one's measure it, and
-    the model is built."""
-    summary = fly(FlyConfig(scene=str(DATA / "town-10245.yaml"), no_record=True))
-    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
-    assert summary.evaluation.matched_building == "b05"
-    assert summary.evaluation.model_iou is not None and summary.evaluation.model_iou > 0.8

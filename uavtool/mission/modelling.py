@@ -8,6 +8,7 @@ import dataclasses
 import math
 from typing import TYPE_CHECKING
 
+from uavtool.mission.analysis import roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import DiagonalView, Level, ModelBuilt, Viewpoints
 from uavtool.mission.search import Found, photo_shapes
@@ -23,6 +24,7 @@ from uavtool.mission.survey import (
 from uavtool.nav import (
     Viewpoint,
     ViewpointFailure,
+    ViewpointParams,
     ground_polygon,
     min_area_rect,
     plan_diagonal,
@@ -55,12 +57,7 @@ def photograph_and_model(
     # from the others, each measured on its own.
     roof = max(found.roof_m, building_top_m(seen, same_building(m, seen, found.poi.shape_index)))
     k = found.photo.intrinsics
-    # Side photos: a horizontal camera halfway up, its view holding the whole height.
-    vp_params = dataclasses.replace(
-        m.params.viewpoints,
-        camera_alt_m=max(m.params.viewpoints.camera_alt_m, roof / 2.0),
-        assumed_height_m=max(m.params.viewpoints.assumed_height_m, roof),
-    )
+    vp_params = _side_params(m, roof)
     footprint = ground_polygon(
         found.shape.polygon_px,
         found.photo.pose,
@@ -105,6 +102,21 @@ def photograph_and_model(
     else:
         m.no_model = f"the top photo never showed the whole building ({p.max_looks} tries)"
         return
+    if not found.roof_measured:
+        # The look and the top photo see the building whole from two places: its height,
+        # which neither the overview nor a photo from another altitude could tell (a tower
+        # cut by the overview's border, looked at from the ceiling), plans the side photos.
+        measured = roof_between(found.shape, found.photo, obj, top_photo)
+        if measured is not None and measured < _below(top_photo):
+            m.event(
+                Level.INFO,
+                f"the look and the top photo measure the target's roof {measured:.1f} m above home",
+            )
+            found = dataclasses.replace(found, roof_m=measured, roof_measured=True)
+            roof = max(
+                measured, building_top_m(seen, same_building(m, seen, found.poi.shape_index))
+            )
+            vp_params = _side_params(m, roof)
     # The top photo, low over the target, measures the neighbours the overview could not.
     remeasured = remeasured_obstacles(m, seen, found.poi.shape_index, top_photo, top_shapes)
     obstacles = [f for f, _ in remeasured]
@@ -184,6 +196,16 @@ def photograph_and_model(
     m.event(
         Level.INFO,
         f"model built: height {model.height_m:.2f} m, volume {float(mesh.volume):.1f} m³",
+    )
+
+
+def _side_params(m: SearchMission, roof_m: float) -> ViewpointParams:
+    """Side photos of a building ``roof_m`` tall: a horizontal camera halfway up, its view
+    holding the whole height."""
+    return dataclasses.replace(
+        m.params.viewpoints,
+        camera_alt_m=max(m.params.viewpoints.camera_alt_m, roof_m / 2.0),
+        assumed_height_m=max(m.params.viewpoints.assumed_height_m, roof_m),
     )
 
 

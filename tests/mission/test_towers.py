@@ -1,0 +1,48 @@
+"""Tower targets of the town scenes whose height the overviews could not tell: measured
+before their side photos are planned, so the side photos hold the whole height (issue 26)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from uavtool.mission import Status
+from uavtool.recording import LogEntry, RecordingReader
+from uavtool.recording.topics import EVENTS
+from uavtool.runner.fly import FlyConfig, fly
+
+DATA = Path(__file__).parent / "data"
+
+
+def _events(path: Path) -> list[str]:
+    with RecordingReader(path) as reader:
+        return [e.value.message for e in reader.entries([EVENTS]) if isinstance(e.value, LogEntry)]
+
+
+def test_a_courtyard_tower_cut_by_the_overview_is_measured_and_modelled() -> None:
+    """Town scene 10245: the target, a 48.9 m courtyard L, is cut by the overview's border,
+    its courtyard cut open with it. Its height was never measured (the cut outline's
+    courtyard edges fit no height of the whole outline), so its side views were planned
+    for 25 m and cut its top. The whole outline's edges on the cut one's measure it, and
+    the model is built."""
+    summary = fly(FlyConfig(scene=str(DATA / "town-10245.yaml"), no_record=True))
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == "b05"
+    assert summary.evaluation.model_iou is not None and summary.evaluation.model_iou > 0.8
+
+
+def test_a_tower_looked_at_from_the_ceiling_is_measured_by_its_top_photo(tmp_path: Path) -> None:
+    """Town scene 10264: the target, a 58.8 m courtyard L among towers as tall, is cut by
+    the overview's border and looked at from the ceiling, with no room for a photo from
+    another altitude. The look and the top photo see it whole from two places 10 m apart:
+    they measure it, and the side photos planned for that height build the model (planned
+    for the assumed 25 m, every one cut its top)."""
+    record = tmp_path / "f.mcap"
+    summary = fly(FlyConfig(scene=str(DATA / "town-10264.yaml"), record=record))
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == "b05"
+    assert summary.evaluation.model_iou is not None and summary.evaluation.model_iou > 0.8
+    said = [e for e in _events(record) if "the look and the top photo measure" in e]
+    assert len(said) == 1
+    assert float(said[0].split("roof ")[1].split(" m")[0]) == pytest.approx(58.8, abs=1.0)
