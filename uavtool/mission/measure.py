@@ -24,6 +24,7 @@ import numpy as np
 from uavtool.mission.analysis import roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
+from uavtool.mission.peek import frame_on_ground
 from uavtool.mission.search import photo_shapes
 from uavtool.mission.survey import (
     Obstacle,
@@ -63,6 +64,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     obstacles."""
     ceiling_m = seen.photo.pose.pos_enu_m[2]
     m.ceiling_m = ceiling_m
+    m.seen_ground = frame_on_ground(seen.photo)
     below_m = ceiling_m - 1.0
     others = _unclassified(m, seen)  # obstacles of no building colour
     if (

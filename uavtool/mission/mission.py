@@ -10,6 +10,7 @@ which are not — so that no way crosses near a roof lower than the altitude tha
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import Any, ClassVar
 
 from uavtool.camera import Intrinsics
@@ -28,7 +29,13 @@ from uavtool.mission.outputs import (
     Viewpoints,
 )
 from uavtool.mission.params import Params
-from uavtool.nav.geometry import point_polygon_distance, segment_polygon_distance
+from uavtool.mission.peek import Peek
+from uavtool.nav.geometry import (
+    point_in_polygon,
+    point_polygon_distance,
+    point_segment_distance,
+    segment_polygon_distance,
+)
 
 
 class SearchMission(FlightMission):
@@ -59,6 +66,13 @@ class SearchMission(FlightMission):
         """The altitude that clears every known roof (once the survey has measured them)."""
         self.ceiling_m: float | None = None
         """The second overview's altitude: every roof it showed is below it."""
+        self.seen_ground: tuple[tuple[float, float], ...] | None = None
+        """The ground the second overview showed (its frame's corners on the ground): a
+        building standing there would show in it. None before it is taken."""
+        self.peeks: list[Peek] = []
+        """Photos straight down from the ceiling beyond that ground
+        (:func:`uavtool.mission.peek.peek`): where they show no building near a place or a
+        way, it is seen free too."""
         self.unknown: dict[int, tuple[tuple[tuple[float, float], ...], float]] = {}
         """Where buildings of unknown height may stand, and the highest each roof may be (by
         the overview shape's index; an obstacle's is negative): a way near one crosses over
@@ -134,11 +148,54 @@ class SearchMission(FlightMission):
                 Level.INFO,
                 f"{what}: a roof of unknown height near the way: across at {cruise:.1f} m",
             )
+        if (
+            self.ceiling_m is not None
+            and cruise < self.ceiling_m
+            and not self._seen_way((here[0], here[1]), (x, y))
+        ):
+            cruise = self.ceiling_m
+            self.event(
+                Level.INFO,
+                f"{what}: the way leaves the ground the overview saw: across at {cruise:.1f} m",
+            )
         if math.hypot(here[0] - x, here[1] - y) > p.arrive_radius_m:
             if here[2] < cruise - p.arrive_radius_m:
                 yield from self.move((here[0], here[1], cruise), None, f"climb to {cruise:.1f} m")
             yield from self.move((x, y, cruise), None, f"{what}: across at {cruise:.1f} m")
         yield from self.move(pos_enu_m, heading_deg, what)
+
+    def in_seen_ground(self, xy: Sequence[float]) -> bool:
+        """Whether the second overview saw the ground near (x, y) (:meth:`_seen_margin_m`):
+        any building standing there would show in it (everywhere before it is taken)."""
+        if self.seen_ground is None:
+            return True
+        p = (xy[0], xy[1])
+        ring = self.seen_ground
+        need_m = self._seen_margin_m()
+        return point_in_polygon(p, ring) and all(
+            point_segment_distance(p, ring[i], ring[(i + 1) % len(ring)]) >= need_m
+            for i in range(len(ring))
+        )
+
+    def _seen_margin_m(self) -> float:
+        """How far inside what a photo showed a place must be for every building near it
+        to have shown: the safety margin and the arrival radius."""
+        return self.params.viewpoints.safety_margin_m + self.params.mission.arrive_radius_m
+
+    def over_seen_ground(self, x: float, y: float) -> bool:
+        """Whether no building stands within the safety margin (and the arrival radius) of
+        the vertical through (x, y) but those the mission knows: the overview saw the
+        ground there, or a photo straight down from the ceiling (:attr:`peeks`) shows none
+        near it."""
+        return self._seen_way((x, y), (x, y))
+
+    def _seen_way(self, a: tuple[float, float], b: tuple[float, float]) -> bool:
+        """Whether the straight way from ``a`` to ``b`` keeps over ground the overview saw
+        (its frame's ground is convex: a way between two places in it stays in it), or a
+        photo from the ceiling shows no building within the margin of it."""
+        if self.in_seen_ground(a) and self.in_seen_ground(b):
+            return True
+        return any(peek.clear_m(a, b) >= self._seen_margin_m() for peek in self.peeks)
 
     def floor_at(self, x: float, y: float) -> float:
         """The lowest altitude over (x, y) that keeps the safety margin (and the arrival

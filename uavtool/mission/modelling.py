@@ -151,7 +151,9 @@ def photograph_and_model(
             continue
         if vp.fallback:
             m.event(Level.INFO, f"{vp.name} viewpoint: {vp.fallback}")
-        views[vp.name], taken[vp.name] = yield from side_view(m, sides, vp, obj.colour_rgb)
+        got = yield from side_view(m, sides, vp, obj.colour_rgb)
+        if got is not None:
+            views[vp.name], taken[vp.name] = got
 
     missing = [name for name in ("front", "right") if name not in views]
     if missing:
@@ -245,7 +247,10 @@ def _diagonal(
         Level.INFO,
         f"the model is open under {share:.0%} of it: a diagonal photo, {diagonal.fallback}",
     )
-    view, _ = yield from side_view(m, sides, diagonal, colour_rgb, fresh=True)
+    got = yield from side_view(m, sides, diagonal, colour_rgb, fresh=True)
+    if got is None:
+        return model
+    view, _ = got
     try:
         return build_model(*views, m.params.model, more=(view,))
     except VisionError as exc:

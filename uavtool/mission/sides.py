@@ -29,6 +29,7 @@ import shapely
 from uavtool.camera import CameraPose, Intrinsics, project
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level
+from uavtool.mission.peek import peek
 from uavtool.mission.search import photo_shapes
 from uavtool.nav import Rect, Viewpoint, ViewpointFailure, ViewpointParams, plan_towards
 from uavtool.nav.geometry import point_polygon_distance
@@ -133,15 +134,21 @@ def side_view(
     colour_rgb: tuple[int, int, int],
     *,
     fresh: bool = False,
-) -> Wait[tuple[View, Viewpoint]]:
+) -> Wait[tuple[View, Viewpoint] | None]:
     """A side photo from ``vp`` — planned again first if the building proved taller since,
     unless ``fresh`` (planned with the plan's parameters as they are) — and the viewpoint it
-    was finally taken from (see the module doc for the photos taken again)."""
+    was finally taken from (see the module doc for the photos taken again). None when ``vp``
+    lies beyond the ground the overview saw and a look down from the ceiling shows a
+    building may stand within the margin of it."""
     p = m.params.mission
     if not fresh:
         vp = plan.again(m, vp)
     x, y, z = vp.pos_enu_m
     step_m = vp.distance_m * 0.5  # backing away: half the planned distance at a time
+    if not m.over_seen_ground(x, y) and not (
+        yield from peek(m, x, y, f"{vp.name} viewpoint", f"peek-{vp.name}")
+    ):
+        return None
     yield from m.travel(
         (x, y, plan.transit_m), vp.heading_deg, plan.transit_m, f"above the {vp.name} viewpoint"
     )
@@ -167,12 +174,19 @@ def side_view(
             moved = _looking_down_instead(m, plan, vp)
         if moved is None:
             break
-        vp = moved
-        x, y, z = vp.pos_enu_m
         # Up, across and down again: the way may pass a building the plan did not know.
         yield from m.move(
             (photo.pose.pos_enu_m[0], photo.pose.pos_enu_m[1], plan.transit_m), None, "climb"
         )
+        nx, ny, _ = moved.pos_enu_m
+        if not m.over_seen_ground(nx, ny) and not (
+            yield from peek(m, nx, ny, f"{vp.name} viewpoint", f"peek-{vp.name}-{attempt + 1}")
+        ):
+            assert m.ceiling_m is not None  # peek crossed at it: back the same way
+            yield from m.move((x, y, m.ceiling_m), None, f"back over the {vp.name} viewpoint")
+            break
+        vp = moved
+        x, y, z = vp.pos_enu_m
         yield from m.travel((x, y, z), vp.heading_deg, plan.transit_m, f"{vp.name} viewpoint")
     yield from m.move((x, y, plan.transit_m), vp.heading_deg, f"climb from the {vp.name} viewpoint")
     footprints, heights = plan.sight()
