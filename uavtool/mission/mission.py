@@ -192,7 +192,19 @@ class SearchMission(FlightMission):
     def _seen_way(self, a: tuple[float, float], b: tuple[float, float]) -> bool:
         """Whether the straight way from ``a`` to ``b`` keeps over ground the overview saw
         (its frame's ground is convex: a way between two places in it stays in it), or a
-        photo from the ceiling shows no building within the margin of it."""
+        photo from the ceiling shows no building within the margin of it, or the way is
+        one part and then the other (split every metre)."""
+        if self._seen_part(a, b):
+            return True
+        n = int(math.hypot(b[0] - a[0], b[1] - a[1]))
+        for i in range(1, n):
+            t = i / n
+            mid = (a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]))
+            if self._seen_part(a, mid) and self._seen_part(mid, b):
+                return True
+        return False
+
+    def _seen_part(self, a: tuple[float, float], b: tuple[float, float]) -> bool:
         if self.in_seen_ground(a) and self.in_seen_ground(b):
             return True
         return any(peek.clear_m(a, b) >= self._seen_margin_m() for peek in self.peeks)
