@@ -32,6 +32,7 @@ from uavtool.nav import (
     top_viewpoint,
 )
 from uavtool.nav.heights import fit_altitude_m
+from uavtool.nav.viewpoints import farther, for_building
 from uavtool.vision.errors import VisionError
 from uavtool.vision.model3d import (
     Model,
@@ -127,6 +128,15 @@ def photograph_and_model(
     )
     rect = min_area_rect(footprint)
     front, right = plan_viewpoints(rect, obstacles, top_photo.intrinsics, vp_params, heights, apart)
+    far = farther(vp_params, top_photo.intrinsics)
+    failed = sum(isinstance(v, ViewpointFailure) for v in (front, right))
+    if far is not None and failed:
+        # a tower too tall for any camera within the distance limit: from farther off
+        front_far, right_far = plan_viewpoints(
+            rect, obstacles, top_photo.intrinsics, far, heights, apart
+        )
+        if sum(isinstance(v, ViewpointFailure) for v in (front_far, right_far)) < failed:
+            front, right, vp_params = front_far, right_far, far
     m.viewpoints = Viewpoints(footprint, top, front, right)
     m.emit(m.viewpoints)
 
@@ -202,13 +212,11 @@ def photograph_and_model(
 
 
 def _side_params(m: SearchMission, roof_m: float) -> ViewpointParams:
-    """Side photos of a building ``roof_m`` tall: a horizontal camera halfway up, its view
-    holding the whole height."""
-    return dataclasses.replace(
-        m.params.viewpoints,
-        camera_alt_m=max(m.params.viewpoints.camera_alt_m, roof_m / 2.0),
-        assumed_height_m=max(m.params.viewpoints.assumed_height_m, roof_m),
-    )
+    """Side photos of a building ``roof_m`` tall (at least as tall as the viewpoints'
+    ``assumed_height_m``): a horizontal camera halfway up, its view holding the whole
+    height."""
+    p = m.params.viewpoints
+    return for_building(p, max(p.assumed_height_m, roof_m), least_alt_m=p.camera_alt_m)
 
 
 _STANDS_ON_NOTHING = 0.99

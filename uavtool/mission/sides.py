@@ -33,7 +33,7 @@ from uavtool.mission.peek import peek
 from uavtool.mission.search import photo_shapes
 from uavtool.nav import Rect, Viewpoint, ViewpointFailure, ViewpointParams, plan_towards
 from uavtool.nav.geometry import point_polygon_distance
-from uavtool.nav.viewpoints import foot_hidden
+from uavtool.nav.viewpoints import farther, foot_hidden, for_building
 from uavtool.vision import Shape
 from uavtool.vision.model3d import View, same_colour
 from uavtool.vision.shapes import EDGE_PX, cut_edges
@@ -86,7 +86,7 @@ class SidePlan:
 
     def taller(self, m: SearchMission, height_m: float) -> None:
         """Plan from now on for a building ``height_m`` tall."""
-        self.params = _for_height(m, self.params, height_m)
+        self.params = _for_height(m, self, height_m)
         self.grown = True
         clear_m = height_m + m.params.viewpoints.safety_margin_m + m.params.mission.arrive_radius_m
         self.transit_m = max(self.transit_m, clear_m)
@@ -108,12 +108,8 @@ class SidePlan:
         return found
 
 
-def _for_height(m: SearchMission, params: ViewpointParams, height_m: float) -> ViewpointParams:
-    return dataclasses.replace(
-        params,
-        assumed_height_m=height_m,
-        camera_alt_m=max(m.params.viewpoints.camera_alt_m, height_m / 2.0),
-    )
+def _for_height(m: SearchMission, plan: SidePlan, height_m: float) -> ViewpointParams:
+    return for_building(plan.params, height_m, least_alt_m=m.params.viewpoints.camera_alt_m)
 
 
 def _towards(
@@ -282,7 +278,13 @@ def _taller_view(
     up = half_vfov + math.radians(pose.pitch_deg)  # the top of the view above the horizon
     at_least_m = pose.pos_enu_m[2] + vp.distance_m * math.tan(up)
     height_m = _TALLER * max(at_least_m, plan.params.assumed_height_m)
-    found = _towards(plan, vp, _for_height(m, plan.params, height_m))
+    params = _for_height(m, plan, height_m)
+    found = _towards(plan, vp, params)
+    far = farther(params, plan.intrinsics)
+    if not isinstance(found, Viewpoint) and far is not None:
+        farther_off = _towards(plan, vp, far)  # a tower too tall for the distance limit
+        if isinstance(farther_off, Viewpoint):
+            found = farther_off
     if not isinstance(found, Viewpoint):
         m.event(Level.INFO, f"{vp.name} photo: the building's top is cut; {found.reason}")
         return None

@@ -149,6 +149,28 @@ def base_distance_m(side_length_m: float, intrinsics: Intrinsics, params: Viewpo
     return max(d_h, d_v, params.safety_margin_m)
 
 
+def for_building(
+    params: ViewpointParams, height_m: float, *, least_alt_m: float
+) -> ViewpointParams:
+    """``params`` for the side photos of a building ``height_m`` tall: a level camera
+    halfway up (never below ``least_alt_m``) whose view holds the whole height."""
+    return dataclasses.replace(
+        params, assumed_height_m=height_m, camera_alt_m=max(least_alt_m, height_m / 2.0)
+    )
+
+
+def farther(params: ViewpointParams, intrinsics: Intrinsics) -> ViewpointParams | None:
+    """``params`` with ``max_distance_m`` as far as a level camera halfway up must stand
+    to hold ``assumed_height_m`` in its view, one ``distance_step`` beyond; None when that
+    is within it already. The last resort for a tower no camera within the limit sees."""
+    tan_v = (intrinsics.height_px / 2.0) / intrinsics.fy_px
+    held_m = (1.0 + params.margin) * (params.assumed_height_m / 2.0) / tan_v
+    reach_m = held_m * params.distance_step
+    if reach_m <= params.max_distance_m:
+        return None
+    return dataclasses.replace(params, max_distance_m=reach_m)
+
+
 def tilted_cameras(
     distance_m: float, depth_m: float, intrinsics: Intrinsics, params: ViewpointParams
 ) -> Iterator[tuple[float, float]]:
