@@ -50,7 +50,9 @@ class ViewpointParams:
     safety_margin_m: float = 4.0
     """Least horizontal clearance between a camera position and any other building."""
     max_distance_m: float = 60.0
-    """Farthest a camera may stand from the side it photographs."""
+    """Farthest a camera may stand from the side it photographs; for a tower no camera
+    within it can hold, as far as a level camera must stand to, up to two
+    ``distance_step`` beyond it (94 m by default)."""
     distance_step: float = 1.25
     """Factor by which the distance grows on each fallback round."""
     max_pitch_down_deg: float = 40.0
@@ -161,11 +163,12 @@ def for_building(
 
 def farther(params: ViewpointParams, intrinsics: Intrinsics) -> ViewpointParams | None:
     """``params`` with ``max_distance_m`` as far as a level camera halfway up must stand
-    to hold ``assumed_height_m`` in its view, one ``distance_step`` beyond; None when that
-    is within it already. The last resort for a tower no camera within the limit sees."""
+    to hold ``assumed_height_m`` in its view, one ``distance_step`` beyond, but no more than
+    two steps beyond the limit; None when that is within it already. The last resort for a
+    tower no camera within the limit sees."""
     tan_v = (intrinsics.height_px / 2.0) / intrinsics.fy_px
     held_m = (1.0 + params.margin) * (params.assumed_height_m / 2.0) / tan_v
-    reach_m = held_m * params.distance_step
+    reach_m = min(held_m, params.max_distance_m * params.distance_step) * params.distance_step
     if reach_m <= params.max_distance_m:
         return None
     return dataclasses.replace(params, max_distance_m=reach_m)
