@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -21,7 +22,7 @@ from uavtool.nav import (
     top_viewpoint,
 )
 from uavtool.nav.geometry import point_polygon_distance, triangle_hits_polygon
-from uavtool.nav.viewpoints import base_distance_m
+from uavtool.nav.viewpoints import base_distance_m, farther, for_building
 from uavtool.world import building_footprint, load_scene
 
 K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
@@ -375,3 +376,26 @@ def test_walls_round_a_building_are_seen_over_from_as_high_as_needed() -> None:
         for cx, cy in near:
             for at in (P.assumed_height_m, P.assumed_height_m / 2.0):
                 assert _clear((x, y, z), (cx, cy, at), walls, heights)
+
+
+def test_a_tower_too_tall_for_the_distance_limit_is_planned_from_farther() -> None:
+    """A 57 m tower: a level camera halfway up must stand 82.7 m off to hold it with the
+    margin, beyond the 60 m limit, so no level view is planned. ``farther`` stretches the
+    limit to that distance, one step beyond, and the level view is found; a limit stretched
+    further than two steps (a user's 5 m) stays short of it."""
+    tower = Rect((0.0, 0.0), 90.0, 12.0, 12.0)
+    params = for_building(ViewpointParams(), 57.3, least_alt_m=6.0)
+    assert params.camera_alt_m == pytest.approx(28.65)
+    held_m = 1.25 * 28.65 / math.tan(math.radians(K.vfov_deg) / 2.0)
+    assert held_m == pytest.approx(82.7, abs=0.1)
+    front, right = plan_viewpoints(tower, [], K, replace(params, max_pitch_down_deg=0.0))
+    assert isinstance(front, ViewpointFailure) and isinstance(right, ViewpointFailure)
+    far = farther(params, K)
+    assert far is not None and far.max_distance_m == pytest.approx(min(held_m, 75.0) * 1.25)
+    front, right = plan_viewpoints(tower, [], K, replace(far, max_pitch_down_deg=0.0))
+    assert isinstance(front, Viewpoint) and front.pitch_deg == 0.0
+    assert front.distance_m == pytest.approx(held_m, abs=0.5)
+    assert isinstance(right, Viewpoint)
+    assert farther(ViewpointParams(), K) is None  # 12 m: the limit holds it already
+    near = farther(replace(params, max_distance_m=5.0), K)
+    assert near is not None and near.max_distance_m == pytest.approx(5.0 * 1.25**2)
