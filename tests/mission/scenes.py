@@ -18,6 +18,22 @@ _WALLS = {
 }
 
 
+def on_grey_ground(name: str, target: str, buildings: list[dict[str, Any]]) -> Scene:
+    """A scene of ``buildings`` (scene-file dicts) on grey ground, lit as the paper's."""
+    return scene_from_dict(
+        {
+            "version": 1,
+            "name": name,
+            "origin": {"lat_deg": 47.0, "lon_deg": 8.0, "alt_amsl_m": 400.0, "heading_deg": 0.0},
+            "ground": {"color": [128, 128, 128]},
+            "sky": {"color": [205, 218, 232]},
+            "lighting": {"sun_azimuth_deg": 150.0, "sun_elevation_deg": 60.0, "ambient": 0.55},
+            "target": target,
+            "buildings": buildings,
+        }
+    )
+
+
 def with_mission(**changes: Any) -> Params:
     """Default parameters with some ``mission.*`` values changed."""
     return Params(mission=dataclasses.replace(MissionParams(), **changes))

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.mission.scenes import on_grey_ground
 from uavtool.camera import CameraPose, Intrinsics, project
 from uavtool.mission.observations import Photo
 from uavtool.mission.params import Params
@@ -17,43 +18,36 @@ from uavtool.mission.peek import Peek
 from uavtool.recording import JsonDocument, RecordingReader
 from uavtool.recording.topics import OBSERVATIONS
 from uavtool.runner.fly import FlyConfig, fly
-from uavtool.world import render, scene_from_dict
+from uavtool.world import Scene, render
 
 DATA = Path(__file__).parent / "data"
 K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
 
 
-def _scene(buildings: list[tuple[float, float, float, float]]) -> object:
+def _scene(buildings: list[tuple[float, float, float, float]]) -> Scene:
     """Square buildings (centre east, north, half side, height)."""
-    return scene_from_dict(
-        {
-            "version": 1,
-            "name": "peek",
-            "origin": {"lat_deg": 47.0, "lon_deg": 8.0, "alt_amsl_m": 400.0, "heading_deg": 0.0},
-            "ground": {"color": [128, 128, 128]},
-            "sky": {"color": [205, 218, 232]},
-            "lighting": {"sun_azimuth_deg": 150.0, "sun_elevation_deg": 60.0, "ambient": 0.55},
-            "target": "b0",
-            "buildings": [
-                {
-                    "name": f"b{i}",
-                    "color": [217, 84 + 40 * i, 54],
-                    "blocks": [
-                        {
-                            "footprint": [
-                                [cx - h, cy - h],
-                                [cx + h, cy - h],
-                                [cx + h, cy + h],
-                                [cx - h, cy + h],
-                            ],
-                            "base_m": 0.0,
-                            "top_m": top,
-                        }
-                    ],
-                }
-                for i, (cx, cy, h, top) in enumerate(buildings)
-            ],
-        }
+    return on_grey_ground(
+        "peek",
+        "b0",
+        [
+            {
+                "name": f"b{i}",
+                "color": [217, 84 + 40 * i, 54],
+                "blocks": [
+                    {
+                        "footprint": [
+                            [cx - h, cy - h],
+                            [cx + h, cy - h],
+                            [cx + h, cy + h],
+                            [cx - h, cy + h],
+                        ],
+                        "base_m": 0.0,
+                        "top_m": top,
+                    }
+                ],
+            }
+            for i, (cx, cy, h, top) in enumerate(buildings)
+        ],
     )
 
 

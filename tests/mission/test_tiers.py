@@ -14,6 +14,7 @@ from typing import Any
 import pytest
 from shapely.geometry import Point, Polygon  # type: ignore[import-untyped]
 
+from tests.mission.scenes import on_grey_ground
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.mission import Status
 from uavtool.mission.analysis import NOT_FLAT_M, nadir_shapes, not_flat, roof_between
@@ -58,37 +59,26 @@ def _square(cx: float, cy: float, half: float) -> list[tuple[float, float]]:
 def _scene() -> Scene:
     """A flat block and a block with a courtyard (four wings round a yard)."""
     yard_outer = _square(-20.0, 15.0, 6.0)
-    return scene_from_dict(
-        {
-            "version": 1,
-            "name": "tiers",
-            "origin": {"lat_deg": 47.0, "lon_deg": 8.0, "alt_amsl_m": 400.0, "heading_deg": 0.0},
-            "ground": {"color": [128, 128, 128]},
-            "sky": {"color": [205, 218, 232]},
-            "lighting": {"sun_azimuth_deg": 150.0, "sun_elevation_deg": 60.0, "ambient": 0.55},
-            "target": "flat",
-            "buildings": [
-                {
-                    "name": "flat",
-                    "color": [54, 125, 217],
-                    "blocks": [_block(_square(20.0, 20.0, 4.0), 0.0, 12.0)],
-                },
-                {
-                    "name": "yard",
-                    "color": [217, 54, 162],
-                    "blocks": [
-                        _block([*yard_outer[:2], (-14.0, 12.5), (-26.0, 12.5)], 0.0, 15.0),
-                        _block([(-26.0, 17.5), (-14.0, 17.5), *yard_outer[2:]], 0.0, 15.0),
-                        _block(
-                            [(-26.0, 12.5), (-22.5, 12.5), (-22.5, 17.5), (-26.0, 17.5)], 0.0, 15.0
-                        ),
-                        _block(
-                            [(-17.5, 12.5), (-14.0, 12.5), (-14.0, 17.5), (-17.5, 17.5)], 0.0, 15.0
-                        ),
-                    ],
-                },
-            ],
-        }
+    return on_grey_ground(
+        "tiers",
+        "flat",
+        [
+            {
+                "name": "flat",
+                "color": [54, 125, 217],
+                "blocks": [_block(_square(20.0, 20.0, 4.0), 0.0, 12.0)],
+            },
+            {
+                "name": "yard",
+                "color": [217, 54, 162],
+                "blocks": [
+                    _block([*yard_outer[:2], (-14.0, 12.5), (-26.0, 12.5)], 0.0, 15.0),
+                    _block([(-26.0, 17.5), (-14.0, 17.5), *yard_outer[2:]], 0.0, 15.0),
+                    _block([(-26.0, 12.5), (-22.5, 12.5), (-22.5, 17.5), (-26.0, 17.5)], 0.0, 15.0),
+                    _block([(-17.5, 12.5), (-14.0, 12.5), (-14.0, 17.5), (-17.5, 17.5)], 0.0, 15.0),
+                ],
+            },
+        ],
     )
 
 
