@@ -10,8 +10,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.mission.driver import run, target_rgb
+from tests.mission.fakes import FakeVehicle
 from tests.mission.scenes import on_grey_ground
 from uavtool.camera import CameraPose, Intrinsics, project
+from uavtool.mission import GoTo, MissionInputs, SearchMission, TakePhoto
+from uavtool.mission.base import Wait
 from uavtool.mission.observations import Photo
 from uavtool.mission.params import Params
 from uavtool.mission.peek import Peek
@@ -105,3 +109,31 @@ def test_side_cameras_stand_only_over_ground_seen_from_above(tmp_path: Path, sce
     summary = fly(FlyConfig(scene=str(DATA / scene), record=record))
     assert summary.evaluation.model_iou is not None
     assert _unseen(record) == []
+
+
+class _GoBeyond(SearchMission):
+    """Flies only one way: to 15 m over (40, 0), beyond a made-up overview's ground (a
+    40 m square round home), with the ceiling at 60 m."""
+
+    def fly(self) -> Wait[str]:
+        yield from self.arm_and_take_off(30.0)
+        self.ceiling_m = 60.0
+        self.seen_ground = ((-20.0, -20.0), (20.0, -20.0), (20.0, 20.0), (-20.0, 20.0))
+        yield from self.travel((40.0, 0.0, 15.0), None, 30.0, "place beyond")
+        return "there"
+
+
+@pytest.mark.parametrize(("building", "descends"), [((-40.0, 30.0), True), ((44.0, 0.0), False)])
+def test_travel_looks_down_before_descending_beyond_the_seen_ground(
+    building: tuple[float, float], descends: bool
+) -> None:
+    """Below the ceiling beyond the overview's ground the vehicle first looks straight down
+    from the ceiling; with a building 2 m from the place (a 4 m square 4 m east of it) it
+    stays at the ceiling over it, with none near it descends."""
+    scene = _scene([(building[0], building[1], 2.0, 10.0)])
+    mission = _GoBeyond(Params(), MissionInputs(target_rgb(scene)))
+    flight = run(mission, FakeVehicle(scene)).outputs
+    assert [o.tag for o in flight if isinstance(o, TakePhoto)] == ["peek-1"]
+    targets = [o.pos_enu_m for o in flight if isinstance(o, GoTo)]
+    assert ((40.0, 0.0, 15.0) in targets) is descends
+    assert ((40.0, 0.0, 60.0) in targets) is True

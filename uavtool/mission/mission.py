@@ -29,7 +29,7 @@ from uavtool.mission.outputs import (
     Viewpoints,
 )
 from uavtool.mission.params import Params
-from uavtool.mission.peek import Peek
+from uavtool.mission.peek import Peek, peek
 from uavtool.nav.geometry import (
     point_in_polygon,
     point_polygon_distance,
@@ -136,9 +136,19 @@ class SearchMission(FlightMission):
     ) -> Wait[None]:
         """Fly to a position over every known roof: straight up to ``transit_m`` (or the
         destination's altitude, if higher) when below it, across at that altitude, then
-        straight to the destination."""
+        straight to the destination. Below the ceiling over ground no photo from above saw,
+        a look straight down from the ceiling comes first; where it shows a building near,
+        the vehicle stops at the ceiling over the destination."""
         p = self.params.mission
         x, y, z = pos_enu_m
+        if (
+            self.ceiling_m is not None
+            and z < self.ceiling_m - p.arrive_radius_m
+            and not self.over_seen_ground(x, y)
+            and not (yield from peek(self, x, y, what, f"peek-{len(self.peeks) + 1}"))
+        ):  # nothing is known below: the ceiling is as low as it goes there
+            yield from self.move((x, y, self.ceiling_m), heading_deg, f"{what}: at the ceiling")
+            return
         cruise = max(transit_m, z)
         here = self.last.pos_enu_m if self.last is not None else (x, y, cruise)
         over = self._over_unknown(here, (x, y))

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level
+from uavtool.mission.search import photo_shapes
 from uavtool.nav import NavError, ground_point
 from uavtool.nav.geometry import point_in_polygon, segment_polygon_distance
 from uavtool.vision.params import VectorizeParams
@@ -85,6 +86,7 @@ def peek(m: SearchMission, x: float, y: float, what: str, tag: str) -> Wait[bool
     assert m.ceiling_m is not None
     yield from m.travel((x, y, m.ceiling_m), None, m.ceiling_m, f"over the {what}, looking down")
     photo = yield from m.photo(tag, -90.0)
+    photo_shapes(m, photo)  # what it shows, as for every photo (viewers, re-analysis)
     seen = Peek.of(photo, m.params.vectorize)
     if seen is not None:
         m.peeks.append(seen)
