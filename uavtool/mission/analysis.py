@@ -13,7 +13,7 @@ from uavtool.camera import Intrinsics, project
 from uavtool.mission.errors import MissionInputError
 from uavtool.mission.observations import Photo, U8Array
 from uavtool.mission.params import Params
-from uavtool.nav import NavError, ground_point
+from uavtool.nav import NavError, frame_corners_px, frame_on_plane
 from uavtool.nav.heights import higher_part_m, outline_residual_px, roof_from_photos
 from uavtool.vision import Shape, best_match, mirror_score, vectorize
 from uavtool.vision.merge import merge_touching
@@ -172,12 +172,9 @@ def _shows_ground(
     wall_px: npt.NDArray[np.int32], photo: Photo, other: Photo, plane_m: float, ground: U8Array
 ) -> bool:
     k = photo.intrinsics
-    corners = [(0.0, 0.0), (k.width_px - 1.0, 0.0), (k.width_px - 1.0, k.height_px - 1.0)]
-    corners.append((0.0, k.height_px - 1.0))
+    corners = frame_corners_px(k)
     try:
-        world = [
-            (*ground_point(u, v, photo.pose, k, plane_z_m=plane_m), plane_m) for u, v in corners
-        ]
+        world = [(x, y, plane_m) for x, y in frame_on_plane(photo.pose, k, plane_z_m=plane_m)]
     except NavError:
         return False
     there = project(np.array(world), other.pose, other.intrinsics)

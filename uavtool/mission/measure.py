@@ -24,7 +24,6 @@ import numpy as np
 from uavtool.mission.analysis import roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
-from uavtool.mission.peek import frame_on_ground
 from uavtool.mission.search import photo_shapes
 from uavtool.mission.survey import (
     Obstacle,
@@ -42,7 +41,7 @@ from uavtool.mission.unknown import (
     unexplained,
     unknown_place,
 )
-from uavtool.nav import NavError, ground_point
+from uavtool.nav import NavError, frame_on_plane, ground_point
 from uavtool.nav.heights import roof_from_cut_outline
 from uavtool.vision import Shape
 from uavtool.vision.vectorize import non_ground
@@ -64,7 +63,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     obstacles."""
     ceiling_m = seen.photo.pose.pos_enu_m[2]
     m.ceiling_m = ceiling_m
-    m.seen_ground = frame_on_ground(seen.photo)
+    m.seen_ground = frame_on_plane(seen.photo.pose, seen.photo.intrinsics)
     below_m = ceiling_m - 1.0
     others = _unclassified(m, seen)  # obstacles of no building colour
     if (

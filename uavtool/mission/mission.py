@@ -10,7 +10,6 @@ which are not — so that no way crosses near a roof lower than the altitude tha
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from typing import Any, ClassVar
 
 from uavtool.camera import Intrinsics
@@ -174,12 +173,11 @@ class SearchMission(FlightMission):
             yield from self.move((x, y, cruise), None, f"{what}: across at {cruise:.1f} m")
         yield from self.move(pos_enu_m, heading_deg, what)
 
-    def in_seen_ground(self, xy: Sequence[float]) -> bool:
+    def in_seen_ground(self, p: tuple[float, float]) -> bool:
         """Whether the second overview saw the ground near (x, y) (:meth:`_seen_margin_m`):
         any building standing there would show in it (everywhere before it is taken)."""
         if self.seen_ground is None:
             return True
-        p = (xy[0], xy[1])
         ring = self.seen_ground
         need_m = self._seen_margin_m()
         return point_in_polygon(p, ring) and all(

@@ -56,7 +56,8 @@ def photograph_and_model(
     p = m.params.mission
     # The building's highest part: one tier of a stepped tower may have been found apart
     # from the others, each measured on its own.
-    roof = max(found.roof_m, building_top_m(seen, same_building(m, seen, found.poi.shape_index)))
+    top_m = building_top_m(seen, same_building(m, seen, found.poi.shape_index))
+    roof = max(found.roof_m, top_m)
     k = found.photo.intrinsics
     vp_params = _side_params(m, roof)
     footprint = ground_polygon(
@@ -114,9 +115,7 @@ def photograph_and_model(
                 f"the look and the top photo measure the target's roof {measured:.1f} m above home",
             )
             found = dataclasses.replace(found, roof_m=measured, roof_measured=True)
-            roof = max(
-                measured, building_top_m(seen, same_building(m, seen, found.poi.shape_index))
-            )
+            roof = max(measured, top_m)
             vp_params = _side_params(m, roof)
     # The top photo, low over the target, measures the neighbours the overview could not.
     remeasured = remeasured_obstacles(m, seen, found.poi.shape_index, top_photo, top_shapes)

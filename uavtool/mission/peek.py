@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level
 from uavtool.mission.search import photo_shapes
-from uavtool.nav import NavError, ground_point
+from uavtool.nav import NavError, frame_on_plane, ground_point
 from uavtool.nav.geometry import point_in_polygon, segment_polygon_distance
 from uavtool.vision.params import VectorizeParams
 from uavtool.vision.vectorize import not_ground_regions
@@ -30,14 +30,6 @@ if TYPE_CHECKING:
 
 Point = tuple[float, float]
 Ring = tuple[Point, ...]
-
-
-def frame_on_ground(photo: Photo) -> Ring:
-    """The corners, on the ground, of what the nadir ``photo`` shows."""
-    k = photo.intrinsics
-    pixels = [(0.0, 0.0), (k.width_px - 1.0, 0.0), (k.width_px - 1.0, k.height_px - 1.0)]
-    pixels.append((0.0, k.height_px - 1.0))
-    return tuple(ground_point(u, v, photo.pose, k) for u, v in pixels)
 
 
 @dataclass(frozen=True, slots=True)
@@ -53,7 +45,7 @@ class Peek:
         """None for a photo that is not straight down (a pixel above the horizon)."""
         k = photo.intrinsics
         try:
-            frame = frame_on_ground(photo)
+            frame = frame_on_plane(photo.pose, k)
             buildings = tuple(
                 tuple(ground_point(u, v, photo.pose, k) for u, v in region.polygon_px.tolist())
                 for region in not_ground_regions(photo.image_rgb, params)

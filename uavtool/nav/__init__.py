@@ -7,7 +7,13 @@ for bit. Frames: local ENU metres around home; headings in degrees clockwise fro
 from __future__ import annotations
 
 from uavtool.nav.errors import NavError, NavParamError
-from uavtool.nav.projection import ground_point, ground_polygon, poi_offset
+from uavtool.nav.projection import (
+    frame_corners_px,
+    frame_on_plane,
+    ground_point,
+    ground_polygon,
+    poi_offset,
+)
 from uavtool.nav.rect import Rect, min_area_rect
 from uavtool.nav.route import route_length_m, visit_order
 from uavtool.nav.viewpoints import (
@@ -27,6 +33,8 @@ __all__ = [
     "Viewpoint",
     "ViewpointFailure",
     "ViewpointParams",
+    "frame_corners_px",
+    "frame_on_plane",
     "ground_point",
     "ground_polygon",
     "min_area_rect",

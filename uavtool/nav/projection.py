@@ -56,6 +56,23 @@ def ground_point(
     return (cam_x + t * d[0], cam_y + t * d[1])
 
 
+def frame_corners_px(intrinsics: Intrinsics) -> list[tuple[float, float]]:
+    """The corner pixels of a frame, clockwise on screen from the top left."""
+    w, h = intrinsics.width_px - 1.0, intrinsics.height_px - 1.0
+    return [(0.0, 0.0), (w, 0.0), (w, h), (0.0, h)]
+
+
+def frame_on_plane(
+    pose: CameraPose, intrinsics: Intrinsics, *, plane_z_m: float = 0.0
+) -> tuple[tuple[float, float], ...]:
+    """Where the frame's corners (:func:`frame_corners_px`) meet z = ``plane_z_m``: what a
+    photo looking down shows of that plane. NavError as :func:`ground_point`."""
+    return tuple(
+        ground_point(u, v, pose, intrinsics, plane_z_m=plane_z_m)
+        for u, v in frame_corners_px(intrinsics)
+    )
+
+
 def poi_offset(
     u_px: float,
     v_px: float,
