@@ -5,11 +5,15 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 
 from tests.mission.driver import fly
+from uavtool.runner.fly import FlyConfig
+from uavtool.runner.fly import fly as fly_scene
 from uavtool.world import Scene, scene_from_dict
 
 RED = [210, 40, 40]
+DATA = Path(__file__).parent / "data"
 
 
 def _tee(x0: float, y0: float, right_arm_m: float = 4.5) -> list[list[float]]:
@@ -71,3 +75,15 @@ def test_a_small_building_of_the_targets_colour_is_visited() -> None:
     matched = pois[flown.outcome.matched_poi]
     assert matched.area_px < flown.mission.params.mission.min_poi_area_px
     assert flown.outcome.model_built
+
+
+def test_walls_of_the_targets_hue_are_a_rival_though_no_roof_shows() -> None:
+    """Town scene 10918: the target, a 55 m L, stands at the overview's border with its roof
+    beyond the frame; only its walls show, a darker shade of its hue, so the vectorizer keeps
+    no shape of it. A courtyard decoy of the target's colour scores 0.748 and was matched.
+    The walls are a point of interest of the target's hue: looked at, they show the target,
+    which wins."""
+    summary = fly_scene(FlyConfig(scene=str(DATA / "town-10918.yaml"), no_record=True))
+    assert summary.evaluation.matched_building == "b00"
+    assert summary.outcome.match_score > 0.95
+    assert summary.evaluation.model_iou is not None and summary.evaluation.model_iou > 0.8

@@ -44,6 +44,7 @@ from uavtool.mission.unknown import (
 from uavtool.nav import NavError, frame_on_plane, ground_point
 from uavtool.nav.heights import roof_from_cut_outline
 from uavtool.vision import Shape
+from uavtool.vision.colour import has_hue, hue_distance_deg
 from uavtool.vision.vectorize import non_ground
 
 if TYPE_CHECKING:
@@ -141,6 +142,23 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     def place_of(o: Shape) -> Unknown:
         return unknown_place(o, seen.photo, tallest_m, views, seen.regions, hue_tolerance_deg=hue)
 
+    # What is not ground and has the target's hue, though the vectorizer kept no roof of it
+    # (walls whose roof lies beyond the frame, a darker shade), may be the target: it is a
+    # point of interest, looked at before any match is final, and an obstacle as every
+    # building is.
+    rivals = [may_be_target(m, o) for o in others]
+    shapes = seen.shapes + tuple(o for o, r in zip(others, rivals, strict=True) if r)
+    roofs += [assumed_m if h is None else h for h, r in zip(others_m, rivals, strict=True) if r]
+    measured += [h is not None for h, r in zip(others_m, rivals, strict=True) if r]
+    at_first = seen.measured + (False,) * (len(shapes) - len(seen.shapes))
+    others_m = [h for h, r in zip(others_m, rivals, strict=True) if not r]
+    others = [o for o, r in zip(others, rivals, strict=True) if not r]
+    if any(rivals):
+        m.event(
+            Level.INFO,
+            f"{sum(rivals)} regions of the target's hue show no roof (walls, a darker shade): "
+            "points of interest too",
+        )
     obstacles = tuple(
         Obstacle(o, assumed_m, False, *place_of(o))
         if h is None
@@ -156,14 +174,14 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         )
     places = [  # for the roofs still unknown, the tour's photos rule out more
         Unknown(footprint_at(s, seen.photo, roofs[i]), roofs[i])
-        if measured[i] and not seen.measured[i]
-        else Unknown(fp, roofs[i])
+        if measured[i] and not at_first[i]
+        else Unknown(seen.footprints[i], roofs[i])
         if measured[i]
         else place_of(s)
-        for i, (s, fp) in enumerate(zip(seen.shapes, seen.footprints, strict=True))
+        for i, s in enumerate(shapes)
     ]
     footprints = tuple(place.footprint for place in places)
-    pois = points_of_interest(m, seen.shapes, seen.photo, roofs, measured, footprints)
+    pois = points_of_interest(m, shapes, seen.photo, roofs, measured, footprints)
     taller = [
         f"{poi.index} ({poi.roof_m:.1f} m)"
         for poi in pois
@@ -186,8 +204,8 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     m.unknown.update(
         {
             i: place_of(s)
-            for i, (s, ok) in enumerate(zip(seen.shapes, measured, strict=True))
-            if ok and s.cut_by_border and not seen.measured[i]
+            for i, (s, ok) in enumerate(zip(shapes, measured, strict=True))
+            if ok and s.cut_by_border and not at_first[i]
         }
     )
     m.unknown.update(
@@ -195,6 +213,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     )
     return replace(
         seen,
+        shapes=shapes,
         roofs_m=tuple(roofs),
         measured=tuple(measured),
         footprints=footprints,
@@ -202,6 +221,16 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         pois=pois,
         obstacles=obstacles,
     )
+
+
+def may_be_target(m: SearchMission, region: Shape) -> bool:
+    """Whether a region no colour class kept could still be the target: it has a hue (not
+    grey, white or black) within the match's hue gate of the target's (any hue without a
+    gate)."""
+    if not has_hue(region.colour_rgb, m.params.vectorize):
+        return False
+    limit = m.params.mission.match_hue_tolerance_deg
+    return limit <= 0 or hue_distance_deg(region.colour_rgb, m.target.colour_rgb) <= limit
 
 
 def _unclassified(m: SearchMission, seen: Survey) -> list[Shape]:

@@ -23,7 +23,8 @@ from uavtool.mission.analysis import (
 )
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest, Recognition, Shapes, Status, Vec3
-from uavtool.nav import ground_point, ground_polygon
+from uavtool.nav import NavError, ground_point, ground_polygon
+from uavtool.nav.geometry import point_polygon_distance
 from uavtool.nav.heights import fit_altitude_m
 from uavtool.vision import Shape
 from uavtool.vision.vectorize import hue_distance_deg
@@ -146,7 +147,13 @@ def search(
             best_score, best_poi = top, k
         look = looks[-1]  # a match ends the looking: the last look is the match if any
         j = look.judgement
-        if j.matched and (best is None or j.score > best.score):
+        if j.matched and best is not None and _shows_again(best, look):
+            m.event(
+                Level.INFO,
+                f"point of interest {k}: the look shows point of interest {best.poi.index}'s "
+                "building again, no rival",
+            )
+        elif j.matched and (best is None or j.score > best.score):
             shape = look.shapes[j.candidate]
             seen = overview_shapes[poi.shape_index]
             roof = roof_between(seen, overview, shape, look.photo)
@@ -173,6 +180,24 @@ def search(
         f"roof {best.roof_m:.1f} m above home",
     )
     return best
+
+
+def _shows_again(best: Found, look: _Look) -> bool:
+    """Whether a look's matched candidate is the building already matched (``best``): its
+    centre, on the matched roof's plane, lies on that roof. A look aimed at a rival of the
+    target's hue (walls whose roof the overview did not show) may find the matched
+    building nearer its centre; that is no new evidence."""
+    shape = look.shapes[look.judgement.candidate]
+    photo = look.photo
+    plane_m = min(best.roof_m, best.photo.pose.pos_enu_m[2] - 1.0, photo.pose.pos_enu_m[2] - 1.0)
+    try:
+        ring = ground_polygon(
+            best.shape.polygon_px, best.photo.pose, best.photo.intrinsics, plane_z_m=plane_m
+        )
+        here = ground_point(*shape.centroid_px, photo.pose, photo.intrinsics, plane_z_m=plane_m)
+    except NavError:
+        return False
+    return point_polygon_distance(here, ring) == 0.0
 
 
 def _rivals(

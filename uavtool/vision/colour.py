@@ -94,6 +94,14 @@ def hue_of(colour_rgb: tuple[int, int, int]) -> int:
     return int(cv2.cvtColor(px, cv2.COLOR_RGB2HSV_FULL)[0, 0, 0])
 
 
+def has_hue(colour_rgb: tuple[int, int, int], params: VectorizeParams) -> bool:
+    """Whether a colour is one :func:`uavtool.vision.vectorize` classes by hue: saturated
+    and bright enough (``min_saturation``, ``min_value``), not a grey, white or black."""
+    px = np.array([[colour_rgb]], dtype=np.uint8)
+    _h, s, v = (int(c) for c in cv2.cvtColor(px, cv2.COLOR_RGB2HSV_FULL)[0, 0])
+    return s >= params.min_saturation and v >= params.min_value
+
+
 def hue_distance_deg(a_rgb: tuple[int, int, int], b_rgb: tuple[int, int, int]) -> float:
     """Circular hue difference of two colours, degrees in [0, 180]."""
     d = abs(hue_of(a_rgb) - hue_of(b_rgb))
