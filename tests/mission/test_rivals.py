@@ -8,6 +8,7 @@ import math
 from pathlib import Path
 
 from tests.mission.driver import fly
+from uavtool.mission import Status
 from uavtool.runner.fly import FlyConfig
 from uavtool.runner.fly import fly as fly_scene
 from uavtool.world import Scene, scene_from_dict
@@ -87,3 +88,16 @@ def test_walls_of_the_targets_hue_are_a_rival_though_no_roof_shows() -> None:
     assert summary.evaluation.matched_building == "b00"
     assert summary.outcome.match_score > 0.95
     assert summary.evaluation.model_iou is not None and summary.evaluation.model_iou > 0.8
+
+
+def test_a_rival_look_that_shows_another_building_is_not_the_rivals_match(tmp_path: Path) -> None:
+    """Town scene 3531: b01, a 24 m building in a darker shade of the target's hue, shows no
+    roof the vectorizer keeps, so it is a point of interest. Its look found the target 36 m
+    away, and the match was taken as b01's: b01 was then left out of the obstacles as the
+    target's own, and a side camera passed 0.06 m from it. A match at such a point must be
+    a building that explains what the overview showed there."""
+    scene = str(DATA / "town-3531.yaml")
+    summary = fly_scene(FlyConfig(scene=scene, record=tmp_path / "f.mcap"))
+    assert summary.evaluation.matched_building == "b03"
+    assert summary.clearance_m is not None and summary.clearance_m > 4.0
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason

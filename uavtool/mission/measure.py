@@ -220,6 +220,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         uppers_m=tuple(place.upper_m for place in places),
         pois=pois,
         obstacles=obstacles,
+        roofless=frozenset(range(len(seen.shapes), len(shapes))),
     )
 
 

@@ -53,7 +53,13 @@ def fly(m: SearchMission) -> Wait[None]:
     transit_m = seen.highest_roof_m + m.params.viewpoints.safety_margin_m + p.arrive_radius_m
     m.transit_m = transit_m
     found = yield from search(
-        m, pois, order, overview=seen.photo, overview_shapes=seen.shapes, transit_m=transit_m
+        m,
+        pois,
+        order,
+        overview=seen.photo,
+        overview_shapes=seen.shapes,
+        transit_m=transit_m,
+        roofless=seen.roofless,
     )
     if found is None:
         return

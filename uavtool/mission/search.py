@@ -23,6 +23,7 @@ from uavtool.mission.analysis import (
 )
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest, Recognition, Shapes, Status, Vec3
+from uavtool.mission.unknown import shows_as
 from uavtool.nav import NavError, ground_point, ground_polygon
 from uavtool.nav.geometry import point_polygon_distance
 from uavtool.nav.heights import fit_altitude_m
@@ -89,10 +90,13 @@ def search(
     overview: Photo,
     overview_shapes: tuple[Shape, ...],
     transit_m: float,
+    roofless: frozenset[int] = frozenset(),
 ) -> Wait[Found | None]:
     """Visit the points of interest in order (across at ``transit_m``, over every known
     roof); the best match (the first one unless ``visit_all``); ends the mission with
-    NO_MATCH when nothing matched."""
+    NO_MATCH when nothing matched. A look at a point of interest whose overview shape shows
+    no roof (``roofless``: walls, a darker shade) matches only a building that explains
+    that shape."""
     p = m.params.mission
     best: Found | None = None
     best_score, best_poi = 0.0, -1
@@ -147,6 +151,25 @@ def search(
             best_score, best_poi = top, k
         look = looks[-1]  # a match ends the looking: the last look is the match if any
         j = look.judgement
+        if j.matched and poi.shape_index in roofless:
+            upper = (
+                poi.roof_m
+                if poi.roof_measured
+                else m.unknown.get(poi.shape_index, (None, ceiling_m))[1]
+            )
+            if not shows_as(
+                look.shapes[j.candidate],
+                look.photo,
+                overview_shapes[poi.shape_index],
+                overview,
+                upper,
+            ):
+                m.event(
+                    Level.INFO,
+                    f"point of interest {k}: the match is another building than the one seen there "
+                    "(walls or a darker shade of the target's hue): not its match",
+                )
+                continue
         if j.matched and best is not None and _shows_again(best, look):
             m.event(
                 Level.INFO,

@@ -332,6 +332,39 @@ def _prism_px(shape: Shape, photo: Photo, roof_m: float) -> list[Any]:
     return [pixels(ring) for ring in (top, bottom, *walls)]
 
 
+def shows_as(
+    shape: Shape, photo: Photo, region: Shape, other: Photo, highest_m: float, *, least: float = 0.5
+) -> bool:
+    """Whether the building whose roof is ``shape`` in nadir ``photo`` can be what ``region``
+    of another nadir photo (``other``) shows: at some roof height up to ``highest_m`` (every
+    metre), the building seen from ``other`` — its roof, its walls down to the ground —
+    covers at least ``least`` of the region. A region of walls whose roof lay beyond that
+    photo's frame is shown so by its own building, and never by one standing elsewhere."""
+    k = other.intrinsics
+    want = np.zeros((k.height_px, k.width_px), np.uint8)
+    cv2.fillPoly(want, [pixels(region.polygon_px)], 255)
+    total = cv2.countNonZero(want)
+    top_m = min(highest_m, other.pose.pos_enu_m[2] - 1.0, photo.pose.pos_enu_m[2] - 1.0)
+    seen = np.zeros_like(want)
+    for roof_m in np.arange(0.0, top_m + 1e-9, 1.0):
+        world = np.array(footprint_at(shape, photo, float(roof_m)))
+        if len(world) < 3:
+            continue
+        top = project(np.column_stack([world, np.full(len(world), roof_m)]), other.pose, k)
+        base = project(np.column_stack([world, np.zeros(len(world))]), other.pose, k)
+        seen[:] = 0
+        n = len(world)
+        rings = [top[:, :2], base[:, :2]] + [
+            np.array([top[i, :2], top[(i + 1) % n, :2], base[(i + 1) % n, :2], base[i, :2]])
+            for i in range(n)
+        ]
+        for ring in rings:  # one by one: where two overlap, one call leaves the overlap empty
+            cv2.fillPoly(seen, [pixels(ring)], 255)
+        if total and cv2.countNonZero(cv2.bitwise_and(seen, want)) >= least * total:
+            return True
+    return False
+
+
 def pixels(polygon_px: Any) -> Any:
     """A ring of float pixels as OpenCV draws it: int32 ``(n, 1, 2)``."""
     return np.round(np.asarray(polygon_px)).astype(np.int32).reshape(-1, 1, 2)
