@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 import trimesh
 
+from tests.world.bodies import body_count
 from uavtool.world import building_footprint, building_mesh, load_scene
 
 
@@ -28,7 +29,7 @@ def test_every_building_is_a_watertight_solid_of_the_right_volume(scene_name: st
 def test_red_target_keeps_both_through_holes() -> None:
     red = load_scene("paper").target_building
     mesh = building_mesh(red)
-    assert len(mesh.split(only_watertight=False)) == 1  # touching blocks are merged
+    assert body_count(mesh) == 1  # touching blocks are merged
     tunnels = [(8.75, -10.0, 1.0), (13.0, -6.25, 1.5)]  # under the wing's and the leg's bridges
     walls = [(6.0, -10.0, 1.0), (8.75, -10.0, 4.0), (13.0, -8.0, 1.5), (13.0, -6.25, 5.0)]
     for point, solid in [(p, False) for p in tunnels] + [(p, True) for p in walls]:
@@ -48,3 +49,10 @@ def building_footprint_area(ring: tuple[tuple[float, float], ...]) -> float:
     from uavtool.world.polygon import signed_area
 
     return signed_area(ring)
+
+
+def test_body_count_tells_apart_boxes_that_do_not_touch() -> None:
+    a, b = trimesh.creation.box(extents=(1, 1, 1)), trimesh.creation.box(extents=(1, 1, 1))
+    b.apply_translation((3.0, 0.0, 0.0))
+    assert body_count(a) == 1
+    assert body_count(trimesh.util.concatenate([a, b])) == 2
