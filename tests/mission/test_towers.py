@@ -46,3 +46,27 @@ def test_a_tower_looked_at_from_the_ceiling_is_measured_by_its_top_photo(tmp_pat
     said = [e for e in _events(record) if "the look and the top photo measure" in e]
     assert len(said) == 1
     assert float(said[0].split("roof ")[1].split(" m")[0]) == pytest.approx(58.8, abs=1.0)
+
+
+def test_a_tower_merged_with_one_of_its_colour_behind_it_is_whole_in_the_side_photo() -> None:
+    """Town scene 3387: the target, a 55.2 m courtyard L, stands in front of a tower of its
+    colour. In the front photo the two merge, and the one behind rises out of the frame.
+    Cut back to the box where the target stands (its height measured), the silhouette kept
+    a tenth more than the box and so reached the frame: taken for a cut top, the camera
+    backed away until the target's own top left the frame, and no model was built."""
+    summary = fly(FlyConfig(scene=str(DATA / "town-3387.yaml"), no_record=True))
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == "b12"
+    assert summary.evaluation.model_iou is not None and summary.evaluation.model_iou > 0.8
+
+
+def test_a_courtyard_tower_is_measured_though_one_photo_sees_no_courtyard_floor() -> None:
+    """Town scene 3519: the target, a 50.2 m courtyard rectangle, looked at from the ceiling
+    shows its courtyard's far walls but no floor; the top photo shows the courtyard as a
+    hole. The walls were taken for a taller part standing on the roof, so the two photos
+    gave no height, and side photos planned for 25 m never held the tower. A wall that
+    falls in a hole of the other photo's outline goes down: the roof is measured."""
+    summary = fly(FlyConfig(scene=str(DATA / "town-3519.yaml"), no_record=True))
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == "b01"
+    assert summary.evaluation.model_iou is not None and summary.evaluation.model_iou > 0.8

@@ -146,18 +146,30 @@ def roof_between(a: Shape, photo_a: Photo, b: Shape, photo_b: Photo) -> float | 
         return None
     # ... and nothing inside the outline may stand higher: tiers of one colour show from
     # above only as walls inside the lowest tier's outline.
-    flat = not (not_flat(a, photo_a, roof, photo_b) or not_flat(b, photo_b, roof, photo_a))
+    flat = not (not_flat(a, photo_a, roof, photo_b, b) or not_flat(b, photo_b, roof, photo_a, a))
     return roof if flat else None
 
 
-def not_flat(shape: Shape, photo: Photo, roof_m: float, other: Photo | None = None) -> bool:
+def not_flat(
+    shape: Shape,
+    photo: Photo,
+    roof_m: float,
+    other: Photo | None = None,
+    other_shape: Shape | None = None,
+) -> bool:
     """Whether the walls seen inside ``shape``'s outline (a nadir ``photo``) show a part of
     the building standing at least ``NOT_FLAT_M`` above the roof the outline is at. A wall
-    whose place on the roof ``other`` (another nadir photo) shows as ground is a courtyard's
-    far wall, going down, not a higher part's."""
+    whose place on the roof ``other`` (another nadir photo) shows as ground, or falls in a
+    hole of the roof's outline there (``other_shape``'s courtyards, which show ground
+    somewhere), is a courtyard's far wall, going down, not a higher part's: a higher part
+    shows from above as its walls on one side and its roof, never as a hole."""
     walls = inner_walls(photo.image_rgb, shape)
     if other is not None and walls:
         ground = ground_mask(other.image_rgb)
+        if other_shape is not None and other_shape.holes_px:
+            ground = ground.copy()
+            for hole in other_shape.holes_px:
+                cv2.fillPoly(ground, [np.round(hole).astype(np.int32).reshape(-1, 1, 2)], 255)
         walls = [w for w in walls if not _shows_ground(w, photo, other, roof_m, ground)]
     top = higher_part_m(walls, photo.pose, photo.intrinsics, roof_m=roof_m)
     return top is not None and top > roof_m + NOT_FLAT_M

@@ -216,13 +216,22 @@ def _in_line(
     uvz = project(corners, photo.pose, photo.intrinsics)
     if np.any(uvz[:, 2] <= 0.0):
         return shapes
-    box = shapely.MultiPoint([(float(u), float(v)) for u, v, _ in uvz]).convex_hull
-    lo_u, lo_v, hi_u, hi_v = box.bounds
-    box = box.buffer(0.1 * max(hi_u - lo_u, hi_v - lo_v))
+    raw = shapely.MultiPoint([(float(u), float(v)) for u, v, _ in uvz]).convex_hull
+    lo_u, lo_v, hi_u, hi_v = raw.bounds
+    size = max(hi_u - lo_u, hi_v - lo_v)
+    box = raw.buffer(0.1 * size)
     kept = tuple(s for s in shapes if _share_inside(s, box) >= _IN_VIEW) or shapes
     if not clip:
         return kept
-    return tuple(part for s in kept for part in _clipped(s, box, photo.intrinsics))
+    # Cut back nearer the box than the tenth that tells which shapes are the building's:
+    # where the box lies inside the frame and a shape reaches the frame's edge beyond it,
+    # a building of its colour merged with it there (a tower behind it rising out of the
+    # frame), and the building itself is whole.
+    grow = _CLIP_GROWTH * size
+    near = shapely.box(lo_u - grow, lo_v - grow, hi_u + grow, hi_v + grow)
+    return tuple(
+        part for s in kept for part in _clipped(s, box.intersection(near), photo.intrinsics)
+    )
 
 
 def _clipped(shape: Shape, box: shapely.Polygon, k: Intrinsics) -> tuple[Shape, ...]:
@@ -256,6 +265,11 @@ def _clipped(shape: Shape, box: shapely.Polygon, k: Intrinsics) -> tuple[Shape, 
         )
     return tuple(out) or (shape,)
 
+
+_CLIP_GROWTH = 0.03
+"""How far past the building's box in the photo (its height measured), as a share of the
+box's size, a shape cut by the frame is kept: the box's error (the footprint and height
+measured, ~1 m, a few pixels) and no more."""
 
 _IN_VIEW = 0.5
 """The least share of a shape's outline's area inside where the building stands in the
