@@ -126,17 +126,11 @@ def search(
                 closer = _closer_look(m, looks[-1], before, poi.shape_index)
             if closer is not None:
                 pos, roof_m = closer
-                j = looks[-1].judgement
                 m.event(
                     Level.INFO,
-                    f"point of interest {k}: "
-                    + (
-                        f"a match (score {j.score:.3f}) from over the highest its roof may be"
-                        if j.matched
-                        else f"score {j.score:.3f} just below the threshold"
-                    )
-                    + f"; its roof measured {roof_m:.1f} m above home: looking again from "
-                    f"closer, at {pos[2]:.1f} m",
+                    f"point of interest {k}: score {looks[-1].judgement.score:.3f} just below "
+                    f"the threshold; its roof measured {roof_m:.1f} m above home: looking "
+                    f"again from closer, at {pos[2]:.1f} m",
                 )
                 yield from m.travel(pos, None, transit_m, f"point of interest {k}, look {n}")
                 looks.append((yield from _look(m, k, n, pos[2], poi.colour_rgb)))
@@ -155,7 +149,7 @@ def search(
         top = max(look.judgement.score for look in looks)
         if top > best_score:
             best_score, best_poi = top, k
-        look = looks[-1]  # the last look, the closest or clearest, is the match if any
+        look = looks[-1]  # a match ends the looking: the last look is the match if any
         j = look.judgement
         if j.matched and poi.shape_index in roofless:
             upper = (
@@ -314,9 +308,7 @@ def _closer_look(
 ) -> tuple[Vec3, float] | None:
     """Where to look again from, lower, and the roof height measured, when the look was
     taken high over a roof of unknown height (assumed the tallest expected) and its
-    candidate has the target's hue and matches or scores just below the threshold (from
-    that high a small building's outline has few pixels: a match there and a rival's from a
-    proper look are not alike evidence, and the closer look decides): the candidate,
+    candidate has the target's hue and scores just below the threshold: the candidate,
     whole in the look and in an earlier photo of it (``before``: the overview's shape, the
     earlier looks' candidates; the one furthest in altitude that tells), gives its roof's
     height, and from it the altitude at which it fills the photo as a look should. None
@@ -324,7 +316,7 @@ def _closer_look(
     told."""
     p = m.params.mission
     j, photo = look.judgement, look.photo
-    if j.candidate < 0 or not (j.same_hue and j.judgeable):
+    if j.matched or j.candidate < 0 or not (j.same_hue and j.judgeable):
         return None
     if j.score < p.recheck_min_score:
         return None
