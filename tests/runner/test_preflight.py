@@ -15,12 +15,19 @@ from uavtool.cli import cli
 from uavtool.geo import geo_from_enu
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mission import Params, SearchMission, Status
+from uavtool.mission.base import Envelope
 from uavtool.mission.params import with_overrides
 from uavtool.mission.scenario import NO_GIMBAL_REASON
 from uavtool.plugins import ref_of
 from uavtool.runner.fly import FlyConfig, describe, fly
 from uavtool.runner.placement import place_scene
-from uavtool.runner.preflight import ANSWER_S, UNHEARD_S, PreflightError, check_gimbal
+from uavtool.runner.preflight import (
+    ANSWER_S,
+    UNHEARD_S,
+    PreflightError,
+    check_fence,
+    check_gimbal,
+)
 from uavtool.runner.summary import format_summary
 from uavtool.world import load_scene
 
@@ -152,9 +159,12 @@ class _SilentForAWhile:
     target_system = 1
     target_component = 1
 
-    def __init__(self, heard_from_s: float, answer: object | None) -> None:
+    def __init__(
+        self, heard_from_s: float, answer: object | None, params: dict[str, float] | None = None
+    ) -> None:
         self.heard_from_s = heard_from_s
         self.answer = answer
+        self.params = params or {}
         self.now = 0.0
         self.asked: list[float] = []
         self._out: list[object] = []
@@ -169,8 +179,14 @@ class _SilentForAWhile:
             if self.answer is not None:
                 self._out.append(self.answer)
 
-    def send(self, _msg: object) -> None:  # parameter reads: never answered here
-        pass
+    def send(self, msg: object) -> None:  # parameter reads: answered from ``params``
+        raw = getattr(msg, "param_id", "")
+        name = (raw.decode() if isinstance(raw, bytes) else raw).rstrip("\0")
+        if self.now >= self.heard_from_s and name in self.params:
+            value = M.MAVLink_param_value_message(
+                name.encode(), self.params[name], M.MAV_PARAM_TYPE_REAL32, len(self.params), 0
+            )
+            self._out.append(value)
 
     def poll(self, timeout_s: float) -> list[object]:
         self.now += timeout_s
@@ -205,3 +221,19 @@ def test_a_vehicle_that_acknowledges_no_request_is_asked_for_longer_then_has_no_
     with pytest.raises(PreflightError, match="no gimbal"):
         check_gimbal(link, ArduPilot())  # type: ignore[arg-type]
     assert link.now == pytest.approx(UNHEARD_S + ANSWER_S, abs=0.2)
+
+
+def test_a_fence_whose_parameters_are_lost_for_a_while_still_stops_on_the_ground() -> None:
+    """A lossy link that loses every parameter read for 5 s (longer than ANSWER_S): the
+    fence check took the silence for a vehicle without those parameters and passed a fence
+    at 100 m under a mission that climbs to 117.4 m."""
+    fence = {"FENCE_ENABLE": 1.0, "FENCE_TYPE": 7.0, "FENCE_ALT_MAX": 100.0, "FENCE_RADIUS": 300.0}
+    link = _SilentForAWhile(heard_from_s=5.0, answer=None, params=fence)
+    with pytest.raises(PreflightError, match="FENCE_ALT_MAX=100 m"):
+        check_fence(link, ArduPilot(), Envelope(altitude_m=117.4))  # type: ignore[arg-type]
+
+
+def test_a_vehicle_without_fence_parameters_passes_after_asking_long_enough() -> None:
+    link = _SilentForAWhile(heard_from_s=0.0, answer=None)
+    check_fence(link, ArduPilot(), Envelope(altitude_m=117.4))  # type: ignore[arg-type]
+    assert link.now == pytest.approx(UNHEARD_S, abs=0.2)  # FENCE_ENABLE unanswered: no fence

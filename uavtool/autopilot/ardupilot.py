@@ -74,12 +74,13 @@ class ArduPilot(Autopilot):
         return "set MNT1_PITCH_MIN=-90 and MNT1_PITCH_MAX=0"
 
     def fence(self, read: ParamReader) -> Fence | None:
-        values = [read(n) for n in ("FENCE_ENABLE", "FENCE_TYPE", "FENCE_ALT_MAX", "FENCE_RADIUS")]
-        if None in values:
+        enabled = read("FENCE_ENABLE")
+        if enabled is None:  # no fence parameters: one unanswered question, not four
             return None
-        enabled, types, alt_max, radius = (float(v) for v in values if v is not None)
-        if not enabled:
+        values = [read(n) for n in ("FENCE_TYPE", "FENCE_ALT_MAX", "FENCE_RADIUS")]
+        if None in values or not enabled:
             return None
+        types, alt_max, radius = (float(v) for v in values if v is not None)
         return Fence(
             alt_max_m=alt_max if int(types) & _FENCE_ALT_MAX else None,
             alt_param="FENCE_ALT_MAX",

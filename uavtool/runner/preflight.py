@@ -95,10 +95,12 @@ def check_fence(
     must fly (``envelope``): an altitude limit below the highest it climbs, or a horizontal
     one closer than the farthest it goes. The vehicle would refuse the move or breach the
     fence and return home mid-mission. A vehicle whose parameters do not answer, or a mission
-    that does not say where it flies, passes."""
+    that does not say where it flies, passes. Each fence parameter is asked for
+    :data:`UNHEARD_S`: on a lossy link a few lost answers in a row would otherwise pass a
+    fence that stops the mission mid-flight."""
     if envelope.altitude_m is None and envelope.distance_m is None:
         return
-    fence = autopilot.fence(param_reader(link, autopilot, on_wait))
+    fence = autopilot.fence(param_reader(link, autopilot, on_wait, within_s=UNHEARD_S))
     if fence is None:
         return
     up, out = envelope.altitude_m, envelope.distance_m
@@ -121,17 +123,29 @@ def check_fence(
 
 
 def param_reader(
-    link: VehicleLink, autopilot: Autopilot, on_wait: Callable[[], None] | None
+    link: VehicleLink,
+    autopilot: Autopilot,
+    on_wait: Callable[[], None] | None,
+    *,
+    within_s: float = ANSWER_S,
 ) -> ParamReader:
     def read(name: str) -> float | None:
-        msg = read_param(link, name, on_wait)
+        msg = read_param(link, name, on_wait, within_s=within_s)
         return None if msg is None else autopilot.param_value(msg)
 
     return read
 
 
-def read_param(link: VehicleLink, name: str, on_wait: Callable[[], None] | None) -> Any:
-    """The vehicle's PARAM_VALUE for ``name``, or None if it does not answer."""
+def read_param(
+    link: VehicleLink,
+    name: str,
+    on_wait: Callable[[], None] | None,
+    *,
+    within_s: float = ANSWER_S,
+) -> Any:
+    """The vehicle's PARAM_VALUE for ``name``, or None if it does not answer ``within_s``
+    (PARAM_REQUEST_READ has no acknowledgement: a vehicle without the parameter and a link
+    that lost every question look alike)."""
     return _ask(
         link,
         lambda: link.send(
@@ -142,6 +156,7 @@ def read_param(link: VehicleLink, name: str, on_wait: Callable[[], None] | None)
         "PARAM_VALUE",
         on_wait,
         lambda msg: _param_name(msg) == name,
+        within_s=within_s,
     )
 
 
@@ -158,16 +173,17 @@ def _ask(
     wanted: Callable[[Any], bool] = lambda _msg: True,
     *,
     acked_by: int | None = None,
+    within_s: float = ANSWER_S,
 ) -> Any:
     """The first ``kind`` message after ``request`` that is ``wanted`` (a parameter's value,
     not another one's), asked again every :data:`RETRY_S` (a lossy link may drop the
-    question or the answer); None after :data:`ANSWER_S`.
+    question or the answer); None after ``within_s`` (:data:`ANSWER_S`).
 
     A request that is a command (``acked_by``, its id) waits :data:`ANSWER_S` from the first
     COMMAND_ACK for it: a vehicle that has heard the question and sends nothing has nothing
     to send. One that acknowledges none is asked for :data:`UNHEARD_S` (dozens of questions,
     more than a lossy link loses in a row) and is then taken not to know the command."""
-    deadline = link.clock() + (ANSWER_S if acked_by is None else UNHEARD_S)
+    deadline = link.clock() + (within_s if acked_by is None else UNHEARD_S)
     asked = -math.inf
     while link.clock() < deadline:
         if link.clock() - asked >= RETRY_S:
