@@ -146,17 +146,19 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     # (walls whose roof lies beyond the frame, a darker shade), may be the target: it is a
     # point of interest, looked at before any match is final, and an obstacle as every
     # building is.
-    rivals = [may_be_target(m, o) for o in others]
-    shapes = seen.shapes + tuple(o for o, r in zip(others, rivals, strict=True) if r)
-    roofs += [assumed_m if h is None else h for h, r in zip(others_m, rivals, strict=True) if r]
-    measured += [h is not None for h, r in zip(others_m, rivals, strict=True) if r]
-    at_first = seen.measured + (False,) * (len(shapes) - len(seen.shapes))
-    others_m = [h for h, r in zip(others_m, rivals, strict=True) if not r]
-    others = [o for o, r in zip(others, rivals, strict=True) if not r]
-    if any(rivals):
+    rivals: list[tuple[Shape, float | None]] = []
+    rest: list[tuple[Shape, float | None]] = []
+    for o, h in zip(others, others_m, strict=True):
+        (rivals if may_be_target(m, o) else rest).append((o, h))
+    shapes = seen.shapes + tuple(o for o, _ in rivals)
+    roofs += [assumed_m if h is None else h for _, h in rivals]
+    measured += [h is not None for _, h in rivals]
+    at_first = seen.measured + (False,) * len(rivals)
+    others, others_m = [o for o, _ in rest], [h for _, h in rest]
+    if rivals:
         m.event(
             Level.INFO,
-            f"{sum(rivals)} regions of the target's hue show no roof (walls, a darker shade): "
+            f"{len(rivals)} regions of the target's hue show no roof (walls, a darker shade): "
             "points of interest too",
         )
     obstacles = tuple(

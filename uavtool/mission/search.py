@@ -151,25 +151,23 @@ def search(
             best_score, best_poi = top, k
         look = looks[-1]  # a match ends the looking: the last look is the match if any
         j = look.judgement
-        if j.matched and poi.shape_index in roofless:
-            upper = (
-                poi.roof_m
-                if poi.roof_measured
-                else m.unknown.get(poi.shape_index, (None, ceiling_m))[1]
-            )
-            if not shows_as(
+        if (
+            j.matched
+            and poi.shape_index in roofless
+            and not shows_as(
                 look.shapes[j.candidate],
                 look.photo,
                 overview_shapes[poi.shape_index],
                 overview,
-                upper,
-            ):
-                m.event(
-                    Level.INFO,
-                    f"point of interest {k}: the match is another building than the one seen there "
-                    "(walls or a darker shade of the target's hue): not its match",
-                )
-                continue
+                poi.roof_m if upper is None else upper,
+            )
+        ):
+            m.event(
+                Level.INFO,
+                f"point of interest {k}: the match is another building than the one seen there "
+                "(walls or a darker shade of the target's hue): not its match",
+            )
+            continue
         if j.matched and best is not None and _shows_again(best, look):
             m.event(
                 Level.INFO,

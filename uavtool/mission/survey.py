@@ -50,12 +50,12 @@ class Survey:
     lower: Photo | None = None
     """The lower overview photo."""
     obstacles: tuple[Obstacle, ...] = ()
+    """What else is not ground in the higher photo: buildings of no colour the vectorizer
+    keeps (grey, white, black, a darker shade of another's colour)."""
     roofless: frozenset[int] = frozenset()
     """The shapes that are regions of the target's hue showing no roof (walls whose roof
     lay beyond the frame, a darker shade): points of interest whose look must show a
     building that explains them (:func:`~uavtool.mission.unknown.shows_as`)."""
-    """What else is not ground in the higher photo: buildings of no colour the vectorizer
-    keeps (grey, white, black, a darker shade of another's colour)."""
 
     @property
     def highest_roof_m(self) -> float:

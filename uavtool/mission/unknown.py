@@ -326,7 +326,12 @@ def _prism_px(shape: Shape, photo: Photo, roof_m: float) -> list[Any]:
     ``roof_m``), its base on the ground, and each wall between."""
     world = footprint_at(shape, photo, roof_m)
     base = project(np.array([(x, y, 0.0) for x, y in world]), photo.pose, photo.intrinsics)
-    top, bottom = np.asarray(shape.polygon_px, np.float64), base[:, :2]
+    return _prism_rings(np.asarray(shape.polygon_px, np.float64), base[:, :2])
+
+
+def _prism_rings(top: Any, bottom: Any) -> list[Any]:
+    """A flat-roofed building's roof ``top`` and base ``bottom`` (pixel rings, vertex for
+    vertex) and each wall between, as OpenCV draws them."""
     n = len(top)
     walls = [np.array([top[i], top[(i + 1) % n], bottom[(i + 1) % n], bottom[i]]) for i in range(n)]
     return [pixels(ring) for ring in (top, bottom, *walls)]
@@ -353,13 +358,8 @@ def shows_as(
         top = project(np.column_stack([world, np.full(len(world), roof_m)]), other.pose, k)
         base = project(np.column_stack([world, np.zeros(len(world))]), other.pose, k)
         seen[:] = 0
-        n = len(world)
-        rings = [top[:, :2], base[:, :2]] + [
-            np.array([top[i, :2], top[(i + 1) % n, :2], base[(i + 1) % n, :2], base[i, :2]])
-            for i in range(n)
-        ]
-        for ring in rings:  # one by one: where two overlap, one call leaves the overlap empty
-            cv2.fillPoly(seen, [pixels(ring)], 255)
+        for ring in _prism_rings(top[:, :2], base[:, :2]):  # one by one: overlaps stay filled
+            cv2.fillPoly(seen, [ring], 255)
         if total and cv2.countNonZero(cv2.bitwise_and(seen, want)) >= least * total:
             return True
     return False
