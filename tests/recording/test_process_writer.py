@@ -15,12 +15,15 @@ import pytest
 
 from tests.recording.sample import OBS_SCHEMA, T0_NS, mavlink_frames, other_values
 from uavtool.geo import GeoPoint
+from uavtool.glb import mesh_glb
 from uavtool.recording import (
     Direction,
+    Model3D,
     ProcessWriter,
     RecordingError,
     RecordingReader,
     RecordingWriter,
+    TriangleMesh,
     summarize,
 )
 from uavtool.recording.process import BATCH_NS
@@ -179,3 +182,29 @@ def _alive(pid: int) -> bool:
     # a zombie (its parent, the killed flight, is gone: init reaps it) counts as ended
     state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
     return state != "Z"
+
+
+_CUBE = TriangleMesh(
+    tuple((float(x), float(y), float(z)) for x in (0, 1) for y in (0, 1) for z in (0, 1)),
+    (
+        (0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1),
+        (2, 3, 7), (2, 7, 6), (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3),
+    ),
+)  # fmt: skip
+
+
+@pytest.mark.parametrize("kind", [RecordingWriter, ProcessWriter])
+def test_a_model_given_as_a_mesh_is_written_as_its_glb(tmp_path: Path, kind: Any) -> None:
+    """A writer process makes the GLB of a model given as a mesh (the flight's process never
+    imports trimesh): the file holds what the model's GLB bytes would have written."""
+    as_mesh, as_glb = tmp_path / "mesh.mcap", tmp_path / "glb.mcap"
+    with kind(as_mesh, fsync=False) as writer:
+        writer.write("/mission/model", Model3D(_CUBE), log_time_ns=T0_NS)
+    glb = mesh_glb(_CUBE.vertices_m, _CUBE.faces)
+    with RecordingWriter(as_glb, fsync=False) as writer:
+        writer.write("/mission/model", Model3D(glb), log_time_ns=T0_NS)
+    assert as_mesh.read_bytes() == as_glb.read_bytes()
+    with RecordingReader(as_mesh) as reader:
+        (entry,) = reader.entries(["/mission/model"])
+    assert entry.value == Model3D(glb)
+    assert glb[:4] == b"glTF" and len(glb) > 12 * 3 * 24  # 36 vertices, each with a normal

@@ -156,7 +156,6 @@ def replay(
     from uavtool.recording.files import refuse_same_file
     from uavtool.replay import load_flight, reanalyse_frames
     from uavtool.replay import replay as run_replay
-    from uavtool.replay.write import write_replay
 
     if vision_only and not refly and not update_golden:
         from uavtool.replay.photos import is_recorded_flight
@@ -241,6 +240,8 @@ def replay(
             else:
                 click.echo("mission stopped there")
         if out is not None:
+            from uavtool.replay.write import write_replay  # mcap's writer: ~30 ms
+
             write_replay(
                 recording, out, result.outputs, result.blobs, params, outcome=result.outcome
             )

@@ -25,7 +25,7 @@ from uavtool.mission.observations import (
     Telemetry,
     U8Array,
 )
-from uavtool.mission.outputs import Output
+from uavtool.mission.outputs import Output, Picture
 
 _PLAIN = frozenset({int, float, str, bool, type(None)})
 _FIELDS: dict[type, tuple[str, ...]] = {}
@@ -154,3 +154,9 @@ def decode_camera(data: dict[str, Any]) -> tuple[CameraPose, Intrinsics]:
 def _vec3(value: Any) -> tuple[float, float, float]:
     x, y, z = value
     return (float(x), float(y), float(z))
+
+
+def output_bytes(out: Output) -> bytes | None:
+    """The bytes an output carries beside its JSON form (which holds only their digest): a
+    picture's PNG."""
+    return out.png if isinstance(out, Picture) else None

@@ -39,7 +39,6 @@ from uavtool.vision.model3d import (
     View,
     build_model,
     central_shape,
-    model_glb,
     open_beneath,
 )
 
@@ -190,13 +189,11 @@ def photograph_and_model(
         m.no_model = "the side photos never saw the building's foot: the model stands on nothing"
         m.event(Level.WARNING, f"model not built: {m.no_model}")
         return
-    mesh = model.mesh
     m.model = ModelBuilt(
-        tuple(tuple(v) for v in mesh.vertices.tolist()),
-        tuple(tuple(f) for f in mesh.faces.tolist()),
-        model_glb(model),
+        tuple(tuple(v) for v in model.vertices_m.tolist()),
+        tuple(tuple(f) for f in model.faces.tolist()),
         model.height_m,
-        float(mesh.volume),
+        model.volume_m3,
     )
     m.emit(m.model)
     m.model_built = True
@@ -206,7 +203,7 @@ def photograph_and_model(
     m.roofs = (*m.roofs, (tuple(footprint), model.height_m))
     m.event(
         Level.INFO,
-        f"model built: height {model.height_m:.2f} m, volume {float(mesh.volume):.1f} m³",
+        f"model built: height {model.height_m:.2f} m, volume {model.volume_m3:.1f} m³",
     )
 
 

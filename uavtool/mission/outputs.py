@@ -160,11 +160,12 @@ class DiagonalView:
 
 @dataclass(frozen=True, slots=True)
 class ModelBuilt:
-    """The 3D model (world ENU metres): mesh arrays as nested tuples, and GLB bytes."""
+    """The 3D model (world ENU metres): a watertight triangle mesh as nested tuples (faces
+    counter-clockwise seen from outside). A recording holds it as GLB too (``/mission/model``,
+    :func:`uavtool.glb.mesh_glb`)."""
 
     vertices_m: tuple[tuple[float, float, float], ...]
     faces: tuple[tuple[int, int, int], ...]
-    glb: bytes
     height_m: float
     volume_m3: float
 

@@ -40,12 +40,13 @@ if TYPE_CHECKING:
         PosesInFrame,
         SceneEntity,
         SceneMarkers,
+        TriangleMesh,
     )
     from uavtool.recording.writer import RecordingWriter
 
 _VALUES = (
     "CameraCalibration CompressedImage Direction Entry FrameTransform JsonDocument LocationFix "
-    "LogEntry LogLevel MavlinkFrame Model3D Pose PosesInFrame SceneEntity SceneMarkers"
+    "LogEntry LogLevel MavlinkFrame Model3D Pose PosesInFrame SceneEntity SceneMarkers TriangleMesh"
 )
 _MODULE_OF = {
     **dict.fromkeys(_VALUES.split(), "values"),
@@ -96,6 +97,7 @@ __all__ = [
     "SceneMarkers",
     "TlogError",
     "TopicNotFoundError",
+    "TriangleMesh",
     "UnknownSchemaError",
     "export_tlog",
     "import_tlog",

@@ -19,8 +19,8 @@ from foxglove_schemas_protobuf.LocationFix_pb2 import LocationFix as PbLocationF
 from foxglove_schemas_protobuf.Log_pb2 import Log as PbLog
 from foxglove_schemas_protobuf.PosesInFrame_pb2 import PosesInFrame as PbPosesInFrame
 from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate as PbSceneUpdate
-from mcap_protobuf.schema import build_file_descriptor_set
 
+from uavtool.glb import mesh_glb
 from uavtool.recording.scene import decode_markers, encode_markers
 from uavtool.recording.values import (
     CameraCalibration,
@@ -33,6 +33,7 @@ from uavtool.recording.values import (
     Pose,
     PosesInFrame,
     SceneMarkers,
+    TriangleMesh,
 )
 
 FoxgloveValue = (
@@ -72,6 +73,9 @@ def schema_data(value_type: type) -> bytes:
     """The serialized FileDescriptorSet MCAP stores as the channel's schema."""
     data = _SCHEMA_DATA.get(value_type)
     if data is None:
+        # mcap_protobuf imports mcap's writer and importlib.metadata (~30 ms): reading needs none
+        from mcap_protobuf.schema import build_file_descriptor_set  # noqa: PLC0415
+
         fds = build_file_descriptor_set(_PB_CLASS[value_type])
         data = _SCHEMA_DATA[value_type] = bytes(fds.SerializeToString(deterministic=True))
     return data
@@ -140,7 +144,10 @@ def encode(value: FoxgloveValue, t_ns: int) -> bytes:
         model = entity.models.add()
         _pose_pb(value.pose, model.pose)
         model.scale.x = model.scale.y = model.scale.z = 1.0
-        model.media_type, model.data = _GLB_MEDIA_TYPE, value.glb
+        glb = value.glb
+        if isinstance(glb, TriangleMesh):
+            glb = mesh_glb(glb.vertices_m, glb.faces)
+        model.media_type, model.data = _GLB_MEDIA_TYPE, glb
     return bytes(pb.SerializeToString(deterministic=True))
 
 

@@ -45,7 +45,7 @@ from typing import TYPE_CHECKING, Any, BinaryIO, NoReturn
 from uavtool.recording.errors import RecordingError, create_file
 from uavtool.recording.schemas import DEFAULT_DIALECT, dialect_module, dumps
 from uavtool.recording.topics import FIX, POSE
-from uavtool.recording.values import Direction, LocationFix, PosesInFrame
+from uavtool.recording.values import Direction, LocationFix, Model3D, PosesInFrame, TriangleMesh
 from uavtool.recording.writer import (
     RecordingWriter,
     check_metadata,
@@ -66,9 +66,19 @@ BATCH_CALLS = 2048
 PIPE_BYTES = 1 << 20
 
 # the calls, as the first item of each tuple in a batch (most frequent first)
-_MAV_IN, _MAV_OUT, _VEHICLE, _PROTO, _JSON, _PROTO_TOPIC, _JSON_TOPIC, _METADATA, _FLUSH, _CLOSE = (
-    range(10)
-)
+(
+    _MAV_IN,
+    _MAV_OUT,
+    _VEHICLE,
+    _PROTO,
+    _JSON,
+    _PROTO_TOPIC,
+    _JSON_TOPIC,
+    _METADATA,
+    _FLUSH,
+    _CLOSE,
+    _ENCODE,
+) = range(11)
 _END_NS = 1 << 64
 _CHILD = (
     "import sys, json; sys.path[:] = json.loads(sys.argv[1]); "
@@ -268,7 +278,9 @@ class ProcessWriter:
         _check_times(log_time_ns, publish_time_ns)
         kind = type(value)
         foxglove = foxglove_module()
-        data = foxglove.encode(value, log_time_ns)
+        # a model given as a mesh is encoded (its GLB made) by the child, off the flight's path
+        deferred = isinstance(value, Model3D) and isinstance(value.glb, TriangleMesh)
+        data = None if deferred else foxglove.encode(value, log_time_ns)
         with self._lock:
             self._check_open()
             if topic not in self._protobuf_topics:
@@ -278,7 +290,8 @@ class ProcessWriter:
                 self._batch.append((_PROTO_TOPIC, topic, *schema))
             elif self._topic_kind[topic] is not kind:
                 raise ValueError(f"topic {topic!r} carries {self._topic_kind[topic]!r}, not {kind}")
-            self._queue((_PROTO, topic, data, log_time_ns, publish_time_ns), log_time_ns)
+            op, payload = (_ENCODE, value) if deferred else (_PROTO, data)
+            self._queue((op, topic, payload, log_time_ns, publish_time_ns), log_time_ns)
 
     def write_mavlink(
         self,
@@ -477,11 +490,11 @@ def _serve(writer: Any, source: Any, reply: Any) -> None:
                 )
             elif op == _VEHICLE:
                 writer.write_vehicle(call[1], call[2], call[3], log_time_ns=call[4])
-            elif op == _PROTO:
+            elif op in (_PROTO, _ENCODE):
                 name, schema = protobuf[call[1]]
                 write_protobuf(
                     call[1],
-                    call[2],
+                    call[2] if op == _PROTO else foxglove_module().encode(call[2], call[3]),
                     schema_name=name,
                     schema=schema,
                     log_time_ns=call[3],

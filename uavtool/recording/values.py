@@ -182,10 +182,23 @@ class LogEntry:
 
 
 @dataclass(frozen=True, slots=True)
-class Model3D:
-    """A 3D model as GLB bytes, placed at ``pose`` in ``frame_id``."""
+class TriangleMesh:
+    """Triangles in metres: ``vertices_m`` ``(n, 3)`` and ``faces`` ``(m, 3)``, indices into
+    them, counter-clockwise seen from outside."""
 
-    glb: bytes
+    vertices_m: tuple[Vec3, ...]
+    faces: tuple[tuple[int, int, int], ...]
+
+
+@dataclass(frozen=True, slots=True)
+class Model3D:
+    """A 3D model as GLB bytes, placed at ``pose`` in ``frame_id``.
+
+    ``glb`` may be a :class:`TriangleMesh` instead: the writer encodes it as GLB
+    (:func:`uavtool.glb.mesh_glb`, flat light-grey faces) where it encodes the message — in a
+    writer process, off the flight's path — and it reads back as those bytes."""
+
+    glb: bytes | TriangleMesh
     entity_id: str = "model"
     frame_id: str = "world"
     pose: Pose = Pose((0.0, 0.0, 0.0))

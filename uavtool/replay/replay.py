@@ -18,10 +18,9 @@ from typing import Any
 
 from uavtool.geo import wrap_180
 from uavtool.mission import FlightParams, MissionInputs, Output
-from uavtool.mission.codec import encode_output
+from uavtool.mission.codec import encode_output, output_bytes
 from uavtool.plugins import create_mission, flight_params, guarded
 from uavtool.replay.load import RecordedFlight, RecordedOutput
-from uavtool.runner.record import output_bytes
 
 Progress = Callable[[int, int], None]
 """Called with (observations done, total)."""

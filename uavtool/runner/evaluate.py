@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from uavtool.mission import SearchMission
-from uavtool.world import Scene, building_footprint, building_mesh
+from uavtool.world import Scene, building_footprint, building_solid
 
 if TYPE_CHECKING:
     from uavtool.runner.runner import Runner
@@ -152,16 +152,9 @@ def model_iou(
     vertices_m: Any, faces: Any, scene: Scene, offset_en: tuple[float, float] = (0.0, 0.0)
 ) -> float:
     """Volumetric IoU of a mesh (vehicle-home ENU) with the scene's target building."""
-    import manifold3d  # noqa: PLC0415
 
     model = _manifold(vertices_m, faces, offset_en)
-    truth_mesh = building_mesh(scene.target_building)
-    truth = manifold3d.Manifold(
-        manifold3d.Mesh(
-            np.asarray(truth_mesh.vertices, dtype=np.float32),
-            np.asarray(truth_mesh.faces, dtype=np.uint32),
-        )
-    )
+    truth = building_solid(scene.target_building)
     inter = (model ^ truth).volume()
     union = model.volume() + truth.volume() - inter
     return inter / union if union > 0 and math.isfinite(union) else 0.0

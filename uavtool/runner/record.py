@@ -26,9 +26,8 @@ from typing import Any
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.geo import GeoPoint
 from uavtool.images import png_encode
-from uavtool.mission import Level, ModelBuilt, Observation, Output, Photo, Telemetry
-from uavtool.mission.codec import encode_observation, encode_output
-from uavtool.mission.outputs import Picture
+from uavtool.mission import Level, Observation, Output, Photo, Telemetry
+from uavtool.mission.codec import encode_observation, encode_output, output_bytes
 from uavtool.mission.schema import observation_schema, output_schema
 from uavtool.recording import (
     CameraCalibration,
@@ -39,6 +38,7 @@ from uavtool.recording import (
     LogLevel,
     Model3D,
     SceneMarkers,
+    TriangleMesh,
 )
 from uavtool.recording.topics import (
     CALIBRATION,
@@ -140,8 +140,8 @@ class MissionRecorder:
         log_time_ns: int,
     ) -> None:
         """One output in its JSON form (``n``, ``step``, ``encode_output``), plus its Foxglove
-        view: an event as a log line, a model's GLB (``blob``) as a 3D model, a picture's PNG
-        as an image."""
+        view: an event as a log line, a model's mesh as a 3D model (its GLB made by the
+        writer), a picture's PNG (``blob``) as an image."""
         self.writer.write_json(
             OUTPUTS,
             {"n": n, "step": step, **data},
@@ -150,8 +150,11 @@ class MissionRecorder:
         if data.get("type") == "Event":
             entry = LogEntry(_LEVELS[Level(data["level"])], str(data["text"]))
             self.writer.write(EVENTS, entry, log_time_ns=log_time_ns)
-        elif blob is not None and data.get("type") == "ModelBuilt":
-            self.writer.write(MODEL, Model3D(blob), log_time_ns=log_time_ns)
+        elif data.get("type") == "ModelBuilt":
+            mesh = TriangleMesh(
+                tuple(tuple(v) for v in data["vertices_m"]), tuple(tuple(f) for f in data["faces"])
+            )
+            self.writer.write(MODEL, Model3D(mesh), log_time_ns=log_time_ns)
         elif blob is not None and data.get("type") == "Picture":
             picture = CompressedImage(blob, frame_id=str(data.get("tag", "")))
             self.writer.write(PICTURES, picture, log_time_ns=log_time_ns)
@@ -229,15 +232,6 @@ def telemetry_json(step: int, t: Telemetry) -> bytes | None:
 
 
 _FIELDS_NOW = tuple(f.name for f in dataclasses.fields(Telemetry))
-
-
-def output_bytes(out: Output) -> bytes | None:
-    """The bytes an output carries beside its JSON form (which holds only their digest)."""
-    if isinstance(out, ModelBuilt):
-        return out.glb
-    if isinstance(out, Picture):
-        return out.png
-    return None
 
 
 def _text(value: Any) -> str:

@@ -26,10 +26,11 @@ from typing import Any
 
 import cv2
 import numpy as np
-import trimesh
+import numpy.typing as npt
 
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.geo import wrap_180
+from uavtool.glb import mesh_glb
 from uavtool.vision.colour import hue_distance_deg
 from uavtool.vision.errors import ModelInputError
 from uavtool.vision.params import ModelParams
@@ -66,15 +67,26 @@ class View:
 
 @dataclass(frozen=True, slots=True)
 class Model:
-    """The built model: a watertight mesh in world ENU metres, and what was measured.
+    """The built model: a watertight triangle mesh in world ENU metres, and what was measured.
 
+    ``vertices_m`` ``(n, 3)`` and ``faces`` ``(m, 3)``: the mesh as manifold3d made it (each
+    edge shared by exactly two faces, faces counter-clockwise seen from outside);
     ``footprint_enu_m`` : the outer footprint ring ``(n, 2)``; ``height_m`` : the highest
-    roof above the ground.
+    roof above the ground; ``volume_m3`` : the mesh's volume.
     """
 
-    mesh: trimesh.Trimesh
+    vertices_m: FloatArray
+    faces: npt.NDArray[np.int64]
     height_m: float
     footprint_enu_m: FloatArray
+    volume_m3: float
+
+    @property
+    def mesh(self) -> Any:
+        """The mesh as a ``trimesh.Trimesh`` (imports trimesh, ~0.1 s the first time)."""
+        import trimesh  # noqa: PLC0415 — heavy; the mission needs none of it
+
+        return trimesh.Trimesh(vertices=self.vertices_m, faces=self.faces, process=True)
 
 
 def build_model(
@@ -132,8 +144,18 @@ def build_model(
             f"the side photos leave out {1.0 - covered:.0%} of what the top photo shows of the "
             "building: they saw only part of it (hidden behind its neighbours, or only its top)"
         )
-    mesh = _to_trimesh(solid)
-    return Model(mesh, float(mesh.bounds[1][2]) - p.ground_z_m, rings[0])
+    mesh = solid.to_mesh()
+    vertices = np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3]
+    faces = np.asarray(mesh.tri_verts, dtype=np.int64)
+    height_m = float(vertices[:, 2].max()) - p.ground_z_m
+    return Model(vertices, faces, height_m, rings[0], _volume(vertices, faces))
+
+
+def _volume(vertices: FloatArray, faces: npt.NDArray[np.int64]) -> float:
+    """A closed mesh's volume (the divergence theorem: each face's signed tetrahedron with
+    the origin)."""
+    a, b, c = (vertices[faces[:, i]] for i in range(3))
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
 
 
 def _covered(solid: Any, rings: list[FloatArray]) -> float:
@@ -153,13 +175,13 @@ def open_beneath(model: Model, *, ground_z_m: float = 0.0, above_m: float = 0.5)
     photos saw through under it (an arch, a bridge, a deck on pillars)."""
     import manifold3d  # noqa: PLC0415
 
-    mesh = model.mesh
     solid = manifold3d.Manifold(
         manifold3d.Mesh(
-            np.asarray(mesh.vertices, dtype=np.float32), np.asarray(mesh.faces, dtype=np.uint32)
+            np.asarray(model.vertices_m, dtype=np.float32),
+            np.asarray(model.faces, dtype=np.uint32),
         )
     )
-    top = float(mesh.bounds[1][2])
+    top = float(model.vertices_m[:, 2].max())
     low = ground_z_m + above_m
     if top <= low:
         return 0.0
@@ -170,27 +192,8 @@ def open_beneath(model: Model, *, ground_z_m: float = 0.0, above_m: float = 0.5)
 
 
 def model_glb(model: Model) -> bytes:
-    """The model's mesh as binary glTF bytes, shaded as flat light-grey faces.
-
-    Each face gets its own vertices and their normal, and the mesh a matte material:
-    viewers built on three.js (Foxglove's and Lichtblick's 3D panels) compute no normals for
-    a glTF mesh that has none and draw it black."""
-    m = model.mesh
-    visual: Any = trimesh.visual  # its constructors are untyped
-    matte = visual.material.PBRMaterial(
-        name="model", baseColorFactor=[190, 190, 190, 255], metallicFactor=0.0, roughnessFactor=1.0
-    )
-    mesh = trimesh.Trimesh(
-        vertices=m.vertices[m.faces].reshape(-1, 3),
-        faces=np.arange(3 * len(m.faces)).reshape(-1, 3),
-        vertex_normals=np.repeat(m.face_normals, 3, axis=0),
-        visual=visual.TextureVisuals(material=matte),
-        process=False,
-    )
-    data = mesh.export(file_type="glb", include_normals=True)
-    if not isinstance(data, bytes):  # trimesh returns bytes for binary formats
-        raise TypeError(f"trimesh returned {type(data).__name__} for GLB")
-    return data
+    """The model's mesh as binary glTF bytes (:func:`uavtool.glb.mesh_glb`)."""
+    return mesh_glb(model.vertices_m, model.faces)
 
 
 def _check_views(top: View, front: View, right: View, p: ModelParams, more: Sequence[View]) -> None:
@@ -350,13 +353,6 @@ def _prism(rings: Sequence[FloatArray], base_z_m: float, top_z_m: float) -> Any:
 
     section = manifold3d.CrossSection(list(rings), manifold3d.FillRule.EvenOdd)
     return section.extrude(top_z_m - base_z_m).translate((0.0, 0.0, base_z_m))
-
-
-def _to_trimesh(solid: Any) -> trimesh.Trimesh:
-    mesh = solid.to_mesh()
-    verts = np.asarray(mesh.vert_properties, dtype=np.float64)[:, :3]
-    faces = np.asarray(mesh.tri_verts, dtype=np.int64)
-    return trimesh.Trimesh(vertices=verts, faces=faces, process=True)
 
 
 def central_shape(shapes: tuple[Shape, ...], intrinsics: Intrinsics) -> Shape | None:

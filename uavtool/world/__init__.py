@@ -9,7 +9,7 @@
 """
 
 from uavtool.world.errors import SceneError
-from uavtool.world.meshes import building_footprint, building_mesh
+from uavtool.world.meshes import building_footprint, building_mesh, building_solid
 from uavtool.world.render import render
 from uavtool.world.scene import (
     Block,
@@ -30,6 +30,7 @@ __all__ = [
     "SceneError",
     "building_footprint",
     "building_mesh",
+    "building_solid",
     "builtin_scene_names",
     "load_scene",
     "render",
