@@ -11,18 +11,22 @@ import time
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from tests.recording.sample import OBS_SCHEMA, T0_NS, mavlink_frames, other_values
 from uavtool.geo import GeoPoint
 from uavtool.glb import mesh_glb
+from uavtool.images import png_decode, png_encode
 from uavtool.recording import (
+    CompressedImage,
     Direction,
     Model3D,
     ProcessWriter,
     RecordingError,
     RecordingReader,
     RecordingWriter,
+    RgbImage,
     TriangleMesh,
     summarize,
 )
@@ -199,7 +203,7 @@ def test_a_model_given_as_a_mesh_is_written_as_its_glb(tmp_path: Path, kind: Any
     imports trimesh): the file holds what the model's GLB bytes would have written."""
     as_mesh, as_glb = tmp_path / "mesh.mcap", tmp_path / "glb.mcap"
     with kind(as_mesh, fsync=False) as writer:
-        writer.write("/mission/model", Model3D(_CUBE), log_time_ns=T0_NS)
+        writer.write("/mission/model", Model3D(b"", mesh=_CUBE), log_time_ns=T0_NS)
     glb = mesh_glb(_CUBE.vertices_m, _CUBE.faces)
     with RecordingWriter(as_glb, fsync=False) as writer:
         writer.write("/mission/model", Model3D(glb), log_time_ns=T0_NS)
@@ -208,3 +212,21 @@ def test_a_model_given_as_a_mesh_is_written_as_its_glb(tmp_path: Path, kind: Any
         (entry,) = reader.entries(["/mission/model"])
     assert entry.value == Model3D(glb)
     assert glb[:4] == b"glTF" and len(glb) > 12 * 3 * 24  # 36 vertices, each with a normal
+
+
+@pytest.mark.parametrize("kind", [RecordingWriter, ProcessWriter])
+def test_a_raw_frame_is_written_as_its_png(tmp_path: Path, kind: Any) -> None:
+    """A writer process encodes a raw frame's PNG (the flight's process does not): the file
+    holds what the frame's PNG bytes would have written."""
+    rng = np.random.default_rng(7)
+    rgb = rng.integers(0, 256, size=(48, 64, 3), dtype=np.uint8)
+    raw = RgbImage(rgb.tobytes(), 48, 64)
+    as_raw, as_png = tmp_path / "raw.mcap", tmp_path / "png.mcap"
+    with kind(as_raw, fsync=False) as writer:
+        writer.write("/camera/image", CompressedImage(b"", raw=raw), log_time_ns=T0_NS)
+    with RecordingWriter(as_png, fsync=False) as writer:
+        writer.write("/camera/image", CompressedImage(png_encode(rgb)), log_time_ns=T0_NS)
+    assert as_raw.read_bytes() == as_png.read_bytes()
+    with RecordingReader(as_raw) as reader:
+        (entry,) = reader.entries(["/camera/image"])
+    assert np.array_equal(png_decode(entry.value.data), rgb)

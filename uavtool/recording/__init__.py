@@ -38,6 +38,7 @@ if TYPE_CHECKING:
         Model3D,
         Pose,
         PosesInFrame,
+        RgbImage,
         SceneEntity,
         SceneMarkers,
         TriangleMesh,
@@ -46,7 +47,8 @@ if TYPE_CHECKING:
 
 _VALUES = (
     "CameraCalibration CompressedImage Direction Entry FrameTransform JsonDocument LocationFix "
-    "LogEntry LogLevel MavlinkFrame Model3D Pose PosesInFrame SceneEntity SceneMarkers TriangleMesh"
+    "LogEntry LogLevel MavlinkFrame Model3D Pose PosesInFrame RgbImage SceneEntity SceneMarkers "
+    "TriangleMesh"
 )
 _MODULE_OF = {
     **dict.fromkeys(_VALUES.split(), "values"),
@@ -93,6 +95,7 @@ __all__ = [
     "RecordingInfo",
     "RecordingReader",
     "RecordingWriter",
+    "RgbImage",
     "SceneEntity",
     "SceneMarkers",
     "TlogError",

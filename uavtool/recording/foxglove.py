@@ -32,8 +32,8 @@ from uavtool.recording.values import (
     Model3D,
     Pose,
     PosesInFrame,
+    RgbImage,
     SceneMarkers,
-    TriangleMesh,
 )
 
 FoxgloveValue = (
@@ -81,6 +81,23 @@ def schema_data(value_type: type) -> bytes:
     return data
 
 
+def deferred(value: FoxgloveValue) -> bool:
+    """Whether encoding ``value`` makes something heavy first (a frame's PNG, a model's GLB):
+    a writer process does that off the flight's path."""
+    return (isinstance(value, CompressedImage) and value.raw is not None) or (
+        isinstance(value, Model3D) and value.mesh is not None
+    )
+
+
+def _png(image: RgbImage) -> bytes:
+    import numpy as np  # noqa: PLC0415 — a writer process imports numpy for frames only
+
+    from uavtool.images import png_encode  # noqa: PLC0415
+
+    shape = (image.height_px, image.width_px, 3)
+    return png_encode(np.frombuffer(image.pixels, dtype=np.uint8).reshape(shape))
+
+
 def _stamp(pb: Any, t_ns: int) -> None:
     pb.timestamp.seconds, pb.timestamp.nanos = divmod(t_ns, 1_000_000_000)
 
@@ -101,7 +118,8 @@ def encode(value: FoxgloveValue, t_ns: int) -> bytes:
     pb: Any = _PB_CLASS[type(value)]()
     if isinstance(value, CompressedImage):
         _stamp(pb, t_ns)
-        pb.frame_id, pb.data, pb.format = value.frame_id, value.data, value.format
+        data = value.data if value.raw is None else _png(value.raw)
+        pb.frame_id, pb.data, pb.format = value.frame_id, data, value.format
     elif isinstance(value, CameraCalibration):
         _stamp(pb, t_ns)
         pb.frame_id, pb.width, pb.height = value.frame_id, value.width_px, value.height_px
@@ -144,9 +162,8 @@ def encode(value: FoxgloveValue, t_ns: int) -> bytes:
         model = entity.models.add()
         _pose_pb(value.pose, model.pose)
         model.scale.x = model.scale.y = model.scale.z = 1.0
-        glb = value.glb
-        if isinstance(glb, TriangleMesh):
-            glb = mesh_glb(glb.vertices_m, glb.faces)
+        mesh = value.mesh
+        glb = value.glb if mesh is None else mesh_glb(mesh.vertices_m, mesh.faces)
         model.media_type, model.data = _GLB_MEDIA_TYPE, glb
     return bytes(pb.SerializeToString(deterministic=True))
 

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
+import importlib
 import json
 import os
 import pickle
@@ -45,7 +46,7 @@ from typing import TYPE_CHECKING, Any, BinaryIO, NoReturn
 from uavtool.recording.errors import RecordingError, create_file
 from uavtool.recording.schemas import DEFAULT_DIALECT, dialect_module, dumps
 from uavtool.recording.topics import FIX, POSE
-from uavtool.recording.values import Direction, LocationFix, Model3D, PosesInFrame, TriangleMesh
+from uavtool.recording.values import Direction, LocationFix, PosesInFrame
 from uavtool.recording.writer import (
     RecordingWriter,
     check_metadata,
@@ -278,8 +279,8 @@ class ProcessWriter:
         _check_times(log_time_ns, publish_time_ns)
         kind = type(value)
         foxglove = foxglove_module()
-        # a model given as a mesh is encoded (its GLB made) by the child, off the flight's path
-        deferred = isinstance(value, Model3D) and isinstance(value.glb, TriangleMesh)
+        # a frame's PNG and a model's GLB are made by the child, off the flight's path
+        deferred = foxglove.deferred(value)
         data = None if deferred else foxglove.encode(value, log_time_ns)
         with self._lock:
             self._check_open()
@@ -454,6 +455,10 @@ def serve() -> None:
             fsync=fsync,
             file=os.fdopen(fd, "wb"),
         )
+        # What the frames' PNGs and a model's GLB need (~0.2 s to import): ready before they
+        # come, the model near a flight's end, where the flight would wait for the import at
+        # close.
+        threading.Thread(target=_import_quietly, args=("cv2", "trimesh"), daemon=True).start()
         _serve(writer, source, reply)
     except RecordingError as exc:
         reply("error", exc.path, exc.problem)
@@ -463,6 +468,12 @@ def serve() -> None:
         # the file is closed (or, the flight gone, its chunks flushed) and the reply sent: an
         # interpreter's orderly exit would keep the flight waiting ~50 ms more at its close
         os._exit(0)
+
+
+def _import_quietly(*names: str) -> None:
+    for name in names:
+        with contextlib.suppress(Exception):  # not installed, broken: the encoder will say so
+            importlib.import_module(name)
 
 
 def _serve(writer: Any, source: Any, reply: Any) -> None:

@@ -84,12 +84,26 @@ class JsonDocument:
 
 
 @dataclass(frozen=True, slots=True)
+class RgbImage:
+    """A frame's raw pixels: ``height_px`` rows of ``width_px`` RGB pixels, 3 bytes each."""
+
+    pixels: bytes
+    height_px: int
+    width_px: int
+
+
+@dataclass(frozen=True, slots=True)
 class CompressedImage:
-    """A camera frame as encoded bytes (PNG by default: lossless)."""
+    """A camera frame as encoded bytes (PNG by default: lossless).
+
+    Given ``raw`` pixels instead (``data`` empty, ``format`` "png"), the writer encodes them
+    (:func:`uavtool.images.png_encode`) where it encodes the message — in a writer process,
+    off the flight's path — and the frame reads back with those bytes as ``data``."""
 
     data: bytes
     format: str = "png"
     frame_id: str = "camera"
+    raw: RgbImage | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -194,14 +208,16 @@ class TriangleMesh:
 class Model3D:
     """A 3D model as GLB bytes, placed at ``pose`` in ``frame_id``.
 
-    ``glb`` may be a :class:`TriangleMesh` instead: the writer encodes it as GLB
+    Given a ``mesh`` instead (``glb`` empty), the writer encodes it as GLB
     (:func:`uavtool.glb.mesh_glb`, flat light-grey faces) where it encodes the message — in a
-    writer process, off the flight's path — and it reads back as those bytes."""
+    writer process, off the flight's path — and the model reads back with those bytes as
+    ``glb``."""
 
-    glb: bytes | TriangleMesh
+    glb: bytes
     entity_id: str = "model"
     frame_id: str = "world"
     pose: Pose = Pose((0.0, 0.0, 0.0))
+    mesh: TriangleMesh | None = None
 
 
 @dataclass(frozen=True, slots=True)

@@ -25,7 +25,6 @@ from typing import Any
 
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.geo import GeoPoint
-from uavtool.images import png_encode
 from uavtool.mission import Level, Observation, Output, Photo, Telemetry
 from uavtool.mission.codec import encode_observation, encode_output, output_bytes
 from uavtool.mission.schema import observation_schema, output_schema
@@ -37,6 +36,7 @@ from uavtool.recording import (
     LogEntry,
     LogLevel,
     Model3D,
+    RgbImage,
     SceneMarkers,
     TriangleMesh,
 )
@@ -64,14 +64,16 @@ ClockNs = Callable[[], int]
 
 def write_camera_frame(
     writer: MessageWriter,
-    png: bytes,
+    png: bytes | RgbImage,
     intrinsics: Intrinsics,
     pose: CameraPose,
     log_time_ns: int,
 ) -> None:
-    """One camera frame on ``/camera/image``, with its calibration and its pose."""
+    """One camera frame on ``/camera/image``, with its calibration and its pose; ``png`` may be
+    the raw frame, which the writer encodes."""
     t = log_time_ns
-    writer.write(IMAGE, CompressedImage(png), log_time_ns=t)
+    image = CompressedImage(png) if isinstance(png, bytes) else CompressedImage(b"", raw=png)
+    writer.write(IMAGE, image, log_time_ns=t)
     writer.write(CALIBRATION, CameraCalibration.from_intrinsics(intrinsics), log_time_ns=t)
     writer.write(CAMERA_POSE, FrameTransform.from_camera_pose(pose), log_time_ns=t)
 
@@ -106,10 +108,11 @@ class MissionRecorder:
         )
 
     def observation(self, step: int, obs: Observation, png: bytes | None = None) -> None:
-        """Record one observation; a photo's frame as ``png`` if the caller encoded it."""
+        """Record one observation; a photo's frame as ``png`` if the caller encoded it, else
+        the writer encodes it (a writer process off the flight's path)."""
         t = self.clock_ns()
         if isinstance(obs, Photo):
-            image = png if png is not None else png_encode(obs.image_rgb)
+            image: bytes | RgbImage = png if png is not None else _raw(obs.image_rgb)
             write_camera_frame(self.writer, image, obs.intrinsics, obs.pose, t)
             self._scene(self._markers.photo(obs.pose), t)
         elif isinstance(obs, Telemetry):
@@ -154,7 +157,7 @@ class MissionRecorder:
             mesh = TriangleMesh(
                 tuple(tuple(v) for v in data["vertices_m"]), tuple(tuple(f) for f in data["faces"])
             )
-            self.writer.write(MODEL, Model3D(mesh), log_time_ns=log_time_ns)
+            self.writer.write(MODEL, Model3D(b"", mesh=mesh), log_time_ns=log_time_ns)
         elif blob is not None and data.get("type") == "Picture":
             picture = CompressedImage(blob, frame_id=str(data.get("tag", "")))
             self.writer.write(PICTURES, picture, log_time_ns=log_time_ns)
@@ -232,6 +235,11 @@ def telemetry_json(step: int, t: Telemetry) -> bytes | None:
 
 
 _FIELDS_NOW = tuple(f.name for f in dataclasses.fields(Telemetry))
+
+
+def _raw(rgb: Any) -> RgbImage:
+    height, width = rgb.shape[:2]
+    return RgbImage(rgb.tobytes(), int(height), int(width))
 
 
 def _text(value: Any) -> str:

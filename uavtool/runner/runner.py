@@ -183,9 +183,10 @@ class Runner:
         while self._queue and self.mission.outcome is None:
             obs = self._queue.popleft()
             self.step += 1
-            # A photo is encoded once, for the recording and the live view alike.
+            # A photo is encoded once, for the recording and the live view alike; without a
+            # live view, the recording's writer encodes it (a writer process, off this path).
             png = None
-            if isinstance(obs, Photo) and (self.recorder is not None or self.live is not None):
+            if isinstance(obs, Photo) and self.live is not None:
                 png = png_encode(obs.image_rgb)
             if self.recorder is not None:
                 self.recorder.observation(self.step, obs, png)
