@@ -9,6 +9,7 @@ from __future__ import annotations
 import gc
 import importlib
 import logging
+import os
 import sys
 from typing import Any
 
@@ -87,6 +88,7 @@ _whole_help_lines(cli)
 def main() -> None:
     """Console-script entry point. A command line click cannot parse (an unknown option, a
     bad value, a missing argument) is one line on stderr, exit 2, like every other error."""
+    _one_blas_thread()
     try:
         _main()
     finally:
@@ -94,6 +96,16 @@ def main() -> None:
         # collection walks every object numpy, OpenCV, trimesh … made: 60-90 ms of a fly or
         # replay. Frozen objects are skipped by it (files are closed, atexit still runs).
         gc.freeze()
+
+
+def _one_blas_thread() -> None:
+    """A command flies one flight (or reads one recording) on one thread, and numpy's
+    OpenBLAS worker threads only spin-wait after each of its small matrix products: ~0.3 s of
+    CPU in a 1.2 s ``uavtool fly``, taken from the core a recording's writer process or a
+    sweep's other workers use. Set before numpy loads (none of the commands' modules imports
+    it); a user's own ``OPENBLAS_NUM_THREADS`` wins. One thread computes the same products,
+    bit for bit: each output element is one thread's dot product either way."""
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 
 def _main() -> None:
