@@ -50,10 +50,12 @@ from uavtool.runner.fly import FlyConfig, fly
 ROOT = Path(__file__).resolve().parents[1]
 BASELINE = "675267c"
 GOLDEN = "recordings/golden/paper.mcap"
-# ``uavtool ARGS`` with fly's choice of writer forced (``spare``: whether a core is free)
+# ``uavtool ARGS`` with fly's choice of writer forced (``spare``: whether a core is free); the
+# entry point's thread setting is made before numpy loads, as `uavtool` makes it
 _FORCED = (
-    "import sys, uavtool.runner.fly as f; f.core_to_spare = lambda: {spare}; "
-    "from uavtool.cli import main; sys.argv[0] = 'uavtool'; main()"
+    "import sys; from uavtool import cli; cli._one_blas_thread(); "  # as `main` does, first
+    "import uavtool.runner.fly as f; f.core_to_spare = lambda: {spare}; "
+    "sys.argv[0] = 'uavtool'; cli.main()"
 )
 
 
