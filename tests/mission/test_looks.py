@@ -222,3 +222,33 @@ def test_a_look_judges_the_building_it_was_aimed_at() -> None:
     assert aimed_shape(params, (pink, blue), K, (51, 132, 204)) is blue
     assert aimed_shape(params, (pink, blue), K, None) is pink
     assert aimed_shape(params, (pink, blue), K, (204, 200, 51)) is pink  # no yellow: any
+
+
+@pytest.mark.parametrize(
+    ("score", "mirror", "reason"),
+    [
+        (0.95, 0.949, "score 0.950, but as much like the target's mirror image"),
+        (0.60, 0.0, "score 0.600 just below the threshold"),
+    ],
+)
+def test_a_look_again_names_why(score: float, mirror: float, reason: str) -> None:
+    """A candidate that scores over the threshold but fails the mirror rule is looked at
+    again for that reason, not as one scoring just below the threshold."""
+    from types import SimpleNamespace
+
+    from uavtool.mission.analysis import Judgement
+    from uavtool.mission.search import _Look, _look_again
+
+    params = Params()
+    assert params.recognize.threshold <= 0.95
+    assert params.mission.recheck_min_score <= 0.60 < params.recognize.threshold
+    k = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
+    photo = SimpleNamespace(pose=CameraPose((0.0, 0.0, 40.0), 0.0, -90.0), intrinsics=k)
+    shape = SimpleNamespace(centroid_px=(330.0, 250.0))
+    j = Judgement((score,), 0, score, False, mirror_score=mirror, not_mirror=mirror == 0.0)
+    look = _Look(photo, (shape,), j, 40.0)  # type: ignore[arg-type]
+    again = _look_again(SimpleNamespace(params=params), look, 10.0, 100.0)  # type: ignore[arg-type]
+    assert again is not None
+    pos, why = again
+    assert why == reason
+    assert pos[2] == pytest.approx(40.0 + params.mission.recheck_climb_m)

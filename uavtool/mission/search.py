@@ -379,6 +379,8 @@ def _look_again(
     off = math.hypot(u - k.cx_px, v - k.cy_px) / (k.height_px / 2.0)
     if not j.judgeable:
         why = "outline cut by the image border"
+    elif j.score >= m.params.recognize.threshold:  # unmatched all the same: the mirror rule
+        why = f"score {j.score:.3f}, but as much like the target's mirror image"
     elif j.score >= p.recheck_min_score:
         why = f"score {j.score:.3f} just below the threshold"
     elif off > p.recheck_offcentre:
