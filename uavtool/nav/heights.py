@@ -354,13 +354,13 @@ def higher_part_m(
             continue  # straight under the camera: no perspective to go by
         step = 1.0 / max(float(rho.mean()), 1.0)  # about a pixel of arc
         bins = np.floor(np.arctan2(dv, du) / step).astype(np.int64)
+        # a set and a sorted median, as np.unique and np.median give them, without their
+        # import of numpy.ma (~20 ms of a flight)
         heights = []
         for b in sorted(set(bins.tolist())):
             r = rho[bins == b]
             width = float(r.max() - r.min())  # a pixel narrower than its pixels span
             heights.append(roof_m + above_m * width / (float(r.max()) + 0.5))
-        # the median, as np.median gives it, without its import of numpy.ma (~20 ms); and
-        # the set, not np.unique, for the same reason
         heights.sort()
         k = len(heights) // 2
         tops.append(heights[k] if len(heights) % 2 else (heights[k - 1] + heights[k]) / 2.0)

@@ -152,7 +152,6 @@ def model_iou(
     vertices_m: Any, faces: Any, scene: Scene, offset_en: tuple[float, float] = (0.0, 0.0)
 ) -> float:
     """Volumetric IoU of a mesh (vehicle-home ENU) with the scene's target building."""
-
     model = _manifold(vertices_m, faces, offset_en)
     truth = building_solid(scene.target_building)
     inter = (model ^ truth).volume()
