@@ -7,13 +7,12 @@ from __future__ import annotations
 
 import itertools
 import subprocess
-import sys
 import time
 from pathlib import Path
 
 import pytest
 
-from tests.integration.peers import PX4, PX4_GIMBAL, check_photo_poses, fly, px4
+from tests.integration.peers import PX4, PX4_GIMBAL, check_photo_poses, fly, px4, uavtool
 from uavtool.recording import LogEntry, RecordingReader
 from uavtool.recording.topics import TELEMETRY, VEHICLE_EVENTS
 
@@ -77,9 +76,8 @@ def test_record_records_a_px4_flight_flown_by_someone_else(tmp_path: Path) -> No
     recording = tmp_path / "rec.mcap"
     with px4(tmp_path, params=PX4_GIMBAL) as port:
         recorder = subprocess.Popen(
-            [sys.executable, "-m", "uavtool", "record", "--connect",
-             f"udpin:0.0.0.0:{PX4_GCS_PORT}", "-o", str(recording), "--camera", "sim",
-             "--until-landed", "--direct"],
+            uavtool("record", "--connect", f"udpin:0.0.0.0:{PX4_GCS_PORT}", "-o",
+                    str(recording), "--camera", "sim", "--until-landed", "--direct"),
             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
         )  # fmt: skip
         time.sleep(3.0)
