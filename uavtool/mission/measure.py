@@ -42,7 +42,7 @@ from uavtool.mission.unknown import (
     unknown_place,
 )
 from uavtool.nav import NavError, frame_on_plane, ground_point
-from uavtool.nav.heights import roof_from_cut_outline
+from uavtool.nav.heights import roof_from_cut_outline, roof_from_photos
 from uavtool.vision import Shape
 from uavtool.vision.colour import has_hue, hue_distance_deg
 from uavtool.vision.vectorize import non_ground
@@ -91,6 +91,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     ]
     stops += [(f"obstacle {j}", f"measure-obstacle-{j}", None, j) for j in range(len(others))]
     photos = [] if seen.lower is None else [seen.lower]  # nadir photos that show the ground
+    sightings: dict[int, list[tuple[Photo, Shape]]] = {}  # unmeasured roofs the tour saw whole
     for what, tag, poi, j in stops:
         if poi is not None:
             if measured[poi.shape_index]:
@@ -109,6 +110,9 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
                 roof = measure_roof(
                     m, shape, seen.photo, photo, shapes, below_m=below_m, cut_plans_only=True
                 )
+                if roof is None and not shape.cut_by_border:
+                    tour = sightings.setdefault(i, [])
+                    roof = measure_on_tour(m, shape, seen.photo, (photo, shapes), tour, below_m)
                 if roof is not None:
                     roofs[i], measured[i] = roof, True
         if None in others_m:
@@ -310,6 +314,58 @@ def measure_roof(
         if miss is not None and miss <= limit_px and (best is None or miss < best[0]):
             best = (miss, roof)
     return None if best is None else best[1]
+
+
+def measure_on_tour(
+    m: SearchMission,
+    shape: Shape,
+    photo: Photo,
+    here: tuple[Photo, tuple[Shape, ...]],
+    tour: list[tuple[Photo, Shape]],
+    below_m: float,
+) -> float | None:
+    """The height of the roof ``shape`` (whole in the overview ``photo``) from two photos of
+    the tour above the points of interest, when no tour photo agrees with the overview's
+    outline: a taller neighbour's walls, leaning out in the overview, may hide part of it,
+    and then one flat roof explains no pair that includes the overview. ``here`` is the new
+    photo and its shapes; ``tour`` the roof's earlier sightings, which this one joins.
+
+    The roof in ``here`` is the shape of its colour, whole, that the two photos' centroids
+    place in one spot; the height is the one `roof_between` finds for it and an earlier
+    sighting (one flat roof explains both outlines, nothing stands higher inside them), and
+    only if the overview's centroid lies there too."""
+    other, shapes = here
+    limit_px = max(_AGREE * math.sqrt(shape.area_px), 2.0)
+    found: tuple[float, Shape] | None = None  # (disagreement px, shape)
+    for cand in shapes:
+        if cand.cut_by_border or not same_colour(m, cand.colour_rgb, shape.colour_rgb):
+            continue
+        roof = roof_from_photos(
+            centroid1_px=shape.centroid_px,
+            area1_px=shape.area_px,
+            pose1=photo.pose,
+            centroid2_px=cand.centroid_px,
+            area2_px=cand.area_px,
+            pose2=other.pose,
+            intrinsics=photo.intrinsics,
+        )
+        if roof is None or not 0.0 <= roof <= below_m:
+            continue
+        miss = _disagreement_px(shape, photo, cand, other, roof)
+        if miss is not None and miss <= limit_px and (found is None or miss < found[0]):
+            found = (miss, cand)
+    if found is None:
+        return None
+    seen_here = found[1]
+    for earlier, seen_there in tour:
+        roof = roof_between(seen_there, earlier, seen_here, other)
+        if roof is None or not 0.0 <= roof <= below_m:
+            continue
+        miss = _disagreement_px(shape, photo, seen_here, other, roof)
+        if miss is not None and miss <= limit_px:
+            return roof
+    tour.append((other, seen_here))
+    return None
 
 
 def _disagreement_px(

@@ -1,0 +1,40 @@
+"""Roofs measured from the tour above the points of interest, before any is flown near
+(issue 26)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from uavtool.mission import Status
+from uavtool.recording import LogEntry, RecordingReader
+from uavtool.recording.topics import EVENTS
+from uavtool.runner.fly import FlyConfig, fly
+
+DATA = Path(__file__).parent / "data"
+
+
+def test_a_roof_the_overview_shows_in_part_is_measured_by_two_tour_photos(
+    tmp_path: Path,
+) -> None:
+    """Town scene 11096: the target, a 12.9 m T, stands beside a 54 m tower whose walls, in
+    the overview, lean over part of its outline. No one flat roof then explained the
+    overview's outline and a tour photo's (1.15 px apart, over the 1.0 px limit), so its
+    roof stayed unknown: the target was looked at from over the highest it might be
+    (114.8 m) and scored 0.763 there, under the wing decoy's 0.779 from a proper look, and
+    the decoy won. Two tour photos agree on its roof (0.06 px): it is looked at from its own
+    altitude, scores 0.999 and wins."""
+    record = tmp_path / "f.mcap"
+    summary = fly(FlyConfig(scene=str(DATA / "town-11096.yaml"), record=record))
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == "b06"
+    assert summary.outcome.match_score > 0.95
+    with RecordingReader(record) as reader:
+        said = [
+            e.value.message
+            for e in reader.entries([EVENTS])
+            if isinstance(e.value, LogEntry) and e.value.message.startswith("target is")
+        ]
+    assert len(said) == 1
+    assert float(said[0].split("roof ")[1].split(" m")[0]) == pytest.approx(12.9, abs=0.5)
