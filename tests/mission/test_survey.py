@@ -38,3 +38,15 @@ def test_a_roof_the_overview_shows_in_part_is_measured_by_two_tour_photos(
         ]
     assert len(said) == 1
     assert float(said[0].split("roof ")[1].split(" m")[0]) == pytest.approx(12.9, abs=0.5)
+
+
+def test_a_stepped_tower_flat_in_two_tour_photos_is_not_measured_at_its_lowest_tier() -> None:
+    """Town scene 11624: the target, a stepped rectangle (tiers at 8.2, 13.7 and 18.7 m), is
+    photographed by the tour from straight above it and from 19 m aside. Neither photo shows
+    its upper tiers' walls, and the two agreed on one flat roof at 8.3 m, its lowest tier;
+    the overview shows those walls. Taken as measured, the roof let the mission descend to
+    measure it again, into the top tier (a crash at 15.4 m). The overview's walls now
+    keep it unmeasured, and the flight completes."""
+    summary = fly(FlyConfig(scene=str(DATA / "town-11624.yaml"), no_record=True))
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == "b02"

@@ -7,7 +7,9 @@ second overview's altitude — space the overview showed free: every roof in it 
 camera — to above each point of interest whose roof is unknown, and photographs straight down.
 Each such photo and the overview see the roofs from two places, so every roof whole in both is
 triangulated, and one cut by a border is fitted by its visible edges
-(:func:`uavtool.nav.heights.roof_from_cut_outline`). A roof measured taller than expected is
+(:func:`uavtool.nav.heights.roof_from_cut_outline`). A roof whose outline in the overview no
+tour photo agrees with (a taller neighbour's walls lean over part of it) is measured by two
+tour photos that do agree (`measure_on_tour`). A roof measured taller than expected is
 believed: as an obstacle, too tall is safe and too low is not.
 """
 
@@ -21,7 +23,7 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
-from uavtool.mission.analysis import roof_between
+from uavtool.mission.analysis import not_flat, roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
 from uavtool.mission.search import photo_shapes
@@ -333,7 +335,8 @@ def measure_on_tour(
     The roof in ``here`` is the shape of its colour, whole, that the two photos' centroids
     place in one spot; the height is the one `roof_between` finds for it and an earlier
     sighting (one flat roof explains both outlines, nothing stands higher inside them), and
-    only if the overview's centroid lies there too."""
+    only if the overview's centroid lies there too and no photo of it, the overview included,
+    shows a part of it standing higher."""
     other, shapes = here
     limit_px = max(_AGREE * math.sqrt(shape.area_px), 2.0)
     found: tuple[float, Shape] | None = None  # (disagreement px, shape)
@@ -362,7 +365,13 @@ def measure_on_tour(
         if roof is None or not 0.0 <= roof <= below_m:
             continue
         miss = _disagreement_px(shape, photo, seen_here, other, roof)
-        if miss is not None and miss <= limit_px:
+        if miss is None or miss > limit_px:
+            continue
+        # Flat in two photos is not flat: a stepped tower seen from straight above hides its
+        # upper tiers' walls, and two such photos put its roof at its lowest tier. No photo
+        # of it may show a part standing higher, the overview included.
+        views = [(photo, shape), *tour]
+        if not any(not_flat(s, view, roof, other, seen_here) for view, s in views):
             return roof
     tour.append((other, seen_here))
     return None
