@@ -101,3 +101,14 @@ def test_a_rival_look_that_shows_another_building_is_not_the_rivals_match(tmp_pa
     assert summary.evaluation.matched_building == "b03"
     assert summary.clearance_m is not None and summary.clearance_m > 4.0
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+
+
+def test_a_decoy_with_a_courtyard_too_deep_to_show_loses_to_the_target() -> None:
+    """Town scene 11450: the target is a U 23.6 m tall, the decoy the same U in the same
+    colour with a courtyard 2 m across in one arm. From any look the courtyard shows its
+    walls and a sliver of ground, too little for a hole, so the two outlines score alike
+    (target 0.996, decoy 0.998) and the decoy won by pixel noise. The decoy's roof shows an
+    opening inside its outline, the target picture none: the target wins."""
+    summary = fly_scene(FlyConfig(scene=str(DATA / "town-11450.yaml"), no_record=True))
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == "b03"

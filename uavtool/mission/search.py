@@ -28,7 +28,7 @@ from uavtool.nav import NavError, ground_point, ground_polygon
 from uavtool.nav.geometry import point_polygon_distance
 from uavtool.nav.heights import fit_altitude_m
 from uavtool.vision import Shape
-from uavtool.vision.vectorize import hue_distance_deg
+from uavtool.vision.vectorize import enclosed_openings, hue_distance_deg
 
 if TYPE_CHECKING:
     from uavtool.mission.base import Wait
@@ -174,7 +174,7 @@ def search(
                 f"point of interest {k}: the look shows point of interest {best.poi.index}'s "
                 "building again, no rival",
             )
-        elif j.matched and (best is None or j.score > best.score):
+        elif j.matched and (best is None or _beats(m, k, look, best)):
             shape = look.shapes[j.candidate]
             seen = overview_shapes[poi.shape_index]
             roof = roof_between(seen, overview, shape, look.photo)
@@ -219,6 +219,32 @@ def _shows_again(best: Found, look: _Look) -> bool:
     except NavError:
         return False
     return point_polygon_distance(here, ring) == 0.0
+
+
+def _beats(m: SearchMission, k: int, look: _Look, best: Found) -> bool:
+    """Whether point of interest ``k``'s match (``look``) is the target rather than ``best``:
+    the higher score, unless the two differ by no more than pixel noise
+    (``recognize.mirror_tolerance``, as the mirror rule takes it). Then the outline cannot
+    tell them apart, and what lies inside it may: openings in the roof (a courtyard whose
+    floor does not show, a higher part's walls; `enclosed_openings`). The one with as many
+    as the target picture wins, if only one has."""
+    j = look.judgement
+    if abs(j.score - best.score) > m.params.recognize.mirror_tolerance:
+        return j.score > best.score
+    least = m.params.vectorize.min_hole_area_px
+    want = m.target_openings()
+    here = enclosed_openings(look.photo.image_rgb, look.shapes[j.candidate], least_px=least)
+    there = enclosed_openings(best.photo.image_rgb, best.shape, least_px=least)
+    if (here == want) == (there == want):
+        return j.score > best.score
+    winner, loser, shown = (k, best.poi.index, there) if here == want else (best.poi.index, k, here)
+    m.event(
+        Level.INFO,
+        f"points of interest {k} and {best.poi.index} match as well (scores {j.score:.3f} and "
+        f"{best.score:.3f}); {loser}'s roof shows {shown} opening(s) inside its outline, the "
+        f"target picture's {want}: {winner} is the better match",
+    )
+    return here == want
 
 
 def _rivals(

@@ -231,6 +231,35 @@ def inner_walls(
     return out
 
 
+def enclosed_openings(
+    frame_rgb: U8Array, shape: Shape, *, least_px: float, tolerance_dn: int = 15
+) -> int:
+    """How many regions inside ``shape``'s outline, besides its holes, show no roof: at
+    least ``least_px`` pixels of another colour than the roof's, with roof all round them.
+
+    From above, the roof fills its outline, and its own walls and the ground lie outside.
+    What is enclosed is a courtyard too narrow or deep for its floor to show (its walls, a
+    sliver of ground: the vectorizer then keeps no hole) or a higher part's walls. Two
+    buildings that match one outline equally well may differ by it."""
+    frame = _check_frame(frame_rgb)
+    inside: CvArray = np.zeros(frame.shape[:2], np.uint8)
+    cv2.fillPoly(inside, [_ring(shape.polygon_px)], 255)
+    for hole in shape.holes_px:
+        cv2.fillPoly(inside, [_ring(hole)], 0)
+    kernel = np.ones((3, 3), np.uint8)
+    inside = cv2.erode(inside, kernel)  # the outline's blended edge pixels are no opening
+    rim = cv2.subtract(inside, cv2.erode(inside, kernel))
+    roof = _near(frame, shape.colour_rgb, 2 * tolerance_dn)
+    other = cv2.bitwise_and(inside, cv2.bitwise_not(roof))
+    count, labels, stats, _ = cv2.connectedComponentsWithStats(other, connectivity=8)
+    touching = set(np.unique(labels[rim > 0]).tolist())
+    return sum(
+        1
+        for label in range(1, count)
+        if label not in touching and stats[label, cv2.CC_STAT_AREA] >= least_px
+    )
+
+
 _GREY_SATURATION = 40
 """OpenCV saturation (0-255) under which a colour counts as grey (its hue says nothing)."""
 _WALL_HUE_HALF_DEG = 8
