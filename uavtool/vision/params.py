@@ -131,7 +131,9 @@ class RecognizeParams:
     mirror_tolerance: float = 0.01
     """… less this: how far an outline's score and its mirror image's may differ by pixel
     noise alone. For a reference that is its own mirror image (a rectangle, a T) the rule
-    then only refuses a candidate clearly more like the mirror image."""
+    then only refuses a candidate clearly more like the mirror image. The mission takes it
+    too as how far two buildings' scores may differ by noise alone: within it, the openings
+    inside their outlines decide."""
 
     RANGES: ClassVar[Mapping[str, Range]] = MappingProxyType(
         {
