@@ -111,13 +111,11 @@ def judge(
     return Judgement(scores, candidate, score, matched, judgeable, same_hue, mirrored, not_mirror)
 
 
-def roof_between(a: Shape, photo_a: Photo, b: Shape, photo_b: Photo) -> float | None:
-    """The height above home of one roof seen as ``a`` in ``photo_a`` and ``b`` in
-    ``photo_b`` (nadir photos), at least 0; None when either outline is cut by its border or
-    the two views cannot tell."""
-    if a.cut_by_border or b.cut_by_border:
-        return None
-    roof = roof_from_photos(
+def placed_roof(a: Shape, photo_a: Photo, b: Shape, photo_b: Photo) -> float | None:
+    """The height at which ``a`` (in nadir ``photo_a``) and ``b`` (in ``photo_b``), by their
+    centroids and sizes, are one roof, with no check that one flat roof explains their
+    outlines (`roof_between` makes it); None when the two views cannot tell."""
+    return roof_from_photos(
         centroid1_px=a.centroid_px,
         area1_px=a.area_px,
         pose1=photo_a.pose,
@@ -126,6 +124,15 @@ def roof_between(a: Shape, photo_a: Photo, b: Shape, photo_b: Photo) -> float | 
         pose2=photo_b.pose,
         intrinsics=photo_a.intrinsics,
     )
+
+
+def roof_between(a: Shape, photo_a: Photo, b: Shape, photo_b: Photo) -> float | None:
+    """The height above home of one roof seen as ``a`` in ``photo_a`` and ``b`` in
+    ``photo_b`` (nadir photos), at least 0; None when either outline is cut by its border or
+    the two views cannot tell."""
+    if a.cut_by_border or b.cut_by_border:
+        return None
+    roof = placed_roof(a, photo_a, b, photo_b)
     if roof is None:
         return None
     roof = max(roof, 0.0)

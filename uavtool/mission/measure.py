@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
-from uavtool.mission.analysis import not_flat, roof_between
+from uavtool.mission.analysis import not_flat, placed_roof, roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
 from uavtool.mission.search import photo_shapes
@@ -44,7 +44,7 @@ from uavtool.mission.unknown import (
     unknown_place,
 )
 from uavtool.nav import NavError, frame_on_plane, ground_point
-from uavtool.nav.heights import roof_from_cut_outline, roof_from_photos
+from uavtool.nav.heights import roof_from_cut_outline
 from uavtool.vision import Shape
 from uavtool.vision.colour import has_hue, hue_distance_deg
 from uavtool.vision.vectorize import non_ground
@@ -343,15 +343,7 @@ def measure_on_tour(
     for cand in shapes:
         if cand.cut_by_border or not same_colour(m, cand.colour_rgb, shape.colour_rgb):
             continue
-        roof = roof_from_photos(
-            centroid1_px=shape.centroid_px,
-            area1_px=shape.area_px,
-            pose1=photo.pose,
-            centroid2_px=cand.centroid_px,
-            area2_px=cand.area_px,
-            pose2=other.pose,
-            intrinsics=photo.intrinsics,
-        )
+        roof = placed_roof(shape, photo, cand, other)
         if roof is None or not 0.0 <= roof <= below_m:
             continue
         miss = _disagreement_px(shape, photo, cand, other, roof)
