@@ -61,7 +61,11 @@ class SearchMission(FlightMission):
         self.matched_poi = -1
         self.match_score = 0.0
         self.model_built = False
-        self._target_openings: int | None = None
+        self.target_openings = enclosed_openings(
+            inputs.target_rgb, self.target, least_px=params.vectorize.min_hole_area_px
+        )
+        """How many openings the target picture shows inside its outline
+        (`enclosed_openings`): what tells apart two buildings that match it as well."""
         self.plan: Plan | None = None
         self.transit_m: float | None = None
         """The altitude that clears every known roof (once the survey has measured them)."""
@@ -85,19 +89,6 @@ class SearchMission(FlightMission):
         self._frames_seen = 0
         self.no_model = "unknown"
         """Why no model was built (for a PARTIAL outcome)."""
-
-    def target_openings(self) -> int:
-        """How many openings the target picture shows inside its outline
-        (`enclosed_openings`): what tells apart two buildings that match its outline as
-        well."""
-        if self._target_openings is None:
-            assert self.inputs.target_rgb is not None  # checked in __init__
-            self._target_openings = enclosed_openings(
-                self.inputs.target_rgb,
-                self.target,
-                least_px=self.params.vectorize.min_hole_area_px,
-            )
-        return self._target_openings
 
     # --- the mission's part of the base's contract ---------------------------------------------
 

@@ -232,7 +232,7 @@ def _beats(m: SearchMission, k: int, look: _Look, best: Found) -> bool:
     if abs(j.score - best.score) > m.params.recognize.mirror_tolerance:
         return j.score > best.score
     least = m.params.vectorize.min_hole_area_px
-    want = m.target_openings()
+    want = m.target_openings
     here = enclosed_openings(look.photo.image_rgb, look.shapes[j.candidate], least_px=least)
     there = enclosed_openings(best.photo.image_rgb, best.shape, least_px=least)
     if (here == want) == (there == want):

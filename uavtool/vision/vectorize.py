@@ -178,13 +178,19 @@ def roof_inside(
     ``inset_px`` from its outline and from any pixel of the ground's colour (a courtyard or
     an opening shows the ground; a wall between two tiers of one building does not)."""
     frame = _check_frame(frame_rgb)
+    inside = _outline_mask(frame, shape)
+    inside = cv2.bitwise_and(inside, cv2.bitwise_not(ground_mask(frame, tolerance_dn=tolerance_dn)))
+    side = 2 * inset_px + 1
+    return cv2.erode(inside, np.ones((side, side), np.uint8))
+
+
+def _outline_mask(frame: U8Array, shape: Shape) -> CvArray:
+    """255 inside ``shape``'s outline and not in its holes, over ``frame``'s pixels."""
     inside: CvArray = np.zeros(frame.shape[:2], np.uint8)
     cv2.fillPoly(inside, [_ring(shape.polygon_px)], 255)
     for hole in shape.holes_px:
         cv2.fillPoly(inside, [_ring(hole)], 0)
-    inside = cv2.bitwise_and(inside, cv2.bitwise_not(ground_mask(frame, tolerance_dn=tolerance_dn)))
-    side = 2 * inset_px + 1
-    return cv2.erode(inside, np.ones((side, side), np.uint8))
+    return inside
 
 
 def ground_mask(frame_rgb: U8Array, *, tolerance_dn: int = 15) -> CvArray:
@@ -242,17 +248,14 @@ def enclosed_openings(
     sliver of ground: the vectorizer then keeps no hole) or a higher part's walls. Two
     buildings that match one outline equally well may differ by it."""
     frame = _check_frame(frame_rgb)
-    inside: CvArray = np.zeros(frame.shape[:2], np.uint8)
-    cv2.fillPoly(inside, [_ring(shape.polygon_px)], 255)
-    for hole in shape.holes_px:
-        cv2.fillPoly(inside, [_ring(hole)], 0)
     kernel = np.ones((3, 3), np.uint8)
-    inside = cv2.erode(inside, kernel)  # the outline's blended edge pixels are no opening
+    # the outline's blended edge pixels are no opening
+    inside = cv2.erode(_outline_mask(frame, shape), kernel)
     rim = cv2.subtract(inside, cv2.erode(inside, kernel))
     roof = _near(frame, shape.colour_rgb, 2 * tolerance_dn)
     other = cv2.bitwise_and(inside, cv2.bitwise_not(roof))
     count, labels, stats, _ = cv2.connectedComponentsWithStats(other, connectivity=8)
-    touching = set(np.unique(labels[rim > 0]).tolist())
+    touching = set(labels[rim > 0].tolist())
     return sum(
         1
         for label in range(1, count)
