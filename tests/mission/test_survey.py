@@ -50,3 +50,18 @@ def test_a_stepped_tower_flat_in_two_tour_photos_is_not_measured_at_its_lowest_t
     summary = fly(FlyConfig(scene=str(DATA / "town-11624.yaml"), no_record=True))
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == "b02"
+
+
+def test_a_stepped_tower_beside_home_is_not_measured_at_its_lowest_tier() -> None:
+    """Town scene 11921: home stands 4 m beside a stepped tower (tiers at 25.1, 41.0 and
+    50.3 m, nearly concentric). The second overview, 117 m over home, shows the upper tiers'
+    walls inside the lowest tier's outline, but each wall's strip ends where the tier above
+    meets the lower tier's edge, two pixels from the ground past the outline, and walls near
+    the ground were taken for a courtyard's. The overview and the photo from straight above
+    it then agreed on one flat roof at 25.4 m, and the mission descended to look at it from
+    48.7 m: into the top tier (a crash, reported as one). A wall whose foot, toward the
+    nadir, stands on roof is a higher tier's: the tower stays unmeasured, and the flight
+    completes."""
+    summary = fly(FlyConfig(scene=str(DATA / "town-11921.yaml"), no_record=True))
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == "b08"

@@ -74,3 +74,24 @@ def test_inner_walls_are_those_of_the_numpy_definition(
     assert len(got) == len(want)
     for a, b in zip(got, want, strict=True):
         assert a.dtype == b.dtype and np.array_equal(a, b)
+
+
+def test_a_wall_whose_foot_stands_on_the_roof_is_kept_though_its_end_nears_the_ground() -> None:
+    """With the photo's nadir known, a strip near the ground is dropped only when the ground
+    lies at its foot (its side toward the nadir): a courtyard's far wall. A higher tier's
+    wall whose end reaches the lower tier's edge stands on roof and is kept (town scene
+    11921's stepped tower: without the nadir, both are dropped)."""
+    roof, wall = (62, 51, 204), (49, 40, 162)
+    frame = np.full((100, 100, 3), GROUND, np.uint8)
+    frame[20:80, 20:80] = roof
+    frame[21:60, 60:64] = wall  # a tier's wall, its upper end 2 px from the ground
+    frame[40:56, 30:40] = GROUND  # a courtyard too narrow for the vectorizer's hole...
+    frame[40:56, 26:30] = wall  # ... and its far wall, the courtyard's floor at its foot
+    shape = Shape.from_rings(
+        colour_rgb=roof,
+        polygon_px=np.array([[20.0, 20.0], [79.0, 20.0], [79.0, 79.0], [20.0, 79.0]]),
+    )
+    assert inner_walls(frame, shape) == []
+    kept = inner_walls(frame, shape, nadir_px=(95.0, 50.0))
+    assert len(kept) == 1
+    assert set(kept[0][:, 0].tolist()) == {60, 61, 62, 63}

@@ -165,12 +165,15 @@ def not_flat(
     other_shape: Shape | None = None,
 ) -> bool:
     """Whether the walls seen inside ``shape``'s outline (a nadir ``photo``) show a part of
-    the building standing at least ``NOT_FLAT_M`` above the roof the outline is at. A wall
+    the building standing at least ``NOT_FLAT_M`` above the roof the outline is at: walls
+    whose foot, on their side toward the photo's nadir, is not the ground. A wall
     whose place on the roof ``other`` (another nadir photo) shows as ground, or falls in a
     hole of the roof's outline there (``other_shape``'s courtyards, which show ground
     somewhere), is a courtyard's far wall, going down, not a higher part's: a higher part
     shows from above as its walls on one side and its roof, never as a hole."""
-    walls = inner_walls(photo.image_rgb, shape)
+    x, y, z = photo.pose.pos_enu_m
+    u0, v0, _ = project(np.array([[x, y, z - 1.0]]), photo.pose, photo.intrinsics)[0]
+    walls = inner_walls(photo.image_rgb, shape, nadir_px=(float(u0), float(v0)))
     if other is not None and walls:
         ground = ground_mask(other.image_rgb)
         if other_shape is not None and other_shape.holes_px:

@@ -200,14 +200,25 @@ def ground_mask(frame_rgb: U8Array, *, tolerance_dn: int = 15) -> CvArray:
 
 
 def inner_walls(
-    frame_rgb: U8Array, shape: Shape, *, tolerance_dn: int = 15, least_px: int = 3
+    frame_rgb: U8Array,
+    shape: Shape,
+    *,
+    tolerance_dn: int = 15,
+    least_px: int = 3,
+    nadir_px: tuple[float, float] | None = None,
 ) -> list[npt.NDArray[np.int32]]:
     """The walls seen inside ``shape``'s roof: strips of another shade of its colour (the
-    same hue; grey for a grey roof) that touch neither the ground nor the outline. Seen from
-    above, a roof's own walls lie outside its outline, and a courtyard's go down to the
-    ground that shows between them: a wall inside the outline stands on this roof, under a
-    higher part of the building. Each strip is its ``(n, 2)`` pixels ``(u, v)``, at least
-    ``least_px`` of them."""
+    same hue; grey for a grey roof) that do not stand on the ground. Seen from above, a
+    roof's own walls lie outside its outline, and a courtyard's go down to the ground that
+    shows between them: a wall inside the outline that stands on this roof is under a higher
+    part of the building. Each strip is its ``(n, 2)`` pixels ``(u, v)``, at least
+    ``least_px`` of them.
+
+    Without ``nadir_px`` a strip that comes within two pixels of the ground is dropped. With
+    it (the photo's point straight below the camera), only a strip whose foot is on the
+    ground is: a wall's foot is its side toward the nadir, and a courtyard's wall has the
+    courtyard's floor there, while a higher tier's wall, whose ends may reach the lower
+    tier's edge, has the lower roof at its foot."""
     frame = _check_frame(frame_rgb)
     inside = roof_inside(frame, shape, inset_px=1, tolerance_dn=tolerance_dn)
     # a channel more than 2 * tolerance_dn from the roof's: inRange's exact integer test is
@@ -232,9 +243,44 @@ def inner_walls(
     out: list[npt.NDArray[np.int32]] = []
     for label in range(1, count):
         vs, us = np.nonzero(labels == label)
-        if len(us) >= least_px and not near_ground[vs, us].any():
-            out.append(np.stack([us, vs], axis=1).astype(np.int32))
+        if len(us) < least_px:
+            continue
+        if near_ground[vs, us].any() and (
+            nadir_px is None or _foot_on_ground(us, vs, labels == label, ground, nadir_px)
+        ):
+            continue
+        out.append(np.stack([us, vs], axis=1).astype(np.int32))
     return out
+
+
+_FOOT_PX = 2.0
+"""How far toward the nadir from a wall's pixel its foot is looked for: past the blended
+pixel at the wall's edge."""
+
+
+def _foot_on_ground(
+    us: npt.NDArray[np.intp],
+    vs: npt.NDArray[np.intp],
+    strip: npt.NDArray[np.bool_],
+    ground: CvArray,
+    nadir_px: tuple[float, float],
+) -> bool:
+    """Whether at least half of what lies beside the strip on its nadir side is ground."""
+    du, dv = nadir_px[0] - us, nadir_px[1] - vs
+    rho = np.hypot(du, dv)
+    away = rho >= _FOOT_PX  # a pixel under the camera shows no foot
+    if not away.any():
+        return True
+    step = _FOOT_PX / rho[away]
+    fu = np.round(us[away] + du[away] * step).astype(np.int64)
+    fv = np.round(vs[away] + dv[away] * step).astype(np.int64)
+    h, w = strip.shape
+    seen = (fu >= 0) & (fu < w) & (fv >= 0) & (fv < h)
+    fu, fv = fu[seen], fv[seen]
+    foot = ~strip[fv, fu]  # the strip's own pixels are no foot
+    if not foot.any():
+        return True
+    return float((ground[fv[foot], fu[foot]] > 0).mean()) >= 0.5
 
 
 def enclosed_openings(
