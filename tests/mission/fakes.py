@@ -30,7 +30,8 @@ from uavtool.mission import (
 from uavtool.world import Scene, render
 
 TICK_MS = 100
-REFUSED = "refused (MAV_RESULT_DENIED)"
+REFUSED = "refused (MAV_RESULT_TEMPORARILY_REJECTED)"
+DENIED = "refused (MAV_RESULT_DENIED)"
 INTRINSICS = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
 
 Vec3 = tuple[float, float, float]
@@ -46,7 +47,8 @@ class FakeVehicle:
     """An ArduCopter-like vehicle reduced to what the mission observes.
 
     ``refuse`` / ``ignore``: command key (see :func:`command_key`; ``SetMode`` matches every
-    mode) → how many of those commands to refuse / leave unanswered before behaving.
+    mode) → how many of those commands to refuse for now / leave unanswered before behaving.
+    ``deny``: command keys refused for good (``MAV_RESULT_DENIED``, a final answer).
     ``stuck``: GoTo targets are taken but the vehicle never moves toward them.
     ``airborne``: start there, armed and in LOITER, instead of on the ground at home.
     Rates: horizontal ``speed_m_s``, vertical ``climb_m_s``, yaw and gimbal in degrees/s.
@@ -64,6 +66,7 @@ class FakeVehicle:
         rtl_alt_m: float = 15.0,
         refuse: dict[str, int] | None = None,
         ignore: dict[str, int] | None = None,
+        deny: frozenset[str] = frozenset(),
         stuck: bool = False,
         airborne: Vec3 | None = None,
     ) -> None:
@@ -76,6 +79,7 @@ class FakeVehicle:
         self.rtl_alt_m = rtl_alt_m
         self.refuse = dict(refuse or {})
         self.ignore = dict(ignore or {})
+        self.deny = deny
         self.stuck = stuck
         self.time_ms = 0
         self.pos: Vec3 = (0.0, 0.0, 0.0)
@@ -136,6 +140,8 @@ class FakeVehicle:
                 self.goal = cmd.pos_enu_m
                 self.goal_heading_deg = cmd.heading_deg
             return CommandResult(cmd.id, True, "sent")
+        if command_key(cmd) in self.deny or type(cmd).__name__ in self.deny:
+            return CommandResult(cmd.id, False, DENIED, final=True)
         for table in (self.ignore, self.refuse):
             key = next((k for k in (command_key(cmd), type(cmd).__name__) if table.get(k)), None)
             if key is not None:

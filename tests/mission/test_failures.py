@@ -22,7 +22,7 @@ from tests.mission.driver import (
     fly,
     target_rgb,
 )
-from tests.mission.fakes import REFUSED, command_key
+from tests.mission.fakes import DENIED, REFUSED, command_key
 from uavtool.mission import (
     Arm,
     Command,
@@ -91,6 +91,23 @@ def test_command_failing_four_times_aborts_with_rtl(paper: Scene, kind: str, ans
         assert (
             max(o.pos_enu_m[2] for o in flown.flight.observations if isinstance(o, Telemetry)) == 0
         )
+
+
+@pytest.mark.parametrize("kind", ["Takeoff", "SetGimbal"])
+def test_a_command_refused_for_good_is_not_asked_again(paper: Scene, kind: str) -> None:
+    """MAV_RESULT_DENIED says that asking again will not work (an obstacle above home, a
+    command invalid as given): the mission ends at once, with the vehicle's answer as its
+    reason, and brings the vehicle down as after any abort (LAND on the ground, RTL in the
+    air)."""
+    flown = fly(paper, deny=frozenset({kind}))
+    what = "take-off to 45 m" if kind == "Takeoff" else "gimbal to -90°"
+    assert flown.outcome.status is Status.ABORTED
+    assert flown.outcome.reason == f"{what}: {DENIED}"
+    assert len(_sent_ms(flown.flight, kind)) == 1
+    assert not [t for t in flown.flight.texts() if "(attempt " in t]
+    modes = [c.mode for c in flown.flight.of_type(SetMode)]
+    assert modes[-1] == ("LAND" if kind == "Takeoff" else "RTL")
+    assert_home_safely(flown)
 
 
 def test_transient_refusals_and_silence_are_retried(paper: Scene) -> None:

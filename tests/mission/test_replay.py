@@ -138,7 +138,13 @@ def test_telemetry_round_trips_bit_for_bit(t: Telemetry) -> None:
 
 @given(
     st.one_of(
-        st.builds(CommandResult, st.integers(1, 2**31), st.booleans(), st.text(max_size=40)),
+        st.builds(
+            CommandResult,
+            st.integers(1, 2**31),
+            st.booleans(),
+            st.text(max_size=40),
+            st.booleans(),
+        ),
         st.builds(LinkLost, _finite),
         st.builds(LinkRestored, _finite),
     )
@@ -186,3 +192,10 @@ def test_malformed_observations_are_input_errors() -> None:
     )
     with pytest.raises(MissionInputError, match="image is missing"):
         decode_observation(encode_observation(photo))
+
+
+def test_a_command_result_recorded_before_final_existed_is_not_final() -> None:
+    """Recordings made before `CommandResult.final` have no such field: a refusal in them
+    replays as one the mission asked again after, as it did when it was flown."""
+    old = {"type": "CommandResult", "action_id": 7, "accepted": False, "detail": "refused"}
+    assert decode_observation(old) == CommandResult(7, False, "refused", final=False)

@@ -204,8 +204,9 @@ def test_a_crash_on_the_way_home_is_a_crash_whatever_came_before(tmp_path: Path)
 
 
 def test_a_refused_take_off_ends_disarmed_on_the_ground(tmp_path: Path) -> None:
-    """Home under a deck: the vehicle refuses the take-off; the mission does not send RTL
-    (its climb would hit the deck) but LAND, which disarms the vehicle where it stands."""
+    """Home under a deck: the vehicle refuses the take-off (MAV_RESULT_DENIED, a final
+    answer): the mission ends at once with the vehicle's reason, does not send RTL (its
+    climb would hit the deck) but LAND, which disarms the vehicle where it stands."""
     deck = [
         {"footprint": _square(-2.5, -2.5, 0.5), "top_m": 7},
         {"footprint": _square(0, 0, 3), "base_m": 7, "top_m": 8},
@@ -213,8 +214,11 @@ def test_a_refused_take_off_ends_disarmed_on_the_ground(tmp_path: Path) -> None:
     scene = _paper_with(tmp_path, "deck", deck, False)
     result = CliRunner().invoke(cli, ["fly", "--scene", str(scene), "--no-record"])
     assert result.exit_code == 1, result.output
-    assert "outcome        aborted: take-off to 45 m failed 4 times" in result.output
-    assert "Takeoff: obstacle above at 7.0 m" in result.output
+    assert (
+        "outcome        aborted: take-off to 45 m: refused (MAV_RESULT_DENIED): "
+        "Takeoff: obstacle above at 7.0 m\n" in result.output
+    )
+    assert "(attempt " not in result.output
     assert "still on the ground: LAND to disarm" in result.output
     assert "returning home (RTL)" not in result.output
     assert "landed and disarmed" in result.output

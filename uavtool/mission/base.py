@@ -366,7 +366,8 @@ class FlightMission:
         done: Callable[[Telemetry], bool] | None = None,
     ) -> Wait[None]:
         """Issue a command until the vehicle accepts it, or the telemetry shows it ``done``
-        (its ACK lost on the link); abort (RTL) after the retries."""
+        (its ACK lost on the link); abort (RTL) after the retries, or at once when the vehicle
+        refuses it for good (`CommandResult.final`)."""
         attempts = 1 + (self.flight.command_retries if retries < 0 else retries)
         detail = ""
         for attempt in range(1, attempts + 1):
@@ -376,6 +377,8 @@ class FlightMission:
             if result.accepted or (done is not None and self.last is not None and done(self.last)):
                 return
             detail = result.detail
+            if result.final:
+                raise MissionEnd(Status.ABORTED, f"{what}: {detail}")
             self.event(Level.WARNING, f"{what}: {detail} (attempt {attempt} of {attempts})")
             if attempt < attempts:
                 yield from self.pause(self.flight.retry_wait_s)

@@ -104,8 +104,11 @@ def decode_observation(data: dict[str, Any], image_rgb: U8Array | None = None) -
                 int(data["battery_pct"]),
             )
         if kind == "CommandResult":
-            return CommandResult(
-                int(data["action_id"]), bool(data["accepted"]), str(data["detail"])
+            return CommandResult(  # recordings before "final" have none: not final
+                int(data["action_id"]),
+                bool(data["accepted"]),
+                str(data["detail"]),
+                bool(data.get("final", False)),
             )
         if kind == "LinkLost":
             return LinkLost(float(data["silent_s"]))

@@ -51,11 +51,15 @@ class Telemetry:
 @dataclass(frozen=True, slots=True)
 class CommandResult:
     """The vehicle's answer to a command the mission issued (``action_id``): accepted, or
-    refused / unanswered with the reason."""
+    refused / unanswered with the reason. ``final``: the vehicle refused it as one that
+    asking again cannot change (MAVLink's ``MAV_RESULT_DENIED``: invalid as given, or
+    ``MAV_RESULT_UNSUPPORTED``); a temporary refusal, a failure (ArduPilot's answer while
+    its pre-arm checks or position estimate are not ready) or a lost ACK is not."""
 
     action_id: int
     accepted: bool
     detail: str = ""
+    final: bool = False
 
 
 @dataclass(frozen=True, slots=True)

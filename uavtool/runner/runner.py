@@ -253,15 +253,16 @@ class Runner:
         del self._pending[command]
         self._unacked.pop(command, None)
         accepted = result == M.MAV_RESULT_ACCEPTED
-        detail = "" if accepted else f"refused ({RESULT_NAMES.get(result, result)})"
+        detail = ""
         if not accepted:
             # The vehicle's reason is the warning it sent since the command (ArduPilot sends
             # it just before the ACK, PX4 around it); DO_MOUNT_CONTROL without a mount has none.
             said = self._warnings[-1] if len(self._warnings) > pending[2] else ""
-            name = COMMAND_NAMES.get(command, str(command))
-            self.last_refusal = f"{name} {detail}" + (f": {said}" if said else "")
-            self.vehicle_says(f"vehicle refused {self.last_refusal}")
-        self._queue.append(CommandResult(pending[0], accepted, detail))
+            detail = f"refused ({RESULT_NAMES.get(result, result)})" + (f": {said}" if said else "")
+            self.last_refusal = f"{COMMAND_NAMES.get(command, str(command))} {detail}"
+            self.vehicle_says(f"vehicle: {self.last_refusal}")
+        final = result in (M.MAV_RESULT_DENIED, M.MAV_RESULT_UNSUPPORTED)
+        self._queue.append(CommandResult(pending[0], accepted, detail, final))
 
     def _expire_acks(self, now_ms: int) -> None:
         limit_ms = self.config.ack_timeout_s * 1000.0
