@@ -14,7 +14,12 @@ from uavtool.mission.errors import MissionInputError
 from uavtool.mission.observations import Photo, U8Array
 from uavtool.mission.params import Params
 from uavtool.nav import NavError, frame_corners_px, frame_on_plane
-from uavtool.nav.heights import higher_part_m, outline_residual_px, roof_from_photos
+from uavtool.nav.heights import (
+    higher_part_m,
+    nadir_px,
+    outline_residual_px,
+    roof_from_photos,
+)
 from uavtool.vision import Shape, best_match, mirror_score, vectorize
 from uavtool.vision.merge import merge_touching
 from uavtool.vision.model3d import central_shape
@@ -171,9 +176,7 @@ def not_flat(
     hole of the roof's outline there (``other_shape``'s courtyards, which show ground
     somewhere), is a courtyard's far wall, going down, not a higher part's: a higher part
     shows from above as its walls on one side and its roof, never as a hole."""
-    x, y, z = photo.pose.pos_enu_m
-    u0, v0, _ = project(np.array([[x, y, z - 1.0]]), photo.pose, photo.intrinsics)[0]
-    walls = inner_walls(photo.image_rgb, shape, nadir_px=(float(u0), float(v0)))
+    walls = inner_walls(photo.image_rgb, shape, nadir_px=nadir_px(photo.pose, photo.intrinsics))
     if other is not None and walls:
         ground = ground_mask(other.image_rgb)
         if other_shape is not None and other_shape.holes_px:

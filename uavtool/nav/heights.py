@@ -323,6 +323,14 @@ def _reprojected(
     return out
 
 
+def nadir_px(pose: CameraPose, intrinsics: Intrinsics) -> tuple[float, float]:
+    """The pixel straight below the camera: where a wall's foot and top line up, the foot
+    nearer."""
+    x, y, z = pose.pos_enu_m
+    u0, v0, _ = project(np.array([[x, y, z - 1.0]]), pose, intrinsics)[0]
+    return float(u0), float(v0)
+
+
 def higher_part_m(
     walls_px: Sequence[npt.NDArray[np.int32]],
     pose: CameraPose,
@@ -340,9 +348,8 @@ def higher_part_m(
     for a photo not taken straight down."""
     if not walls_px or abs(pose.pitch_deg + 90.0) > _NADIR_DEG:
         return None
-    cam_x, cam_y, cam_z = pose.pos_enu_m
-    u0, v0, _ = project(np.array([[cam_x, cam_y, cam_z - 1.0]]), pose, intrinsics)[0]
-    above_m = cam_z - roof_m
+    u0, v0 = nadir_px(pose, intrinsics)
+    above_m = pose.pos_enu_m[2] - roof_m
     if not above_m > 0.0:
         return None
     tops: list[float] = []

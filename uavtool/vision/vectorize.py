@@ -242,11 +242,12 @@ def inner_walls(
     count, labels = cv2.connectedComponents(strips.astype(np.uint8), connectivity=8)
     out: list[npt.NDArray[np.int32]] = []
     for label in range(1, count):
-        vs, us = np.nonzero(labels == label)
+        strip = labels == label
+        vs, us = np.nonzero(strip)
         if len(us) < least_px:
             continue
         if near_ground[vs, us].any() and (
-            nadir_px is None or _foot_on_ground(us, vs, labels == label, ground, nadir_px)
+            nadir_px is None or _foot_on_ground(us, vs, strip, ground, nadir_px)
         ):
             continue
         out.append(np.stack([us, vs], axis=1).astype(np.int32))
