@@ -66,16 +66,18 @@ def test_fly_writes_where_it_is_told(
     """``uavtool fly --writer process|thread`` takes that writer whatever the load; ``auto``
     asks whether a core is free. The files are the same (above)."""
     import uavtool.runner.fly as runner
+    from uavtool.recording import writer
 
     made: list[str] = []
-    for name in ("ProcessWriter", "RecordingWriter"):
-        real = getattr(runner, name)
+    # fly imports the MCAP writer only when it writes on the flight's thread
+    for module, name in ((runner, "ProcessWriter"), (writer, "RecordingWriter")):
+        real = getattr(module, name)
 
         def spy(*args: object, _real: type = real, _name: str = name, **kw: object) -> object:
             made.append(_name)
             return _real(*args, **kw)
 
-        monkeypatch.setattr(runner, name, spy)
+        monkeypatch.setattr(module, name, spy)
     monkeypatch.setattr(runner, "core_to_spare", lambda: spare)
     out = tmp_path / "f.mcap"
     result = CliRunner().invoke(cli, ["fly", "--writer", choice, "-o", str(out), "-q"])

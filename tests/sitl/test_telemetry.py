@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from tests.sitl.client import Client
 from uavtool.mavlink import mavlink as M
+from uavtool.sitl.telemetry import Streams
 
 STREAMED = (
     "GLOBAL_POSITION_INT",
@@ -69,3 +70,15 @@ def test_landed_state_and_battery_drain(client: Client) -> None:
     ]
     used = [m.current_consumed for m in client.received if m.get_type() == "BATTERY_STATUS"]
     assert used[-1] > used[0]
+
+
+def test_a_stream_started_between_others_is_due_at_once() -> None:
+    """`Streams.due` skips the steps before the soonest stream is due; a stream turned on
+    (or sped up) in between is still sent at the next step, then at its rate."""
+    streams = Streams()
+    streams.due(0)  # every default stream, now
+    assert streams.due(1_000_000) == []  # none due 1 ms later
+    streams.set_interval(M.MAVLINK_MSG_ID_RAW_IMU, 50_000, 2_000_000)  # 20 Hz from 2 ms
+    assert streams.due(2_000_000) == [M.MAVLINK_MSG_ID_RAW_IMU]
+    assert streams.due(51_000_000) == []
+    assert M.MAVLINK_MSG_ID_RAW_IMU in streams.due(52_000_000)

@@ -19,6 +19,7 @@ from uavtool.link.freshness import FreshnessFilter
 from uavtool.link.transport import Transport
 from uavtool.mavlink.dialect import mavlink as M
 from uavtool.mavlink.framing import FrameParser, new_encoder
+from uavtool.mavlink.packing import pack
 
 GCS_SYSID = 255
 GCS_COMPID = M.MAV_COMP_ID_MISSIONPLANNER
@@ -171,7 +172,7 @@ class VehicleLink:
     # --- sending ------------------------------------------------------------------------------
 
     def send(self, msg: Any) -> None:
-        frame = bytes(msg.pack(self._mav))
+        frame = pack(msg, self._mav)
         self._mav.seq = (self._mav.seq + 1) % 256
         if self.tap is not None:
             self.tap("out", frame, None)

@@ -44,15 +44,10 @@ from types import TracebackType
 from typing import TYPE_CHECKING, Any, BinaryIO, NoReturn
 
 from uavtool.recording.errors import RecordingError, create_file
+from uavtool.recording.protocol import check_metadata, check_topic, foxglove_module
 from uavtool.recording.schemas import DEFAULT_DIALECT, dialect_module, dumps
 from uavtool.recording.topics import FIX, POSE
 from uavtool.recording.values import Direction, LocationFix, PosesInFrame
-from uavtool.recording.writer import (
-    RecordingWriter,
-    check_metadata,
-    check_topic,
-    foxglove_module,
-)
 
 if TYPE_CHECKING:
     from uavtool.geo import GeoPoint
@@ -287,8 +282,8 @@ class ProcessWriter:
             if topic not in self._protobuf_topics:
                 self._check_kind(topic, kind)
                 self._protobuf_topics.add(topic)
-                schema = (foxglove.schema_name(kind), foxglove.schema_data(kind))
-                self._batch.append((_PROTO_TOPIC, topic, *schema))
+                # the child makes the schema (mcap_protobuf imports mcap's writer, ~30 ms)
+                self._batch.append((_PROTO_TOPIC, topic, kind))
             elif self._topic_kind[topic] is not kind:
                 raise ValueError(f"topic {topic!r} carries {self._topic_kind[topic]!r}, not {kind}")
             op, payload = (_ENCODE, value) if deferred else (_PROTO, data)
@@ -437,6 +432,10 @@ def _abandon(proc: subprocess.Popen[bytes]) -> None:
 
 def serve() -> None:
     """The child's loop: an init tuple, then batches of calls on stdin; replies on stdout."""
+    # the MCAP writer, imported here: the flight's process, which imports this module too,
+    # never needs it
+    from uavtool.recording.writer import RecordingWriter  # noqa: PLC0415
+
     replies = os.fdopen(os.dup(1), "wb", buffering=0)
     sys.stdout = sys.stderr  # stdout carries replies only
     source = sys.stdin.buffer
@@ -514,7 +513,8 @@ def _serve(writer: Any, source: Any, reply: Any) -> None:
             elif op == _JSON:
                 write_json(call[1], call[2], log_time_ns=call[3], publish_time_ns=call[4])
             elif op == _PROTO_TOPIC:
-                protobuf[call[1]] = (call[2], call[3])
+                foxglove = foxglove_module()
+                protobuf[call[1]] = (foxglove.schema_name(call[2]), foxglove.schema_data(call[2]))
             elif op == _JSON_TOPIC:
                 writer.add_json_topic(call[1], schema_name=call[2], schema=call[3])
             elif op == _METADATA:

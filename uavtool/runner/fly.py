@@ -31,10 +31,9 @@ from uavtool.mission import Level, MissionInputs, Outcome, SearchMission
 from uavtool.mission.outputs import Result
 from uavtool.mission.params import to_dict, with_overrides
 from uavtool.plugins import DEFAULT, MissionRef, create_mission, resolve
-from uavtool.recording import ProcessWriter, RecordingError, RecordingWriter
+from uavtool.recording.errors import RecordingError
 from uavtool.recording.files import atomic_output
-from uavtool.recording.process import core_to_spare
-from uavtool.recording.writer import MessageWriter
+from uavtool.recording.process import ProcessWriter, core_to_spare
 from uavtool.runner.backends import open_backend
 from uavtool.runner.camera import open_camera
 from uavtool.runner.evaluate import Evaluation, evaluate
@@ -47,7 +46,7 @@ from uavtool.runner.runner import Progress, Runner
 from uavtool.world import Scene, load_scene, render, scene_to_dict
 
 if TYPE_CHECKING:
-    pass
+    from uavtool.recording.protocol import MessageWriter
 
 _TARGET_VIEW_M = 30.0  # the default target picture: from this far above its roof
 
@@ -214,6 +213,8 @@ def fly(
             if in_process is None:
                 in_process = not core_to_spare()
             if in_process:
+                from uavtool.recording.writer import RecordingWriter  # noqa: PLC0415 - only to write here
+
                 writer = stack.enter_context(RecordingWriter(partial, metadata=metadata))
             else:
                 writer = stack.enter_context(ProcessWriter(partial, metadata=metadata))

@@ -40,6 +40,7 @@ from uavtool.recording import (
     SceneMarkers,
     TriangleMesh,
 )
+from uavtool.recording.protocol import MessageWriter
 from uavtool.recording.topics import (
     CALIBRATION,
     CAMERA_POSE,
@@ -52,7 +53,6 @@ from uavtool.recording.topics import (
     SCENE,
     TARGET,
 )
-from uavtool.recording.writer import MessageWriter
 from uavtool.runner.markers import RouteMarkers
 
 _LEVELS = {Level.INFO: LogLevel.INFO, Level.WARNING: LogLevel.WARNING, Level.ERROR: LogLevel.ERROR}

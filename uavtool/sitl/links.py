@@ -21,6 +21,7 @@ from typing import Any
 from uavtool.errors import LinkError
 from uavtool.mavlink.fields import misfit
 from uavtool.mavlink.framing import Frame, FrameParser, new_encoder
+from uavtool.mavlink.packing import pack
 
 log = logging.getLogger(__name__)
 
@@ -134,7 +135,7 @@ class Link:
         if self.closed:
             return
         try:
-            buf = msg.pack(self.encoder)
+            buf = pack(msg, self.encoder)
         except (struct.error, OverflowError, ValueError, TypeError) as exc:
             self.unsendable += 1
             log.error("%s: %s not sent: %s", self.name, msg.get_type(), misfit(msg) or exc)

@@ -65,6 +65,9 @@ class State:
     on_ground: bool = True
 
 
+_CALM = [0.0, 0.0, 0.0]
+
+
 def sqrt_controller(error: float, p_gain: float, accel_max: float) -> float:
     """ArduPilot's sqrt controller: linear near zero, constant-deceleration far away."""
     linear_dist = accel_max / (p_gain * p_gain)
@@ -117,11 +120,16 @@ class Multicopter:
             ax, ay = ax * k, ay * k
         az = max(-lim.accel_z_mss * 2.5, min(lim.accel_z_mss * 2.5, az))
         self._update_gust(dt_s)
-        airborne = s.pos_ned_m[2] < 0.0
-        for i, a in enumerate((ax, ay, az)):
-            s.accel_ned_mss[i] = a
-            s.vel_ned_ms[i] += a * dt_s
-            s.pos_ned_m[i] += (s.vel_ned_ms[i] + self._gust[i]) * dt_s
+        acc, vel, pos, gust = s.accel_ned_mss, s.vel_ned_ms, s.pos_ned_m, self._gust
+        airborne = pos[2] < 0.0
+        # each axis as a loop over them would, unrolled (every step of every flight)
+        acc[0], acc[1], acc[2] = ax, ay, az
+        vel[0] += ax * dt_s
+        vel[1] += ay * dt_s
+        vel[2] += az * dt_s
+        pos[0] += (vel[0] + gust[0]) * dt_s
+        pos[1] += (vel[1] + gust[1]) * dt_s
+        pos[2] += (vel[2] + gust[2]) * dt_s
         self._update_attitude(ax, ay)
         self._update_yaw(dt_s)
         if s.pos_ned_m[2] >= 0.0:
@@ -176,7 +184,8 @@ class Multicopter:
 
     def _update_gust(self, dt_s: float) -> None:
         if self.turbulence_ms <= 0.0:
-            self._gust = [0.0, 0.0, 0.0]
+            if self._gust != _CALM:
+                self._gust = [0.0, 0.0, 0.0]
             return
         # Ornstein-Uhlenbeck gusts with a 2 s correlation time.
         decay = math.exp(-dt_s / 2.0)
@@ -191,8 +200,9 @@ class Multicopter:
         fx = ax - self.DRAG_PER_S * (wind[0] - s.vel_ned_ms[0])
         fy = ay - self.DRAG_PER_S * (wind[1] - s.vel_ned_ms[1])
         yaw = math.radians(s.yaw_deg)
-        forward = fx * math.cos(yaw) + fy * math.sin(yaw)
-        right = -fx * math.sin(yaw) + fy * math.cos(yaw)
+        cos_yaw, sin_yaw = math.cos(yaw), math.sin(yaw)
+        forward = fx * cos_yaw + fy * sin_yaw
+        right = -fx * sin_yaw + fy * cos_yaw
         lean = self.limits.lean_max_deg
         s.pitch_deg = max(-lean, min(lean, -math.degrees(math.atan2(forward, GRAVITY_MSS))))
         s.roll_deg = max(-lean, min(lean, math.degrees(math.atan2(right, GRAVITY_MSS))))

@@ -233,7 +233,7 @@ class Sitl:
         now = ap.now_ns + self.dt_ns
         ap.tick(now, self.dt_ns / _NS)
         self.steps += 1
-        self.link_down = any(a <= now < b for a, b in self._outages_ns)
+        self.link_down = bool(self._outages_ns) and any(a <= now < b for a, b in self._outages_ns)
         if self.link_down:
             ap.events.clear()  # what the vehicle says during an outage is lost
             return

@@ -383,6 +383,9 @@ class Telemetry:
         return low_pitch, high_pitch, low_yaw, high_yaw
 
 
+_NEVER_NS = 1 << 63
+
+
 class Streams:
     """Per-link stream schedule: message id → (interval ns, next due ns)."""
 
@@ -391,6 +394,7 @@ class Streams:
             mid: round(_NS / hz) for mid, hz in DEFAULT_RATES_HZ.items()
         }
         self._next_ns: dict[int, int] = dict.fromkeys(self.interval_ns, 0)
+        self._soonest_ns = 0  # no stream is due before this (most steps send nothing)
 
     def set_interval(self, msg_id: int, interval_us: float, now_ns: int) -> None:
         """MAV_CMD_SET_MESSAGE_INTERVAL semantics: -1 off, 0 default, else µs."""
@@ -408,17 +412,26 @@ class Streams:
         else:
             self.interval_ns[msg_id] = max(round(interval_us * 1000), 1_000_000)  # ≤ 1 kHz
         self._next_ns[msg_id] = now_ns
+        self._soonest_ns = min(self._soonest_ns, now_ns)
 
     def set_rate_hz(self, msg_id: int, hz: float, now_ns: int) -> None:
         self.set_interval(msg_id, -1 if hz <= 0 else 1e6 / hz, now_ns)
 
     def due(self, now_ns: int) -> list[int]:
+        if now_ns < self._soonest_ns:
+            return []
         out = []
-        for mid, due_ns in self._next_ns.items():
+        soonest = _NEVER_NS
+        next_ns = self._next_ns
+        for mid, due_ns in next_ns.items():
+            next_due = due_ns
             if now_ns >= due_ns:
                 out.append(mid)
                 interval = self.interval_ns[mid]
                 # Keep the phase; if we fell far behind, restart from now rather than burst.
                 following = due_ns + interval
-                self._next_ns[mid] = following if following > now_ns else now_ns + interval
+                next_due = next_ns[mid] = following if following > now_ns else now_ns + interval
+            if next_due < soonest:  # noqa: PLR1730 (no min() call: every stream, every step)
+                soonest = next_due
+        self._soonest_ns = soonest
         return out
