@@ -19,7 +19,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import TYPE_CHECKING, Any, BinaryIO
 
-from mcap.writer import LIBRARY_IDENTIFIER
+from mcap import __version__ as mcap_version
 
 from uavtool import __version__
 from uavtool.geo import GeoPoint, geo_from_enu
@@ -49,7 +49,9 @@ from uavtool.recording.values import Direction, LocationFix, PosesInFrame
 if TYPE_CHECKING:
     from uavtool.recording.foxglove import FoxgloveValue
 
-LIBRARY = f"uavtool/{__version__}; {LIBRARY_IDENTIFIER}"
+# mcap's Writer names itself so (its LIBRARY_IDENTIFIER); importing mcap.writer for the name
+# alone costs ~70 ms (the file is written by McapEncoder)
+LIBRARY = f"uavtool/{__version__}; mcap-python/{mcap_version}"
 
 
 class RecordingWriter:
