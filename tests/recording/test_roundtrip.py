@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 from mcap_protobuf.decoder import DecoderFactory
+from mcap_protobuf.schema import build_file_descriptor_set
 
 from tests.recording.sample import OBS_SCHEMA, T0_NS, mavlink_frames, other_values, write_sample
 from uavtool.recording import (
@@ -21,6 +22,7 @@ from uavtool.recording import (
     RecordingWriter,
     TopicNotFoundError,
     UnknownSchemaError,
+    foxglove,
 )
 from uavtool.recording.schemas import dialect_module, mavlink_schema
 
@@ -201,3 +203,13 @@ def test_files_without_a_summary_are_scanned(tmp_path: Path) -> None:
         assert not reader.health.indexed
         frames = [e.value for e in reader.entries(["/mavlink/raw"])]
     assert frames == [MavlinkFrame(Direction.IN, f) for _, f in mavlink_frames(10)]
+
+
+def test_schemas_are_the_file_descriptor_sets_mcap_protobuf_builds() -> None:
+    """`foxglove.file_descriptor_set` walks the descriptors itself (mcap_protobuf's module
+    imports mcap's writer): the bytes must be mcap_protobuf's, for every schema written."""
+
+    for value_type, pb_class in foxglove._PB_CLASS.items():
+        theirs = build_file_descriptor_set(pb_class).SerializeToString(deterministic=True)
+        assert foxglove.schema_data(value_type) == theirs, pb_class.DESCRIPTOR.full_name
+        assert len(foxglove.FileDescriptorSet.FromString(theirs).file) > 1  # with its imports

@@ -19,6 +19,7 @@ from foxglove_schemas_protobuf.LocationFix_pb2 import LocationFix as PbLocationF
 from foxglove_schemas_protobuf.Log_pb2 import Log as PbLog
 from foxglove_schemas_protobuf.PosesInFrame_pb2 import PosesInFrame as PbPosesInFrame
 from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate as PbSceneUpdate
+from google.protobuf.descriptor_pb2 import FileDescriptorSet  # type: ignore[import-untyped]
 
 from uavtool.glb import mesh_glb
 from uavtool.recording.scene import decode_markers, encode_markers
@@ -73,12 +74,27 @@ def schema_data(value_type: type) -> bytes:
     """The serialized FileDescriptorSet MCAP stores as the channel's schema."""
     data = _SCHEMA_DATA.get(value_type)
     if data is None:
-        # mcap_protobuf imports mcap's writer and importlib.metadata (~30 ms): reading needs none
-        from mcap_protobuf.schema import build_file_descriptor_set  # noqa: PLC0415
-
-        fds = build_file_descriptor_set(_PB_CLASS[value_type])
-        data = _SCHEMA_DATA[value_type] = bytes(fds.SerializeToString(deterministic=True))
+        data = _SCHEMA_DATA[value_type] = file_descriptor_set(_PB_CLASS[value_type])
     return data
+
+
+def file_descriptor_set(pb_class: Any) -> bytes:
+    """mcap_protobuf's ``build_file_descriptor_set(pb_class)``, serialized deterministically:
+    the class's file after every file it depends on, each once. Its module imports mcap's
+    writer (~70 ms, of a writer process that needs none of it), so the walk is made here; a
+    test holds the two byte-identical for every schema uavtool writes."""
+    files = FileDescriptorSet()
+    seen: set[str] = set()
+
+    def add(file: Any) -> None:
+        for dep in file.dependencies:
+            if dep.name not in seen:
+                seen.add(dep.name)
+                add(dep)
+        file.CopyToProto(files.file.add())
+
+    add(pb_class.DESCRIPTOR.file)
+    return bytes(files.SerializeToString(deterministic=True))
 
 
 def deferred(value: FoxgloveValue) -> bool:

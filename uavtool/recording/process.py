@@ -282,7 +282,7 @@ class ProcessWriter:
             if topic not in self._protobuf_topics:
                 self._check_kind(topic, kind)
                 self._protobuf_topics.add(topic)
-                # the child makes the schema (mcap_protobuf imports mcap's writer, ~30 ms)
+                # the child makes the schema, off the flight's path
                 self._batch.append((_PROTO_TOPIC, topic, kind))
             elif self._topic_kind[topic] is not kind:
                 raise ValueError(f"topic {topic!r} carries {self._topic_kind[topic]!r}, not {kind}")
