@@ -21,7 +21,13 @@ folder of its own, whatever ``PYTHONDONTWRITEBYTECODE`` says): an installed pack
 ``.pyc`` files, and compiling uavtool's ~150 modules again costs every command ~0.2 s. The
 report names the machine (cores, load average before and after) and both commits.
 
-    python benchmarks/bench_fly.py [--quick] [--runs N] [--baseline COMMIT]
+    python benchmarks/bench_fly.py [--quick] [--runs N] [--baseline COMMIT] [--instructions]
+
+``--instructions``: instead, each command once under valgrind's callgrind (when valgrind is
+installed), counting the instructions its process and its children (the writer process)
+execute: ~50x slower, but the count moves by well under 1 % between runs, where the wall
+time of a command on a shared virtual machine moves by 20-40 %. It shows what a change
+saves; the wall time shows what a user waits.
 
 ``--quick``: one round (``--runs 1``). The baseline commit must be in the clone (``git fetch
 --unshallow`` in a shallow one). A command the baseline cannot run here is reported with its
@@ -35,6 +41,7 @@ import argparse
 import math
 import os
 import resource
+import shutil
 import statistics
 import subprocess
 import sys
@@ -94,11 +101,7 @@ def run(
     system time of the process, its threads and its children (the writer process), which
     other work on the machine changes much less than the wall time. Bytecode is cached under
     ``pycache``."""
-    env = dict(os.environ)
-    env.pop("PYTHONDONTWRITEBYTECODE", None)
-    env["PYTHONPYCACHEPREFIX"] = str(pycache)
-    if pythonpath is not None:
-        env["PYTHONPATH"] = str(pythonpath)
+    env = _env(pycache, pythonpath)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     done = subprocess.run(
@@ -116,6 +119,50 @@ def run(
         lines = (done.stderr or done.stdout).strip().splitlines() or [f"exit {done.returncode}"]
         return math.nan, math.nan, lines[-1]
     return wall, cpu, None
+
+
+def _env(pycache: Path, pythonpath: Path | None) -> dict[str, str]:
+    env = dict(os.environ)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    env["PYTHONPYCACHEPREFIX"] = str(pycache)
+    if pythonpath is not None:
+        env["PYTHONPATH"] = str(pythonpath)
+    return env
+
+
+def instructions(
+    args: list[str], *, cwd: Path, pycache: Path, pythonpath: Path | None = None
+) -> tuple[int, int]:
+    """Instructions executed by ``python ARGS`` (callgrind's count) and by its children, in
+    one run: (the process's, its children's)."""
+    with tempfile.TemporaryDirectory() as out:
+        proc = subprocess.Popen(
+            [
+                "valgrind",
+                "--tool=callgrind",
+                "--trace-children=yes",
+                f"--callgrind-out-file={out}/%p.out",
+                sys.executable,
+                *args,
+            ],
+            cwd=cwd,
+            env=_env(pycache, pythonpath),
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        _, err = proc.communicate()
+        if proc.returncode != 0:
+            raise SystemExit(f"valgrind python {' '.join(args)} failed: {err.strip()[-300:]}")
+        own = children = 0
+        for path in Path(out).glob("*.out"):
+            text = path.read_text(errors="replace")
+            total = int(text.split("\nsummary: ", 1)[1].split()[0])
+            if path.name == f"{proc.pid}.out":  # valgrind runs the program in its own process
+                own = total
+            else:
+                children += total
+        return own, children
 
 
 def _runs(times: list[float]) -> str:
@@ -154,6 +201,11 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="the smallest run: --runs 1")
     parser.add_argument("--runs", type=int, default=5, help="rounds (default: %(default)s)")
     parser.add_argument("--baseline", default=BASELINE, help="the commit to compare with")
+    parser.add_argument(
+        "--instructions",
+        action="store_true",
+        help="count instructions under valgrind's callgrind instead of timing (slow)",
+    )
     if parser.parse_known_args()[0].quick:
         parser.set_defaults(runs=1)
     args = parser.parse_args()
@@ -187,6 +239,9 @@ def main() -> None:
         today_cpu: dict[str, list[float]] = {k: [] for k in commands}
         then_cpu: dict[str, list[float]] = {k: [] for k in commands}
         failed: dict[str, str] = {}  # the baseline's failures (e.g. on a newer Python)
+        if args.instructions:
+            count_instructions(commands, tmp, base, args.baseline)
+            return
         load_before, spare_before = _load(), core_to_spare()
         for i in range(n + 1):  # round 0 fills the bytecode caches: not counted
             for name, (now_args, base_args) in commands.items():
@@ -257,6 +312,54 @@ def main() -> None:
         f"  the flight alone, in-process, recording on: {vehicle_s:.1f} vehicle s in "
         f"{wall_s:.2f} s wall = {rate:.0f}x (median of {n})"
     )
+
+
+def count_instructions(
+    commands: dict[str, tuple[list[str], list[str] | None]], tmp: Path, base: Path, baseline: str
+) -> None:
+    """Each command once under callgrind, today and on the baseline (bytecode cached first),
+    and the ratios. The baseline writes its recording on the flight's thread: both of today's
+    writers are compared with its `fly` (the writer process: both processes together)."""
+    if shutil.which("valgrind") is None:
+        raise SystemExit("--instructions needs valgrind (Debian: apt install valgrind)")
+    # today's command -> the baseline's
+    pairs = {
+        "fly --no-record": "fly --no-record",
+        "fly, writer process": "fly",
+        "fly, writer in thread": "fly",
+        "replay --check": "replay --check",
+        "--version": "--version",
+    }
+    today: dict[str, tuple[int, int]] = {}
+    then: dict[str, tuple[int, int]] = {}
+    for name, base_name in pairs.items():
+        now_args = commands[name][0]
+        run(now_args, cwd=tmp, pycache=tmp / "pyc-today")  # bytecode caches, as timed runs have
+        today[name] = instructions(now_args, cwd=tmp, pycache=tmp / "pyc-today")
+        base_args = commands[base_name][1]
+        if base_args is not None and base_name not in then:
+            run(base_args, cwd=tmp, pycache=tmp / "pyc-base", pythonpath=base)
+            then[base_name] = instructions(
+                base_args, cwd=tmp, pycache=tmp / "pyc-base", pythonpath=base
+            )
+    python = ".".join(str(v) for v in sys.version_info[:3])
+    print("uavtool (paper, defaults): instructions executed, callgrind, one run each")
+    print(f"  today {_commit('HEAD')}, baseline {_commit(baseline)}; Python {python}")
+    print(f"  {'G = 1e9':<22} {'today':>16} {baseline:>9} {'ratio':>7}   (+ the writer process)")
+    for name, base_name in pairs.items():
+        own, child = today[name]
+        shown = f"{own / 1e9:.3f} G" + (f" + {child / 1e9:.3f}" if child else "")
+        b = sum(then[base_name])
+        print(f"  {name:<22} {shown:>16} {b / 1e9:7.3f} G {(own + child) / b:6.3f}x")
+    bare = sum(today["fly --no-record"])
+    for name in ("fly, writer process", "fly, writer in thread"):
+        own, child = today[name]
+        print(
+            f"  recording's work over --no-record, {name[5:]}: the flight's process "
+            f"{(own - bare) / bare * 100:+.1f} %, in all {(own + child - bare) / bare * 100:+.1f} %"
+        )
+    base_share = sum(then["fly"]) / sum(then["fly --no-record"]) - 1
+    print(f"  {baseline}'s (on the flight's thread): {base_share * 100:+.1f} %")
 
 
 if __name__ == "__main__":
