@@ -1,4 +1,4 @@
-"""`packing.frame` makes the frames the built-in vehicle and the link send: they must be
+"""`packing.pack` makes the frames the built-in vehicle and the link send: they must be
 pymavlink's own ``pack``, byte for byte, for every message type of the dialect, any values,
 any sender and sequence; what pymavlink cannot pack, neither can it; a signing sender is
 left to pymavlink."""

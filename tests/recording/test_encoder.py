@@ -149,5 +149,5 @@ def test_recording_writer_file_equals_the_bare_mcap_writer_file(tmp_path: Path) 
 
 def test_the_header_names_mcaps_writer_as_it_names_itself() -> None:
     """The writer builds mcap's library name from mcap's version (its writer module is
-    ~70 ms to import); it must be the very name mcap's Writer gives."""
+    ~15 ms to import); it must be the very name mcap's Writer gives."""
     assert LIBRARY.endswith(f"; {LIBRARY_IDENTIFIER}")

@@ -208,7 +208,6 @@ def test_files_without_a_summary_are_scanned(tmp_path: Path) -> None:
 def test_schemas_are_the_file_descriptor_sets_mcap_protobuf_builds() -> None:
     """`foxglove.file_descriptor_set` walks the descriptors itself (mcap_protobuf's module
     imports mcap's writer): the bytes must be mcap_protobuf's, for every schema written."""
-
     for value_type, pb_class in foxglove._PB_CLASS.items():
         theirs = build_file_descriptor_set(pb_class).SerializeToString(deterministic=True)
         assert foxglove.schema_data(value_type) == theirs, pb_class.DESCRIPTOR.full_name

@@ -20,8 +20,8 @@ TOOL_METADATA = "uavtool"  # name of the metadata record the writer adds itself
 
 @cache
 def foxglove_module() -> ModuleType:
-    """`uavtool.recording.foxglove`, imported when first needed: a writer process is handed
-    Foxglove messages already encoded, and needs none of Foxglove's modules."""
+    """`uavtool.recording.foxglove`, imported when first needed: a writer that is given no
+    Foxglove value (a telemetry log's import, say) needs none of Foxglove's modules."""
     return importlib.import_module("uavtool.recording.foxglove")
 
 
