@@ -24,7 +24,8 @@ What is kept:
 The child is a fresh interpreter (`subprocess`, never a fork: the flight may run threads,
 and in a Dask worker it is a daemon) with the parent's ``sys.path``; it imports the writer,
 pymavlink's dialect and Foxglove's schemas (~0.1 s of CPU on the other core while the flight
-starts), then OpenCV and trimesh in the background, for the frames' PNGs and the model's GLB.
+starts), then OpenCV in the background, for the frames' PNGs (`uavtool.glb` makes the model's
+GLB with numpy alone).
 """
 
 from __future__ import annotations
@@ -455,10 +456,9 @@ def serve() -> None:
             fsync=fsync,
             file=os.fdopen(fd, "wb"),
         )
-        # What the frames' PNGs and a model's GLB need (~0.2 s to import): ready before they
-        # come, the model near a flight's end, where the flight would wait for the import at
-        # close.
-        threading.Thread(target=_import_quietly, args=("cv2", "trimesh"), daemon=True).start()
+        # What the frames' PNGs need (~0.1 s to import), ready before the first photo comes
+        # (else the writer stops for it there, and the flight too once the pipe is full)
+        threading.Thread(target=_import_quietly, args=("cv2",), daemon=True).start()
         _serve(writer, source, reply)
     except RecordingError as exc:
         reply("error", exc.path, exc.problem)
