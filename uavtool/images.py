@@ -17,6 +17,7 @@ import numpy as np
 import numpy.typing as npt
 
 from uavtool.errors import InputError
+from uavtool.png import rgb_png
 
 U8Array = npt.NDArray[np.uint8]
 
@@ -30,14 +31,14 @@ _JPEG_SOF = frozenset(range(0xC0, 0xD0)) - {0xC4, 0xC8, 0xCC}
 
 
 def png_encode(rgb: U8Array) -> bytes:
-    """(H, W, 3) uint8 RGB → PNG bytes. No adaptive filtering: ~3× faster, nearly as small."""
-    import cv2  # noqa: PLC0415 - keep importing uavtool light
+    """(H, W, 3) uint8 RGB → PNG bytes (:func:`uavtool.png.rgb_png`: unfiltered rows, zlib
+    level 3; as fast as OpenCV's quickest settings, and as small for rendered frames).
 
-    params = [cv2.IMWRITE_PNG_COMPRESSION, 3, cv2.IMWRITE_PNG_FILTER, cv2.IMWRITE_PNG_FILTER_SUB]
-    ok, buf = cv2.imencode(".png", _swap_red_blue(rgb), params)
-    if not ok:
-        raise ValueError("PNG encoding failed")
-    return bytes(buf)
+    Raises ValueError for an array of another shape or type."""
+    if rgb.ndim != 3 or rgb.shape[2] != 3 or rgb.dtype != np.uint8:
+        raise ValueError(f"PNG encoding takes (H, W, 3) uint8 RGB, not {rgb.shape} {rgb.dtype}")
+    height, width = rgb.shape[:2]
+    return rgb_png(np.ascontiguousarray(rgb).data, height, width)
 
 
 def png_decode(data: bytes, *, where: str = "image") -> U8Array:

@@ -22,6 +22,7 @@ from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate as PbSceneUpda
 from google.protobuf.descriptor_pb2 import FileDescriptorSet  # type: ignore[import-untyped]
 
 from uavtool.glb import mesh_glb
+from uavtool.png import rgb_png
 from uavtool.recording.scene import decode_markers, encode_markers
 from uavtool.recording.values import (
     CameraCalibration,
@@ -106,12 +107,7 @@ def deferred(value: FoxgloveValue) -> bool:
 
 
 def _png(image: RgbImage) -> bytes:
-    import numpy as np  # noqa: PLC0415 — a writer process imports numpy for frames only
-
-    from uavtool.images import png_encode  # noqa: PLC0415
-
-    shape = (image.height_px, image.width_px, 3)
-    return png_encode(np.frombuffer(image.pixels, dtype=np.uint8).reshape(shape))
+    return rgb_png(image.pixels, image.height_px, image.width_px)
 
 
 def _stamp(pb: Any, t_ns: int) -> None:

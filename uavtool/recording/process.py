@@ -24,15 +24,14 @@ What is kept:
 The child is a fresh interpreter (`subprocess`, never a fork: the flight may run threads,
 and in a Dask worker it is a daemon) with the parent's ``sys.path``; it imports the writer,
 pymavlink's dialect and Foxglove's schemas (~0.1 s of CPU on the other core while the flight
-starts), then OpenCV in the background, for the frames' PNGs (`uavtool.glb` makes the model's
-GLB with numpy alone).
+starts), and neither numpy nor OpenCV nor trimesh: `uavtool.png` makes the frames' PNGs and
+`uavtool.glb` the model's GLB in plain Python.
 """
 
 from __future__ import annotations
 
 import contextlib
 import fcntl
-import importlib
 import json
 import os
 import pickle
@@ -456,9 +455,6 @@ def serve() -> None:
             fsync=fsync,
             file=os.fdopen(fd, "wb"),
         )
-        # What the frames' PNGs need (~0.1 s to import), ready before the first photo comes
-        # (else the writer stops for it there, and the flight too once the pipe is full)
-        threading.Thread(target=_import_quietly, args=("cv2",), daemon=True).start()
         _serve(writer, source, reply)
     except RecordingError as exc:
         reply("error", exc.path, exc.problem)
@@ -468,12 +464,6 @@ def serve() -> None:
         # the file is closed (or, the flight gone, its chunks flushed) and the reply sent: an
         # interpreter's orderly exit would keep the flight waiting ~50 ms more at its close
         os._exit(0)
-
-
-def _import_quietly(*names: str) -> None:
-    for name in names:
-        with contextlib.suppress(Exception):  # not installed, broken: the encoder will say so
-            importlib.import_module(name)
 
 
 def _serve(writer: Any, source: Any, reply: Any) -> None:
