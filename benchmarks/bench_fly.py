@@ -2,15 +2,16 @@
 today against commit ``BASELINE`` (675267c: before the recording-speed work, issue "Recording
 at the speed of the flight"), in one run, as ratios:
 
-- ``fly`` (records to ``recordings/``), goal <= 1.0 s;
+- ``fly`` (records to ``recordings/``), goal <= 1.0 s, and as a ratio to the baseline
+  <= 0.621 (`GOAL_RATIO`: the goal over the baseline's time where the goal was set);
 - ``fly --no-record``, and the recording's share of ``fly`` over it, goal <= 10 %;
 - ``fly`` with each writer forced (``uavtool fly`` picks one by the machine's load: a writer
   process when a core is free, else the flight's own thread; the file is the same), today
   only;
 - ``fly --no-record --rerun FILE.rrd`` (today at its default pace; the baseline needed
   ``--speedup max`` for that, and took the flight's vehicle time, ~229 s, without it);
-- ``replay --check recordings/golden/paper.mcap``, goal <= 0.5 s (the baseline replays its
-  own commit's golden: the golden's format moved on since);
+- ``replay --check recordings/golden/paper.mcap``, goal <= 0.5 s, and as a ratio <= 0.746
+  (the baseline replays its own commit's golden: the golden's format moved on since);
 - ``uavtool --version``: start-up;
 - and the flight alone, in this process: vehicle seconds per wall second.
 
@@ -56,6 +57,12 @@ from uavtool.runner.fly import FlyConfig, fly
 
 ROOT = Path(__file__).resolve().parents[1]
 BASELINE = "675267c"
+# The issue's goals (fly <= 1.0 s, replay --check <= 0.5 s) were set on a machine where the
+# baseline's fly took 1.61 s and its --no-record 1.20 s (the issue's figures), and its replay
+# --check 0.67 s (a1c4b89's run there, whose 675267c --no-record took those 1.20 s). This
+# machine's speed moves by up to 1.8x within a day, so each goal is also judged as that ratio
+# to the baseline, measured in the same run.
+GOAL_RATIO = {"fly": 1.0 / 1.61, "replay --check": 0.5 / 0.67}
 GOLDEN = "recordings/golden/paper.mcap"
 # ``uavtool ARGS`` with fly's choice of writer forced (``spare``: whether a core is free); the
 # entry point's thread setting is made before numpy loads, as `uavtool` makes it
@@ -171,6 +178,13 @@ def _runs(times: list[float]) -> str:
 
 def _goal(value: float, limit: float) -> str:
     return "met" if value <= limit else "NOT met"
+
+
+def _scaled(today: dict[str, list[float]], then: dict[str, list[float]], name: str) -> str:
+    """The goal of ``name`` as a ratio to the baseline (`GOAL_RATIO`), judged."""
+    ratio = statistics.median(today[name]) / statistics.median(then[name])
+    limit = GOAL_RATIO[name]
+    return f"as a ratio to the baseline (<= {limit:.3f}): {_goal(ratio, limit)} ({ratio:.3f})"
 
 
 def _commit(rev: str) -> str:
@@ -295,7 +309,9 @@ def main() -> None:
     base_share = med(then["fly"]) / med(then["fly --no-record"]) - 1.0
     base_cpu_share = med(then_cpu["fly"]) / med(then_cpu["fly --no-record"]) - 1.0
     check_s = med(today["replay --check"])
-    print(f"  goal fly <= 1.0 s: {_goal(fly_s, 1.0)} ({fly_s:.2f} s)")
+    print(
+        f"  goal fly <= 1.0 s: {_goal(fly_s, 1.0)} ({fly_s:.2f} s); {_scaled(today, then, 'fly')}"
+    )
     print(
         f"  recording's share over --no-record (goal <= 10 %), wall and CPU: baseline "
         f"{base_share * 100:+.1f} %, {base_cpu_share * 100:+.1f} %; file {size / 1e6:.2f} MB"
@@ -306,7 +322,10 @@ def main() -> None:
         print(
             f"    {name:<22} {share * 100:+6.1f} %, {cpu_share * 100:+6.1f} %: {_goal(share, 0.10)}"
         )
-    print(f"  goal replay --check <= 0.5 s: {_goal(check_s, 0.5)} ({check_s:.2f} s)")
+    print(
+        f"  goal replay --check <= 0.5 s: {_goal(check_s, 0.5)} ({check_s:.2f} s); "
+        f"{_scaled(today, then, 'replay --check')}"
+    )
     rate, vehicle_s, wall_s = sorted(flights)[n // 2]
     print(
         f"  the flight alone, in-process, recording on: {vehicle_s:.1f} vehicle s in "
