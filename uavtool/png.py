@@ -36,8 +36,8 @@ def rgb_png(pixels: bytes | bytearray | memoryview, height_px: int, width_px: in
     parts = [deflate.compress(none + data[i : i + stride]) for i in range(0, len(data), stride)]
     parts.append(deflate.flush())
     header = struct.pack(">IIBBBBB", width_px, height_px, 8, 2, 0, 0, 0)
-    return b"".join((_SIGNATURE, _chunk(b"IHDR", header), _chunk(b"IDAT", b"".join(parts)),
-                     _chunk(b"IEND", b"")))  # fmt: skip
+    chunks = (_chunk(b"IHDR", header), _chunk(b"IDAT", b"".join(parts)), _chunk(b"IEND", b""))
+    return _SIGNATURE + b"".join(chunks)
 
 
 def _chunk(kind: bytes, body: bytes) -> bytes:
