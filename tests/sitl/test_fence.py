@@ -9,6 +9,7 @@ import pytest
 from tests.sitl.pilot import Pilot
 from uavtool.geo import GeoPoint
 from uavtool.mavlink import mavlink as M
+from uavtool.sitl.shaping import stopping_distance as leash_m
 
 GEOFENCE = M.MAV_SYS_STATUS_GEOFENCE
 RTL, LAND = 6, 9
@@ -48,7 +49,9 @@ def test_a_velocity_climb_stops_at_the_fence_and_triggers_its_action(
         peak = max(peak, pilot.alt_m())
     assert "Fence breached: Max Alt" in pilot.statustexts()
     assert pilot.mode() == mode
-    assert peak < 22.0  # it stopped just past FENCE_ALT_MAX (20 m), not at 80 m
+    # It stopped past FENCE_ALT_MAX (20 m) by its braking distance from 2.5 m/s at
+    # WPNAV_ACCEL_Z (1 m/s²) and PSC_POSZ_P (1/s), not at 80 m.
+    assert peak < 20.0 + leash_m(2.5, 1.0, 1.0) + 0.5
     assert pilot.alt_m() < 20.0
 
 
@@ -84,9 +87,10 @@ def test_an_auto_mission_far_and_high_stops_at_the_fence() -> None:
         farthest_m, highest_m = max(farthest_m, math.hypot(n, e)), max(highest_m, -d)
     assert any(t.startswith("Fence breached") for t in pilot.statustexts())
     assert pilot.mode() == RTL
-    # It turned back at the 50 m circle and under the 30 m ceiling, not 2 km away at 500 m.
-    assert farthest_m < 70.0
-    assert highest_m < 32.0
+    # It turned back at the 50 m circle and under the 30 m ceiling, each passed by its braking
+    # distance (10 m/s at WPNAV_ACCEL, 2.5 m/s up at WPNAV_ACCEL_Z), not 2 km away at 500 m.
+    assert farthest_m < 50.0 + leash_m(10.0, 1.0, 2.5) + 3.0
+    assert highest_m < 30.0 + leash_m(2.5, 1.0, 1.0) + 0.5
     pilot.run_until(lambda p: not p.armed, 120, "landing at home")
 
 

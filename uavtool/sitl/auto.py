@@ -153,7 +153,7 @@ class AutoMission:
                 ap.vehicle.set_target(Target(pos_ned_m=(n, e, -max(item.z, 1.0))))
         elif cmd == mavlink.MAV_CMD_NAV_WAYPOINT:
             yaw = item.param4 % 360.0 if math.isfinite(item.param4) and item.param4 != 0 else None
-            ap.vehicle.set_target(Target(pos_ned_m=self._target_ned(item), yaw_deg=yaw))
+            ap.vehicle.set_target(Target(pos_ned_m=self._target_ned(item), yaw_deg=yaw, path=True))
         elif cmd == mavlink.MAV_CMD_NAV_LAND:
             n, e, _ = self._target_ned(item)
             ap.land_ne = (n, e)
@@ -174,7 +174,8 @@ class AutoMission:
             goal = ap.vehicle.target.pos_ned_m or tuple(s.pos_ned_m)
             dist = math.dist(goal, s.pos_ned_m)
             if self._hold_until_ns is None:
-                if dist > ap.params["WPNAV_RADIUS"] / 100.0:
+                # ArduCopter: the leg's S-curve has ended, and the vehicle is within the radius
+                if not ap.vehicle.control.leg_done or dist > ap.params["WPNAV_RADIUS"] / 100.0:
                     return False
                 self._hold_until_ns = ap.now_ns + int(max(item.param1, 0.0) * 1e9)
             return ap.now_ns >= self._hold_until_ns

@@ -33,6 +33,7 @@ from uavtool.sitl.state import (
     denied,
     failed,
 )
+from uavtool.sitl.wind import WindParams
 from uavtool.sitl.yaw import travel_yaw_deg
 
 FORCE_MAGIC = 21196  # ArduPilot's "force" value for ARM_DISARM param2
@@ -62,7 +63,11 @@ class Autopilot:
         # Separate streams: how many sensor readings are sent (clients, rates) must not
         # change the gusts, so the trajectory depends only on the seed and the commands.
         self.noise_rng = random.Random(seed * 2 + 1)
-        self.vehicle = Multicopter(yaw_deg=home_heading_deg % 360.0, rng=random.Random(seed * 2))
+        self.vehicle = Multicopter(
+            yaw_deg=home_heading_deg % 360.0,
+            rng=random.Random(seed * 2),
+            home_alt_amsl_m=home.alt_amsl_m,
+        )
         self.mode = Mode.STABILIZE
         self.armed = False
         self.now_ns = 0
@@ -79,6 +84,7 @@ class Autopilot:
         self._landed_since_ns: int | None = 0
         self._rtl_stage = ""
         self._rtl_alt = 0.0
+        self._rtl_loiter_until_ns = 0
         self.land_ne = (0.0, 0.0)
         self._velocity_deadline_ns = 0
         self.battery = Battery(params)
@@ -100,10 +106,18 @@ class Autopilot:
         lim.accel_z_mss = max(p["WPNAV_ACCEL_Z"], 50.0) / 100.0
         lim.yaw_rate_dps = max(p["ATC_SLEW_YAW"], 500.0) / 100.0
         lim.lean_max_deg = max(p["ANGLE_MAX"], 1000.0) / 100.0
-        wind_from = math.radians(p["SIM_WIND_DIR"])
-        speed = p["SIM_WIND_SPD"]
-        self.vehicle.wind_ned_ms = (-speed * math.cos(wind_from), -speed * math.sin(wind_from), 0.0)
-        self.vehicle.turbulence_ms = p["SIM_WIND_TURB"]
+        self.vehicle.air.set_params(wind_params(p))
+        g = self.vehicle.gains
+        g.pos_ne_p, g.vel_ne_p, g.vel_ne_i = p["PSC_POSXY_P"], p["PSC_VELXY_P"], p["PSC_VELXY_I"]
+        g.vel_ne_imax_mss = p["PSC_VELXY_IMAX"] / 100.0
+        g.pos_d_p, g.vel_d_p = p["PSC_POSZ_P"], p["PSC_VELZ_P"]
+        g.jerk_xy_msss, g.jerk_path_msss = p["PSC_JERK_XY"], p["WPNAV_JERK"]
+        g.jerk_z_msss = p["PSC_JERK_Z"]
+        g.input_tc_s = p["ATC_INPUT_TC"]
+        g.accel_rp_max_dss = min(p["ATC_ACCEL_R_MAX"], p["ATC_ACCEL_P_MAX"]) / 100.0
+        g.accel_y_max_dss = p["ATC_ACCEL_Y_MAX"] / 100.0
+        g.spool_time_s = p["MOT_SPOOL_TIME"]
+        g.takeoff_slew_s = p["TKOFF_SLEW_TIME"]
 
     # ------------------------------------------------------------------ state read-outs
     @property
@@ -112,7 +126,8 @@ class Autopilot:
 
     @property
     def on_ground(self) -> bool:
-        return self.vehicle.state.on_ground
+        """Landed, as ArduCopter's land detector says it (not just touching the ground)."""
+        return self.vehicle.state.landed
 
     def alt_rel_m(self) -> float:
         return -self.vehicle.state.pos_ned_m[2]
@@ -149,7 +164,7 @@ class Autopilot:
             if why is not None:
                 return failed(f"Arm: {why}")
         self.armed = True
-        self.vehicle.motors_on = True
+        self.vehicle.arm()
         self.vehicle.set_target(Target(yaw_deg=None))
         self._landed_since_ns = self.now_ns
         self.say(mavlink.MAV_SEVERITY_INFO, "Arming motors")
@@ -162,7 +177,7 @@ class Autopilot:
             return denied("Disarm: vehicle is flying (use force)")
         self.armed = False
         self.taking_off = False
-        self.vehicle.motors_on = False
+        self.vehicle.disarm()
         self.mission.stop()
         self.say(mavlink.MAV_SEVERITY_INFO, reason)
         return ACCEPTED
@@ -362,7 +377,8 @@ class Autopilot:
             if reason is not None:
                 self.crash(reason)
         self._update_gimbal(dt_s)
-        self.battery.drain(self.battery_current_a(), dt_s)
+        v = self.vehicle
+        self.battery.drain(motor_power_w=v.body.watts_per_newton * v.state.thrust_n, dt_s=dt_s)
         self._check_fence()
         self._check_failsafes()
         self._check_landed()
@@ -373,9 +389,10 @@ class Autopilot:
         self.collisions.record_crash(reason)
         self.say(mavlink.MAV_SEVERITY_EMERGENCY, reason)
         s = self.vehicle.state
-        # It stopped against what it hit and has no control left: it can only fall.
+        # It stopped against what it hit and its propellers are broken: it can only fall.
         s.vel_ned_ms[0] = s.vel_ned_ms[1] = 0.0
         s.vel_ned_ms[2] = max(s.vel_ned_ms[2], 0.0)
+        s.thrust_n = 0.0
         self.disarm(force=True, reason="Crash: disarming motors")
 
     def _run_mode(self) -> None:
@@ -418,17 +435,30 @@ class Autopilot:
             if safe_alt is not None:  # return under the fence, descending first if above it
                 alt = min(alt, safe_alt)
             self._rtl_alt = alt
-            if self.vehicle.target.pos_ned_m != (n, e, -alt):
-                self.vehicle.set_target(Target(pos_ned_m=(n, e, -alt)))
+            stop_n, stop_e, _ = self.vehicle.stopping_point()  # ArduCopter's RTL starts there
+            if self.vehicle.target.pos_ned_m != (stop_n, stop_e, -alt):
+                self.vehicle.set_target(Target(pos_ned_m=(stop_n, stop_e, -alt)))
             self._rtl_stage = "climbing"
-        if self._rtl_stage == "climbing" and -d >= self._rtl_alt - 0.2:
-            self.vehicle.set_target(Target(pos_ned_m=(0.0, 0.0, -self._rtl_alt)))
+        climb = self.vehicle.target.pos_ned_m
+        if (
+            self._rtl_stage == "climbing"
+            and -d >= self._rtl_alt - 0.2
+            and self.vehicle.control.leg_done
+            and (climb is None or math.hypot(n - climb[0], e - climb[1]) < 1.0)
+            and math.hypot(self.state.vel_ned_ms[0], self.state.vel_ned_ms[1]) < 0.5
+        ):  # up, and braked to where it could stop: then home
+            self.vehicle.set_target(Target(pos_ned_m=(0.0, 0.0, -self._rtl_alt), path=True))
             self._rtl_stage = "return"
         if (
             self._rtl_stage == "return"
+            and self.vehicle.control.leg_done
             and math.hypot(n, e) < 0.5
             and abs(self.state.vel_ned_ms[0]) < 0.2
         ):
+            # ArduCopter loiters above home for RTL_LOIT_TIME before its final descent.
+            self._rtl_stage = "loiter"
+            self._rtl_loiter_until_ns = self.now_ns + int(self.params["RTL_LOIT_TIME"] * 1e6)
+        if self._rtl_stage == "loiter" and self.now_ns >= self._rtl_loiter_until_ns:
             self._rtl_stage = "land"
             self.land_ne = (0.0, 0.0)
             self.say(mavlink.MAV_SEVERITY_INFO, "RTL: landing at home")
@@ -445,7 +475,7 @@ class Autopilot:
         g.yaw_deg += max(-step, min(step, wrap_180(target_yaw - g.yaw_deg)))
 
     def battery_current_a(self) -> float:
-        return Battery.current_a(armed=self.armed, state=self.vehicle.state)
+        return self.battery.current_a
 
     def _check_failsafes(self) -> None:
         p = self.params
@@ -545,3 +575,17 @@ def _bounded_velocity(vel_ned_ms: tuple[float, float, float]) -> tuple[float, fl
     if across > _MAX_XY_MS:
         n, e = n * _MAX_XY_MS / across, e * _MAX_XY_MS / across
     return n, e, min(max(d, -_MAX_UP_MS), _MAX_DN_MS)
+
+
+def wind_params(p: ParamStore) -> WindParams:
+    """The SIM_WIND_* parameters as the wind model takes them."""
+    return WindParams(
+        speed_ms=p["SIM_WIND_SPD"],
+        from_deg=p["SIM_WIND_DIR"],
+        up_deg=p["SIM_WIND_DIR_Z"],
+        turbulence_ms=p["SIM_WIND_TURB"],
+        change_tc_s=p["SIM_WIND_TC"],
+        profile=int(p["SIM_WIND_T"]),
+        profile_alt_m=p["SIM_WIND_T_ALT"],
+        profile_coef=p["SIM_WIND_T_COEF"],
+    )

@@ -1,8 +1,22 @@
-"""Multicopter dynamics with an ArduCopter-like position controller, stepped by sim time.
+"""The built-in vehicle's flight: ArduCopter's controllers (:mod:`~uavtool.sitl.control`) flying
+an airframe (:mod:`~uavtool.sitl.frame`) through the air (:mod:`~uavtool.sitl.wind`), as
+ArduPilot's SITL builds a multicopter: controllers -> thrust and attitude -> forces -> motion.
 
-Pure and deterministic: the state advances only through ``Multicopter.step(dt_s)``; wind
-gusts come from a ``random.Random`` seeded by the caller. Frames: NED metres relative to
-home, yaw in degrees clockwise from north.
+Each step (``Multicopter.step(dt_s)``):
+
+1. the air moves (the steady wind at this height, turbulence in the air);
+2. the controllers turn the target into a lean of the thrust vector and a thrust command;
+3. the lean and the heading move toward theirs as ArduCopter's attitude controller shapes
+   them, the motors' thrust toward its command with their time constant;
+4. the forces: thrust along the tilted axis (less what air flowing into the propellers takes),
+   drag of the airspeed (wind minus velocity) across and along the rotor plane, gravity;
+5. motion, and the ground: a vehicle on the ground stays where it is (no sliding, level)
+   until its thrust lifts it; on the ground with the throttle at its lower limit for a second
+   it is landed (ArduCopter's land detector).
+
+Pure and deterministic: the state advances only through ``step``; turbulence comes from the
+``random.Random`` the caller seeds. Frames: NED metres relative to home, yaw in degrees
+clockwise from north.
 """
 
 from __future__ import annotations
@@ -11,37 +25,27 @@ import math
 import random
 from dataclasses import dataclass, field
 
-from uavtool.geo import wrap_180
+from uavtool.sitl.control import (
+    GRAVITY_MSS,
+    IDLE,
+    AttitudeShaper,
+    Command,
+    Gains,
+    Limits,
+    PositionController,
+    Target,
+)
+from uavtool.sitl.frame import Airframe, Frame, air_density_kgm3, airframe
+from uavtool.sitl.wind import Wind
 
-GRAVITY_MSS = 9.80665
+__all__ = ["GRAVITY_MSS", "Limits", "Multicopter", "State", "Target", "Touchdown"]
 
-
-@dataclass(slots=True)
-class Limits:
-    """Controller limits in SI units (converted from ArduCopter's cm-based parameters)."""
-
-    speed_xy_ms: float = 10.0
-    speed_up_ms: float = 2.5
-    speed_dn_ms: float = 1.5
-    accel_xy_mss: float = 2.5
-    accel_z_mss: float = 1.0
-    yaw_rate_dps: float = 60.0
-    lean_max_deg: float = 30.0
-
-
-@dataclass(slots=True)
-class Target:
-    """What the controller is asked to do.
-
-    Exactly one of ``pos_ned_m`` (fly to and hold) or ``vel_ned_ms`` (hold a velocity)
-    is used; with neither the vehicle brakes to a stop and holds where it stopped.
-    ``yaw_deg`` None holds the current heading.
-    """
-
-    pos_ned_m: tuple[float, float, float] | None = None
-    vel_ned_ms: tuple[float, float, float] | None = None
-    yaw_deg: float | None = None
-    yaw_rate_dps: float | None = None
+LAND_DETECTOR_TRIGGER_S = 1.0
+"""The throttle at its lower limit on the ground this long means landed (ArduCopter's
+LAND_DETECTOR_TRIGGER_SEC)."""
+_LOWER_LIMIT = 0.05
+"""Thrust below this share of the weight counts as the throttle's lower limit."""
+_DEG = math.pi / 180.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -55,180 +59,213 @@ class Touchdown:
 
 @dataclass(slots=True)
 class State:
+    """The vehicle's true state. ``lean_ne`` is the horizontal part of the unit thrust
+    direction (north, east): the tilt, whatever the heading."""
+
     pos_ned_m: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     vel_ned_ms: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     accel_ned_mss: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     yaw_deg: float = 0.0
     yaw_rate_dps: float = 0.0
-    roll_deg: float = 0.0
-    pitch_deg: float = 0.0
+    lean_ne: list[float] = field(default_factory=lambda: [0.0, 0.0])
+    thrust_n: float = 0.0
+    thrust_max_n: float = 1.0
     on_ground: bool = True
+    """Touching the ground (the ground carries it)."""
+    landed: bool = True
+    """ArduCopter's land detector: on the ground with the throttle at its lower limit."""
 
+    def _forward_right(self) -> tuple[float, float]:
+        yaw = self.yaw_deg * _DEG
+        c, s = math.cos(yaw), math.sin(yaw)
+        ln, le = self.lean_ne
+        return ln * c + le * s, -ln * s + le * c
 
-_CALM = [0.0, 0.0, 0.0]
+    @property
+    def roll_deg(self) -> float:
+        """Roll of the body (right side down positive), from the lean and the heading."""
+        _, right = self._forward_right()
+        return math.degrees(math.asin(max(-1.0, min(1.0, right))))
 
+    @property
+    def pitch_deg(self) -> float:
+        """Pitch of the body (nose up positive), from the lean and the heading."""
+        forward, right = self._forward_right()
+        across = math.sqrt(max(1.0 - right * right, 1e-12))
+        return -math.degrees(math.asin(max(-1.0, min(1.0, forward / across))))
 
-def sqrt_controller(error: float, p_gain: float, accel_max: float) -> float:
-    """ArduPilot's sqrt controller: linear near zero, constant-deceleration far away."""
-    linear_dist = accel_max / (p_gain * p_gain)
-    if abs(error) <= linear_dist:
-        return p_gain * error
-    v = math.sqrt(2.0 * accel_max * (abs(error) - linear_dist / 2.0))
-    return v if error > 0 else -v
+    @property
+    def throttle(self) -> float:
+        """The thrust as a share of the most the motors give (0-1)."""
+        return self.thrust_n / self.thrust_max_n
 
 
 class Multicopter:
-    """A point-mass multicopter flown by a cascaded position → velocity → acceleration loop."""
+    """A multicopter flown by ArduCopter's cascaded controllers through forces."""
 
-    POS_P = 1.0  # 1/s
-    VEL_TAU_S = 0.25  # velocity loop time constant
-    DRAG_PER_S = 0.15  # linear air drag coefficient
-
-    def __init__(self, *, yaw_deg: float = 0.0, rng: random.Random | None = None) -> None:
-        self.state = State(yaw_deg=yaw_deg)
-        self.limits = Limits()
-        self.target = Target()
-        self.wind_ned_ms = (0.0, 0.0, 0.0)
-        self.turbulence_ms = 0.0
-        self._gust = [0.0, 0.0, 0.0]
-        self._rng = rng or random.Random(0)
-        self._hold: tuple[float, float, float] | None = None
+    def __init__(
+        self,
+        *,
+        yaw_deg: float = 0.0,
+        rng: random.Random | None = None,
+        frame: Frame | None = None,
+        home_alt_amsl_m: float = 0.0,
+    ) -> None:
+        self.frame = frame or Frame()
+        self.body: Airframe = airframe(self.frame, density_kgm3=air_density_kgm3(home_alt_amsl_m))
+        self.state = State(yaw_deg=yaw_deg, thrust_max_n=self.body.thrust_max_n)
+        self.control = PositionController(
+            mass_kg=self.body.mass_kg, thrust_max_n=self.body.thrust_max_n
+        )
+        self.limits: Limits = self.control.limits
+        self.gains: Gains = self.control.gains
+        self.attitude = AttitudeShaper()
+        self.air = Wind(rng or random.Random(0))
         self.motors_on = False
         self.touchdown: Touchdown | None = None
         """How the last step met the ground; None when it did not (or was already on it)."""
         self._peak_up_m = 0.0  # greatest height since the vehicle last left the ground
+        self._lower_limit_s = 0.0  # how long the throttle has been at its lower limit
+        self._cmd = IDLE
+        self._dt_s = 0.0
+        self._motor_keep = 0.0
+
+    # ------------------------------------------------------------------ commands
+    @property
+    def target(self) -> Target:
+        return self.control.target
+
+    @target.setter
+    def target(self, target: Target) -> None:
+        self.control.target = target
 
     def set_target(self, target: Target) -> None:
-        self.target = target
-        self._hold = None
+        """A new target (the brake's hold point, if any, is forgotten)."""
+        self.control.set_target(target)
 
+    def arm(self) -> None:
+        """Motors armed: still for ArduCopter's arming delay, then at ground idle."""
+        self.motors_on = True
+        self.control.arm(in_air=not self.state.on_ground)
+
+    def disarm(self) -> None:
+        self.motors_on = False
+        self.control.disarm()
+
+    def stopping_point(self) -> tuple[float, float, float]:
+        """Where the vehicle would come to rest braking now (NED m): ArduCopter starts RTL and
+        its brake from here."""
+        return self.control.stopping_point(self.state.pos_ned_m, self.state.vel_ned_ms)
+
+    # ------------------------------------------------------------------ the step
     def step(self, dt_s: float) -> None:
         s = self.state
         self.touchdown = None
-        if not self.motors_on:
-            self._settle_on_ground(dt_s)
+        if not self.motors_on and s.on_ground and s.thrust_n < 1e-3:
+            s.thrust_n = 0.0
+            s.vel_ned_ms[0] = s.vel_ned_ms[1] = s.vel_ned_ms[2] = 0.0
+            s.accel_ned_mss[0] = s.accel_ned_mss[1] = s.accel_ned_mss[2] = 0.0
+            s.lean_ne[0] = s.lean_ne[1] = s.yaw_rate_dps = 0.0
+            s.landed = True
             return
-        vel_des = self._desired_velocity()
-        lim = self.limits
-        # Acceleration needed to reach the desired velocity, limited like ArduCopter.
-        ax = (vel_des[0] - s.vel_ned_ms[0]) / self.VEL_TAU_S
-        ay = (vel_des[1] - s.vel_ned_ms[1]) / self.VEL_TAU_S
-        az = (vel_des[2] - s.vel_ned_ms[2]) / self.VEL_TAU_S
-        a_xy = math.hypot(ax, ay)
-        if a_xy > lim.accel_xy_mss:
-            k = lim.accel_xy_mss / a_xy
-            ax, ay = ax * k, ay * k
-        az = max(-lim.accel_z_mss * 2.5, min(lim.accel_z_mss * 2.5, az))
-        self._update_gust(dt_s)
-        acc, vel, pos, gust = s.accel_ned_mss, s.vel_ned_ms, s.pos_ned_m, self._gust
-        airborne = pos[2] < 0.0
-        # each axis as a loop over them would, unrolled (every step of every flight)
-        acc[0], acc[1], acc[2] = ax, ay, az
-        vel[0] += ax * dt_s
-        vel[1] += ay * dt_s
-        vel[2] += az * dt_s
-        pos[0] += (vel[0] + gust[0]) * dt_s
-        pos[1] += (vel[1] + gust[1]) * dt_s
-        pos[2] += (vel[2] + gust[2]) * dt_s
-        self._update_attitude(ax, ay)
-        self._update_yaw(dt_s)
-        if s.pos_ned_m[2] >= 0.0:
-            if airborne:
-                self._touch_down()
-            s.pos_ned_m[2] = 0.0
-            s.vel_ned_ms[2] = min(s.vel_ned_ms[2], 0.0)
-            s.on_ground = vel_des[2] >= 0.0
-            if s.on_ground:
-                s.vel_ned_ms[0] = s.vel_ned_ms[1] = 0.0
+        if dt_s != self._dt_s:
+            self._dt_s = dt_s
+            tc = self.body.motor_time_constant_s
+            self._motor_keep = math.exp(-dt_s / tc) if tc > 0.0 else 0.0
+        air = self.air.step(-s.pos_ned_m[2], airborne=not s.on_ground, dt_s=dt_s)
+        control = self.control
+        if self.motors_on:
+            cmd = self._cmd = control.update(
+                s.pos_ned_m,
+                s.vel_ned_ms,
+                s.accel_ned_mss,
+                s.lean_ne,
+                on_ground=s.on_ground,
+                landed=s.landed,
+                thrust_n=s.thrust_n,
+                dt_s=dt_s,
+            )
+        else:
+            cmd = self._cmd = IDLE
+        if s.on_ground and not control.flying:
+            s.lean_ne[0] = s.lean_ne[1] = s.yaw_rate_dps = 0.0
+            self.attitude.stop()
+        else:
+            self.attitude.lean(s.lean_ne, cmd, control.gains, dt_s)
+            s.yaw_deg, s.yaw_rate_dps = self.attitude.yaw(
+                s.yaw_deg, s.yaw_rate_dps, control.target, control.limits, control.gains, dt_s
+            )
+        # the motors follow their command with a lag
+        s.thrust_n = cmd.thrust_n + (s.thrust_n - cmd.thrust_n) * self._motor_keep
+        self._move(air, dt_s)
+        if not s.landed:
+            self._detect_landing(dt_s)
+
+    @property
+    def command(self) -> Command:
+        """What the controllers asked of the airframe in the last step."""
+        return self._cmd
+
+    # ------------------------------------------------------------------ forces and motion
+    def _move(self, air: tuple[float, float, float], dt_s: float) -> None:
+        s, body = self.state, self.body
+        pos, vel, acc = s.pos_ned_m, s.vel_ned_ms, s.accel_ned_mss
+        ln, le = s.lean_ne
+        up = 1.0 - ln * ln - le * le
+        ld = -math.sqrt(up) if up > 0.0 else 0.0  # the thrust direction (NED, unit)
+        thrust = s.thrust_n
+        # Air relative to the vehicle, along the thrust axis and across the rotor plane.
+        rn, re, rd = vel[0] - air[0], vel[1] - air[1], vel[2] - air[2]
+        axial = rn * ln + re * le + rd * ld  # > 0: the vehicle moves along its thrust
+        pn, pe, pd = rn - axial * ln, re - axial * le, rd - axial * ld
+        across = math.sqrt(pn * pn + pe * pe + pd * pd)
+        mom = body.momentum_drag * math.sqrt(thrust) if thrust > 0.0 else 0.0
+        quad = body.drag_area_n_per_ms2
+        k_across = quad * across + mom
+        if axial > 0.0:  # air flowing into the propellers takes some of their thrust
+            thrust -= body.inflow_area_n_per_ms2 * axial * axial
+            thrust = max(thrust, 0.0)
+            f_axial = thrust - (quad * axial + mom) * axial
+        else:
+            f_axial = thrust - (mom - quad * axial) * axial
+        inv_m = 1.0 / body.mass_kg
+        an = (f_axial * ln - k_across * pn) * inv_m
+        ae = (f_axial * le - k_across * pe) * inv_m
+        ad = (f_axial * ld - k_across * pd) * inv_m + GRAVITY_MSS
+        if s.on_ground and ad > 0.0:
+            ad = 0.0  # the ground carries it
+        acc[0], acc[1], acc[2] = an, ae, ad
+        vel[0] += an * dt_s
+        vel[1] += ae * dt_s
+        vel[2] += ad * dt_s
+        pos[0] += vel[0] * dt_s
+        pos[1] += vel[1] * dt_s
+        pos[2] += vel[2] * dt_s
+        if pos[2] >= 0.0:
+            if not s.on_ground:
+                self.touchdown = Touchdown((vel[0], vel[1], vel[2]), self._peak_up_m)
+                self._peak_up_m = 0.0
+            # On the ground: it does not slide, and stands level (ArduPilot's SITL, too).
+            pos[2] = 0.0
+            vel[0] = vel[1] = 0.0
+            vel[2] = min(vel[2], 0.0)
+            acc[0] = acc[1] = 0.0
+            s.lean_ne[0] = s.lean_ne[1] = 0.0
+            self.attitude.stop()
+            s.on_ground = True
         else:
             s.on_ground = False
-            if -s.pos_ned_m[2] > self._peak_up_m:  # noqa: PLR1730 (every step: no max() call)
-                self._peak_up_m = -s.pos_ned_m[2]
+            s.landed = False
+            if -pos[2] > self._peak_up_m:  # noqa: PLR1730 (every step: no max() call)
+                self._peak_up_m = -pos[2]
 
-    def _touch_down(self) -> None:
-        v = self.state.vel_ned_ms
-        self.touchdown = Touchdown((v[0], v[1], v[2]), self._peak_up_m)
-        self._peak_up_m = 0.0
-
-    def _desired_velocity(self) -> tuple[float, float, float]:
-        s, t, lim = self.state, self.target, self.limits
-        if t.vel_ned_ms is not None:
-            vx, vy, vz = t.vel_ned_ms
-            v_xy = math.hypot(vx, vy)
-            if v_xy > lim.speed_xy_ms:
-                vx, vy = vx * lim.speed_xy_ms / v_xy, vy * lim.speed_xy_ms / v_xy
-            return vx, vy, max(-lim.speed_up_ms, min(lim.speed_dn_ms, vz))
-        goal = t.pos_ned_m
-        if goal is None:
-            if self._hold is None:
-                self._hold = self._stopping_point()
-            goal = self._hold
-        en = goal[0] - s.pos_ned_m[0]
-        ee = goal[1] - s.pos_ned_m[1]
-        ed = goal[2] - s.pos_ned_m[2]
-        dist = math.hypot(en, ee)
-        vx = vy = 0.0
-        if dist > 1e-9:
-            speed = min(sqrt_controller(dist, self.POS_P, lim.accel_xy_mss), lim.speed_xy_ms)
-            vx, vy = en / dist * speed, ee / dist * speed
-        vz = sqrt_controller(ed, self.POS_P, lim.accel_z_mss)
-        return vx, vy, max(-lim.speed_up_ms, min(lim.speed_dn_ms, vz))
-
-    def _stopping_point(self) -> tuple[float, float, float]:
-        s, lim = self.state, self.limits
-        point = []
-        for i, acc in ((0, lim.accel_xy_mss), (1, lim.accel_xy_mss), (2, lim.accel_z_mss)):
-            v = s.vel_ned_ms[i]
-            point.append(s.pos_ned_m[i] + v * abs(v) / (2.0 * acc))
-        return (point[0], point[1], min(point[2], 0.0))
-
-    def _update_gust(self, dt_s: float) -> None:
-        if self.turbulence_ms <= 0.0:
-            if self._gust != _CALM:
-                self._gust = [0.0, 0.0, 0.0]
-            return
-        # Ornstein-Uhlenbeck gusts with a 2 s correlation time.
-        decay = math.exp(-dt_s / 2.0)
-        sigma = self.turbulence_ms * math.sqrt(1.0 - decay * decay)
-        self._gust = [g * decay + self._rng.gauss(0.0, sigma) for g in self._gust]
-        self._gust[2] *= 0.3
-
-    def _update_attitude(self, ax: float, ay: float) -> None:
+    def _detect_landing(self, dt_s: float) -> None:
         s = self.state
-        # Thrust must supply the commanded acceleration plus the drag of the relative wind.
-        wind = self.wind_ned_ms
-        fx = ax - self.DRAG_PER_S * (wind[0] - s.vel_ned_ms[0])
-        fy = ay - self.DRAG_PER_S * (wind[1] - s.vel_ned_ms[1])
-        yaw = math.radians(s.yaw_deg)
-        cos_yaw, sin_yaw = math.cos(yaw), math.sin(yaw)
-        forward = fx * cos_yaw + fy * sin_yaw
-        right = -fx * sin_yaw + fy * cos_yaw
-        lean = self.limits.lean_max_deg
-        s.pitch_deg = max(-lean, min(lean, -math.degrees(math.atan2(forward, GRAVITY_MSS))))
-        s.roll_deg = max(-lean, min(lean, math.degrees(math.atan2(right, GRAVITY_MSS))))
-
-    def _update_yaw(self, dt_s: float) -> None:
-        s, t = self.state, self.target
-        if t.yaw_deg is None:
-            s.yaw_rate_dps = 0.0
-            return
-        rate = min(t.yaw_rate_dps or self.limits.yaw_rate_dps, self.limits.yaw_rate_dps)
-        err = wrap_180(t.yaw_deg - s.yaw_deg)
-        step = max(-rate * dt_s, min(rate * dt_s, err))
-        s.yaw_rate_dps = step / dt_s
-        s.yaw_deg = (s.yaw_deg + step) % 360.0
-
-    def _settle_on_ground(self, dt_s: float) -> None:
-        s = self.state
-        if s.pos_ned_m[2] < 0.0:  # motors off in the air: fall
-            s.vel_ned_ms[2] += GRAVITY_MSS * dt_s
-            s.pos_ned_m[2] = min(0.0, s.pos_ned_m[2] + s.vel_ned_ms[2] * dt_s)
-            s.on_ground = s.pos_ned_m[2] >= 0.0
-            if s.on_ground:
-                self._touch_down()
+        if s.on_ground and s.thrust_n <= _LOWER_LIMIT * self.body.weight_n:
+            self._lower_limit_s += dt_s
+            if self._lower_limit_s >= LAND_DETECTOR_TRIGGER_S or not self.motors_on:
+                s.landed = True
+                self._lower_limit_s = 0.0
+                self.control.landed(s.pos_ned_m)
         else:
-            s.on_ground = True
-        if s.on_ground:
-            s.vel_ned_ms[:] = [0.0, 0.0, 0.0]
-            s.accel_ned_mss[:] = [0.0, 0.0, 0.0]
-            s.roll_deg = s.pitch_deg = s.yaw_rate_dps = 0.0
+            self._lower_limit_s = 0.0

@@ -245,7 +245,7 @@ class Telemetry:
         ap = self.ap
         s = ap.state
         speed = math.hypot(s.vel_ned_ms[0], s.vel_ned_ms[1])
-        throttle = 0 if not ap.armed else min(100, round(45 - 10 * s.accel_ned_mss[2]))
+        throttle = 0 if not ap.armed else min(100, round(100.0 * s.throttle))
         return M.MAVLink_vfr_hud_message(
             speed,
             speed,
@@ -257,8 +257,8 @@ class Telemetry:
 
     def battery_status(self) -> Any:
         ap = self.ap
-        cell_mv = round(ap.battery.voltage() * 1000 / 4)
-        cells = [cell_mv] * 4 + [65535] * 6
+        cell_mv = round(ap.battery.voltage() * 1000 / 3)
+        cells = [cell_mv] * 3 + [65535] * 7
         return M.MAVLink_battery_status_message(
             0,
             M.MAV_BATTERY_FUNCTION_ALL,
@@ -267,7 +267,7 @@ class Telemetry:
             cells,
             round(ap.battery_current_a() * 100),
             round(ap.battery.used_mah),
-            -1,
+            round(ap.battery.used_wh * 36.0),  # hJ
             ap.battery.remaining_pct(),
         )
 
