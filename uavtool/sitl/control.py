@@ -327,6 +327,7 @@ class PositionController:
                 and -1e-9 < ee < 1e-9
                 and -1e-9 < ed < 1e-9
             ):
+                self.leg_done = True
                 return  # there, and still: nothing to shape
             an, ae = shape_pos_xy(en, ee, tv[0], tv[1], lim.speed_xy_ms, acc_xy, jerk_xy / acc_xy)
             ad = shape_pos_z(ed, tv[2], lim.speed_up_ms, lim.speed_dn_ms, acc_z, jerk_z / acc_z)
@@ -366,8 +367,11 @@ class PositionController:
         moving = abs(tv[0]) + abs(tv[1]) + abs(tv[2]) > 0.1 or abs(ta[0]) + abs(ta[1]) > 0.5
         dn, de, dd = goal[0] - tp[0], goal[1] - tp[1], goal[2] - tp[2]
         length = math.sqrt(dn * dn + de * de + dd * dd)
-        if moving or length < 1e-6:
-            return  # not from rest: shaped toward the goal instead (and nothing to fly)
+        if length < 1e-6 and not moving:
+            self.leg_done = True  # already there
+            return
+        if moving:
+            return  # not from rest: shaped toward the goal instead
         lim, g = self.limits, self.gains
         across, up = math.sqrt(dn * dn + de * de) / length, abs(dd) / length
         vertical_speed = lim.speed_dn_ms if dd > 0.0 else lim.speed_up_ms
