@@ -396,8 +396,49 @@ def _ratio(ours: float, theirs: float | None) -> str:
     return f"{ours / theirs:6.2f}"
 
 
-def _verdict(ratio: float, low: float, high: float) -> str:
-    return "ok" if low <= ratio <= high else "MISSED"
+def _judge(ours: float, theirs: float | None, low: float, high: float) -> str:
+    if theirs is None or not theirs or not math.isfinite(ours):
+        return ""
+    return "ok" if low <= ours / theirs <= high else "MISSED"
+
+
+def print_manoeuvres(ours: dict[str, float], theirs: dict[str, float] | None) -> None:
+    print(f"\n{'manoeuvre':<34} {'built-in':>9} {'ArduCopter':>10} {'ratio':>6}  goal")
+    for name, value in ours.items():
+        other = None if theirs is None else theirs[name]
+        shown = "-" if other is None else f"{other:10.2f}"
+        if name.startswith("landing:"):
+            goal, verdict = "-", ""
+        elif name.startswith("hold:"):
+            goal, verdict = "x1.5", _judge(value, other, 1 / 1.5, 1.5)
+        else:
+            goal, verdict = "±15 %", _judge(value, other, 0.85, 1.15)
+        print(f"{name:<34} {value:9.2f} {shown:>10} {_ratio(value, other)}  {goal} {verdict}")
+
+
+def print_mission(
+    wind: float, ours: MissionFigures, theirs: MissionFigures | None, *, first: bool
+) -> None:
+    if first:
+        print(f"\n{'mission: paper, wind from 270°, TURB 2':<40} {'built-in':>10} "
+              f"{'ArduCopter':>10} {'ratio':>6}  goal")  # fmt: skip
+    t = theirs
+    rows = (
+        ("outcome", ours.status, None if t is None else t.status, "", 0.0),
+        ("flight time, s", ours.flight_s, None if t is None else t.flight_s, "±10 %", 0.1),
+        ("route, m", ours.route_m, None if t is None else t.route_m, "±10 %", 0.1),
+        ("battery, mAh", ours.mah, None if t is None else t.mah, "±20 %", 0.2),
+        ("battery, Wh", ours.wh, None if t is None else t.wh, "±20 %", 0.2),
+    )
+    for name, mine, other, goal, tol in rows:
+        label = f"wind {wind:g} m/s: {name}"
+        if isinstance(mine, str):
+            print(f"{label:<40} {mine:>10} {other or '-':>10}")
+            continue
+        assert not isinstance(other, str)
+        verdict = _judge(mine, other, 1.0 - tol, 1.0 + tol)
+        shown = "-" if other is None else f"{other:10.1f}"
+        print(f"{label:<40} {mine:10.1f} {shown:>10} {_ratio(mine, other)}  {goal} {verdict}")
 
 
 def main() -> int:
@@ -408,68 +449,34 @@ def main() -> int:
     parser.add_argument("--no-mission", action="store_true", help="the manoeuvres only")
     parser.add_argument("--no-manoeuvres", action="store_true", help="the mission only")
     parser.add_argument("--traces", type=Path, default=None, help="write each trace as JSON")
-    parser.add_argument(
-        "--only", choices=("builtin", "arducopter"), help="one vehicle's manoeuvres"
-    )
+    parser.add_argument("--only", choices=("builtin", "arducopter"), help="one vehicle only")
     args = parser.parse_args()
     missing = "--quick" if args.quick else _arducopter_missing()
+    if args.only == "builtin":
+        missing = "--only builtin"
     if missing:
         print(f"ArduCopter: skipped ({missing})")
-
+    speedup = 50.0 if args.quick else args.speedup  # the built-in vehicle keeps up with any
     if not args.no_manoeuvres:
-        if args.only == "arducopter":
-            print(fly_manoeuvres(arducopter, args.speedup, args.traces, "arducopter"))
-            return 0
-        ours = fly_manoeuvres(builtin, args.speedup, args.traces, "builtin")
-        if args.only == "builtin":
-            print(ours)
-            return 0
-        theirs = (
-            None if missing else fly_manoeuvres(arducopter, args.speedup, args.traces, "arducopter")
-        )
-        print(f"\n{'manoeuvre':<34} {'built-in':>9} {'ArduCopter':>10} {'ratio':>6}  goal")
-        for name, value in ours.items():
-            other = None if theirs is None else theirs[name]
-            ratio = _ratio(value, other)
-            loose = name.startswith("hold:")
-            goal = "x1.5" if loose else "±15 %"
-            verdict = ""
-            if other and name != "landing: distance from home, m":
-                r = value / other
-                verdict = _verdict(r, 1 / 1.5, 1.5) if loose else _verdict(r, 0.85, 1.15)
-            elif name == "landing: distance from home, m":
-                goal = "-"
-            shown = "-" if other is None else f"{other:10.2f}"
-            print(f"{name:<34} {value:9.2f} {shown:>10} {ratio}  {goal} {verdict}")
-
-    if not args.no_mission:
+        ours = theirs = None
+        if args.only != "arducopter":
+            ours = fly_manoeuvres(builtin, speedup, args.traces, "builtin")
+        if not missing:
+            theirs = fly_manoeuvres(arducopter, args.speedup, args.traces, "arducopter")
+        if ours is None:
+            print(theirs)
+        else:
+            print_manoeuvres(ours, theirs)
+    if not args.no_mission and args.only != "arducopter":
         winds = [0.0] if args.quick else [float(w) for w in args.winds.split(",")]
-        print(f"\n{'mission (paper, from 270°, TURB 2)':<36} {'built-in':>22} "
-              f"{'ArduCopter':>22}  ratios (time, route, mAh)")  # fmt: skip
-        for wind in winds:
+        for i, wind in enumerate(winds):
             with tempfile.TemporaryDirectory() as tmp:
                 ours_m = fly_mission(None, wind, Path(tmp))
                 theirs_m = None
                 if not missing:
                     with arducopter(args.speedup, Path(tmp)) as url:
                         theirs_m = fly_mission(url, wind, Path(tmp))
-
-            def cell(m: MissionFigures | None) -> str:
-                if m is None:
-                    return f"{'-':>22}"
-                return f"{m.status[:9]:>9} {m.flight_s:5.1f}s {m.route_m:5.1f}m"
-
-            ratios = ""
-            if theirs_m is not None:
-                ratios = " ".join(
-                    _ratio(a, b)
-                    for a, b in ((ours_m.flight_s, theirs_m.flight_s),
-                                 (ours_m.route_m, theirs_m.route_m), (ours_m.mah, theirs_m.mah))
-                )  # fmt: skip
-            print(f"wind {wind:4.1f} m/s {'':<22} {cell(ours_m)} {cell(theirs_m)}  {ratios}")
-            print(f"{'':<36} battery {ours_m.mah:6.0f} mAh {ours_m.wh:5.1f} Wh"
-                  + ("" if theirs_m is None else
-                     f"   {theirs_m.mah:6.0f} mAh {theirs_m.wh:5.1f} Wh"))  # fmt: skip
+            print_mission(wind, ours_m, theirs_m, first=i == 0)
     return 0
 
 

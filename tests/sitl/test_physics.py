@@ -218,3 +218,25 @@ def test_the_frame_flies_its_reference_flight() -> None:
 def test_a_frame_that_cannot_fly_is_refused() -> None:
     with pytest.raises(ValueError, match="cannot fly"):
         airframe(Frame(hover_throttle=0.0), density_kgm3=1.2)
+
+
+def test_a_ground_station_sees_the_vehicle_lean_into_the_wind() -> None:
+    """Over a real socket (as MAVProxy, QGroundControl or MAVSDK see it), the wall-paced
+    vehicle of ``uavtool sitl --wind 8,270`` holds its place leaning west, into the wind."""
+    from tests.sitl.client import Client
+    from uavtool.sitl import Sitl, SitlConfig
+
+    config = SitlConfig(
+        endpoints=("tcpin:127.0.0.1:0",), speedup=40, wind_speed_ms=8.0, wind_dir_deg=270.0
+    )
+    with Sitl(config) as sitl:
+        c = Client.tcp(sitl.ports[0])
+        c.takeoff(70)
+        c.wait_until(lambda cl: cl.boot_s() > 40.0, timeout=60, what="40 s of flight")
+        att, pos = c.latest["ATTITUDE"], c.latest["LOCAL_POSITION_NED"]
+        heading = math.radians(c.latest["VFR_HUD"].heading)
+        # the thrust vector tilts west: rotate roll and pitch back into north and east
+        west = math.sin(att.roll) * math.cos(heading) - math.sin(att.pitch) * math.sin(heading)
+        assert west < -math.sin(math.radians(10.0))
+        assert math.hypot(pos.x, pos.y) < 1.0
+        c.close()
