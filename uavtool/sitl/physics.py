@@ -25,10 +25,10 @@ import math
 import random
 from dataclasses import dataclass, field
 
+from uavtool.sitl.attitude import AttitudeShaper
 from uavtool.sitl.control import (
     GRAVITY_MSS,
     IDLE,
-    AttitudeShaper,
     Command,
     Gains,
     Limits,
