@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import pytest
@@ -10,18 +11,24 @@ from tests.sitl.pilot import Pilot
 from uavtool.geo import GeoPoint
 from uavtool.mavlink import mavlink as M
 from uavtool.sitl.shaping import stopping_distance as leash_m
+from uavtool.sitl.state import Mode
 
 GEOFENCE = M.MAV_SYS_STATUS_GEOFENCE
 RTL, LAND = 6, 9
 
 
-def _fenced(alt_max_m: float = 20.0, radius_m: float = 50.0, action: int = 1) -> Pilot:
+def _fenced(
+    alt_max_m: float = 20.0, radius_m: float = 50.0, action: int = 1, *, avoid: int = 3
+) -> Pilot:
+    """A vehicle with the fence on; ``avoid`` 0 turns ArduCopter's stop-at-the-fence off, so
+    that a velocity stream breaches it."""
     pilot = Pilot()
     for name, value in (
         ("FENCE_ENABLE", 1),
         ("FENCE_ALT_MAX", alt_max_m),
         ("FENCE_RADIUS", radius_m),
         ("FENCE_ACTION", action),
+        ("AVOID_ENABLE", avoid),
     ):
         assert pilot.set_param(name, value).param_value == value
     return pilot
@@ -40,7 +47,7 @@ def _local_target(
 def test_a_velocity_climb_stops_at_the_fence_and_triggers_its_action(
     action: int, mode: int
 ) -> None:
-    pilot = _fenced(action=action)
+    pilot = _fenced(action=action, avoid=0)
     pilot.takeoff(5)
     peak = 0.0
     for _ in range(60):  # climb at full speed for 30 s: a stream a target check never sees
@@ -138,7 +145,7 @@ def test_sys_status_reports_the_fence_as_arducopter_does() -> None:
     assert status.onboard_control_sensors_present & GEOFENCE
     assert status.onboard_control_sensors_health & GEOFENCE  # not breached: no "fence breach"
     assert not status.onboard_control_sensors_enabled & GEOFENCE  # FENCE_ENABLE 0 by default
-    pilot = _fenced(action=0)  # report only: the breach shows in SYS_STATUS
+    pilot = _fenced(action=0, avoid=0)  # report only: the breach shows in SYS_STATUS
     pilot.takeoff(5)
     for _ in range(24):
         pilot.send(_local_target(vel=(0, 0, -5)))
@@ -147,3 +154,67 @@ def test_sys_status_reports_the_fence_as_arducopter_does() -> None:
     assert status.onboard_control_sensors_enabled & GEOFENCE
     assert not status.onboard_control_sensors_health & GEOFENCE
     assert pilot.mode() == 4  # still GUIDED: FENCE_ACTION 0 only reports
+
+
+def test_velocity_streams_stop_short_of_the_fence_as_arducopters_avoidance() -> None:
+    """AVOID_ENABLE on (ArduCopter's default): a climb at full rate and a stream asking for a
+    million m/s outward both end inside the fence less FENCE_MARGIN, with no breach; the
+    stream outward slides along the circle."""
+    pilot = _fenced(alt_max_m=20.0, radius_m=50.0)
+    pilot.takeoff(5)
+    highest_m = farthest_m = 0.0
+    for _ in range(40):
+        pilot.send(_local_target(vel=(0, 0, -5)))
+        pilot.run(0.5)
+        highest_m = max(highest_m, pilot.alt_m())
+    assert 17.0 < highest_m <= 18.0 + 0.05  # FENCE_ALT_MAX − FENCE_MARGIN
+    for _ in range(60):
+        pilot.send(_local_target(vel=(1e6, 2e5, 0)))
+        pilot.run(0.5)
+        n, e, _ = pilot.sitl.autopilot.state.pos_ned_m
+        farthest_m = max(farthest_m, math.hypot(n, e))
+    assert 45.0 < farthest_m <= 48.0 + 0.3  # FENCE_RADIUS − FENCE_MARGIN
+    assert not any(t.startswith("Fence breached") for t in pilot.statustexts())
+    assert pilot.mode() == 4  # still GUIDED
+
+
+def test_at_the_fence_a_velocity_stream_slides_along_it() -> None:
+    """AVOID_BEHAVE 0 (Copter's default): 20 m east of home, a stream due north ends at the
+    circle's northern edge, not where its line meets the circle (43.6 m north, 20 m east)."""
+    pilot = _fenced(alt_max_m=40.0, radius_m=50.0)
+    pilot.takeoff(10)
+    pilot.send(_local_target(pos=(0, 20, -10)))
+    pilot.run(15.0)
+    for _ in range(80):
+        pilot.send(_local_target(vel=(8, 0, 0)))
+        pilot.run(0.5)
+    n, e, _ = pilot.sitl.autopilot.state.pos_ned_m
+    assert math.hypot(n, e) <= 48.3 and n > 45.0
+    assert e < 10.0  # slid along the circle toward where the stream points
+    assert not any(t.startswith("Fence breached") for t in pilot.statustexts())
+
+
+def test_taking_control_after_a_breach_gets_arducopters_manual_recovery() -> None:
+    """Without avoidance, a stream breaches the fence and RTL flies; a ground station that
+    switches back to GUIDED and streams on gets 10 s (\"Manual recovery started\"), then the
+    backup fence 20 m beyond turns it back again, and 100 m out the fence gives up on RTL and
+    lands: ArduCopter's AC_Fence, step by step."""
+    pilot = _fenced(radius_m=50.0, avoid=0)
+    pilot.takeoff(10)
+    actions = []
+    farthest_m = 0.0
+    ap = pilot.sitl.autopilot
+    for _ in range(240):  # 120 s of a client insisting
+        if ap.mode != Mode.GUIDED:
+            actions.append((pilot.sitl.now_ns / 1e9, int(ap.mode)))
+            assert pilot.set_mode("GUIDED").result == M.MAV_RESULT_ACCEPTED
+        pilot.send(_local_target(vel=(1e6, 0, 0)))
+        pilot.run(0.5)
+        n, e, _ = pilot.sitl.autopilot.state.pos_ned_m
+        farthest_m = max(farthest_m, math.hypot(n, e))
+    texts = pilot.statustexts()
+    assert texts.count("Manual recovery started") >= 2 * len(actions)  # the action's, ours
+    assert [mode for _, mode in actions][:1] == [RTL]
+    # each new action waited out the 10 s of recovery after the last one
+    assert all(b - a >= 10.0 for (a, _), (b, _) in itertools.pairwise(actions))
+    assert LAND in [mode for _, mode in actions]  # given up: more than 100 m outside

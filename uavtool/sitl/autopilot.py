@@ -15,6 +15,7 @@ from collections.abc import Sequence
 from uavtool.geo import GeoPoint, enu_from_geo, geo_from_enu, wrap_180
 from uavtool.mavlink.dialect import mavlink
 from uavtool.sitl.auto import AutoMission
+from uavtool.sitl.avoid import adjust_velocity
 from uavtool.sitl.battery import Battery
 from uavtool.sitl.crash import Collisions
 from uavtool.sitl.fence import Fence
@@ -87,6 +88,7 @@ class Autopilot:
         self._rtl_loiter_until_ns = 0
         self.land_ne = (0.0, 0.0)
         self._velocity_deadline_ns = 0
+        self._velocity_request = (0.0, 0.0, 0.0)  # a GUIDED velocity as asked, before avoidance
         self.battery = Battery(params)
         self.collisions = Collisions(obstacles, body_radius_m)
         self.fence = Fence(params)
@@ -195,6 +197,10 @@ class Autopilot:
         if mode == self.mode:
             return ACCEPTED
         self.mode = mode
+        # ArduCopter: a mode change during a breach is someone taking control to recover (or
+        # the breach's own action): the fence lets them fly for 10 s before it acts again
+        if self.params["FENCE_ACTION"] != 0 and self.fence.manual_recovery_start(self.now_ns):
+            self.say(mavlink.MAV_SEVERITY_INFO, "Manual recovery started")
         self.taking_off = False
         self.speed_override_ms = None
         self.apply_params()
@@ -284,6 +290,7 @@ class Autopilot:
         if not all(math.isfinite(v) for v in vel_ned_ms):
             return denied("Guided: target velocity is not finite")
         vel_ned_ms = _bounded_velocity(vel_ned_ms)
+        self._velocity_request = vel_ned_ms
         self.taking_off = False
         self._velocity_deadline_ns = (
             self.now_ns + 3 * _NS
@@ -401,6 +408,8 @@ class Autopilot:
             t = self.vehicle.target
             if t.vel_ned_ms is not None and self.now_ns > self._velocity_deadline_ns:
                 self.vehicle.set_target(Target(yaw_deg=t.yaw_deg))  # stale velocity stream: stop
+            elif t.vel_ned_ms is not None:
+                self._avoid_fence(t)
             if self.taking_off and self.alt_rel_m() >= -(t.pos_ned_m or (0, 0, 0))[2] - 0.1:
                 self.taking_off = False
         elif mode == Mode.AUTO:
@@ -409,6 +418,20 @@ class Autopilot:
             self._run_rtl()
         elif mode == Mode.LAND:
             self.descend()
+
+    def _avoid_fence(self, t: Target) -> None:
+        """The velocity asked for, cut to what stops the vehicle at the fence (AC_Avoid)."""
+        v, g = self.vehicle, self.vehicle.gains
+        vel = adjust_velocity(
+            self._velocity_request,
+            v.state.pos_ned_m,
+            fence=self.fence,
+            params=self.params,
+            pos_p=(g.pos_ne_p, g.pos_d_p),
+            accel_mss=(v.limits.accel_xy_mss, v.limits.accel_z_mss),
+        )
+        if vel != t.vel_ned_ms:
+            v.target = Target(vel_ned_ms=vel, yaw_deg=t.yaw_deg, yaw_rate_dps=t.yaw_rate_dps)
 
     def descend(self) -> None:
         speed = self.params["LAND_SPEED"] / 100.0
@@ -501,7 +524,7 @@ class Autopilot:
                 self._failsafe_action(mode, keep_auto=False)
 
     def _check_fence(self) -> None:
-        breach = self.fence.check(self.state.pos_ned_m)
+        breach = self.fence.check(self.state.pos_ned_m, self.now_ns)
         if breach is None or not self.armed:
             return
         self.say(mavlink.MAV_SEVERITY_NOTICE, breach.text)

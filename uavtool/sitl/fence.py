@@ -4,7 +4,12 @@ It is enforced twice. A guided target outside it is refused before the vehicle f
 the vehicle's *position* is checked every physics step, in every mode, so that what no target
 check can see (a velocity stream, an AUTO mission, wind) still meets it. A new breach triggers
 ``FENCE_ACTION``; a breach that carries on 20 m further is a new breach again (ArduPilot's
-backup fences), so a vehicle told to fly on after a breach is turned back once more.
+backup fences), so a vehicle told to fly on after a breach is turned back once more. A mode
+change during a breach (a ground station re-taking control, or the breach's own action) starts
+ArduCopter's manual recovery: for 10 s new breaches are noted but not acted on, then the
+backup fences hold again ("Manual recovery started"). Under velocity control the vehicle does
+not reach the fence at all: :mod:`~uavtool.sitl.avoid` stops it short, as ArduCopter's
+AC_Avoid does.
 
 This module only judges and remembers; ``Autopilot`` acts on a :class:`Breach`.
 """
@@ -34,6 +39,9 @@ GIVE_UP_DISTANCE_M = 100.0
 (AC_FENCE_GIVE_UP_DISTANCE): flying back would take too long."""
 BACKUP_DISTANCE_M = 20.0
 """A breach that goes on this much further than where it began triggers the action again."""
+MANUAL_RECOVERY_S = 10.0
+"""After a mode change during a breach, new breaches are not acted on for this long
+(AC_FENCE_MANUAL_RECOVERY_TIME_MIN)."""
 
 # FENCE_ACTION → mode: 1 RTL (or LAND), 2 always LAND, 3 SmartRTL or RTL, 4 BRAKE or LAND,
 # 5 SmartRTL or LAND; this vehicle has no SmartRTL, so 3 falls back to RTL and 5 to LAND.
@@ -67,6 +75,7 @@ class Fence:
         self.breaches = FenceType(0)
         self._backup_alt_m = 0.0
         self._backup_radius_m = 0.0
+        self._recovery_until_ns: int | None = None
 
     @property
     def present(self) -> bool:
@@ -109,8 +118,17 @@ class Fence:
             return denied("Fence: target outside FENCE_RADIUS")
         return None
 
-    def check(self, pos_ned_m: list[float]) -> Breach | None:
-        """Check the vehicle's position; a :class:`Breach` when it newly left the fence."""
+    def manual_recovery_start(self, now_ns: int) -> bool:
+        """A mode change: while a fence is breached, new breaches go unanswered for
+        :data:`MANUAL_RECOVERY_S`. True when that began (ArduCopter says so)."""
+        if not self.breaches:
+            return False
+        self._recovery_until_ns = now_ns + round(MANUAL_RECOVERY_S * 1e9)
+        return True
+
+    def check(self, pos_ned_m: list[float], now_ns: int = 0) -> Breach | None:
+        """Check the vehicle's position; a :class:`Breach` when it newly left the fence (not
+        during a manual recovery, which still moves the backup fences)."""
         types = self.types
         if not types:  # no fence in force (FENCE_ENABLE 0, the default): nothing is breached
             self.breaches = _NONE
@@ -138,6 +156,10 @@ class Fence:
         if not new:
             return None
         self.breaches |= new
+        if self._recovery_until_ns is not None:
+            if now_ns < self._recovery_until_ns:
+                return None
+            self._recovery_until_ns = None
         mode = _ACTION_MODES.get(int(self.params["FENCE_ACTION"]))
         if mode is not None and distance_m > GIVE_UP_DISTANCE_M:
             mode = Mode.LAND

@@ -110,6 +110,8 @@ PARAM_SPECS: tuple[ParamSpec, ...] = (
     P("FENCE_TYPE", 7, _INT8, 0, 15, "fence types: 1 max altitude, 2 circle, 4 polygon, 8 min alt"),
     P("FENCE_ACTION", 1, _INT8, 0, 5, "on a breach: 0 report, 1 RTL or LAND, 2 LAND, 3-5 RTL/LAND"),
     P("FENCE_MARGIN", 2.0, _REAL32, 1, 10, "distance inside the fence RTL keeps to, m"),
+    P("AVOID_ENABLE", 3, _INT8, 0, 7, "avoidance: 1 stop at the fence (+2 proximity, +4 beacons)"),
+    P("AVOID_BEHAVE", 0, _INT8, 0, 1, "at the fence under velocity control: 0 slide, 1 stop"),
     # What each servo output drives (ArduPilot's SERVOn_FUNCTION: 6 mount yaw, 7 mount pitch,
     # 8 mount roll …). Kept so that an ArduCopter parameter file (the mount.parm of
     # docs/vehicles.md) loads as it is; the built-in vehicle's mount moves without them.
