@@ -232,3 +232,24 @@ def test_an_output_pipe_with_a_reader_gets_the_whole_file(tmp_path: Path) -> Non
         assert reader.wait(timeout=10) == 0
     assert _run("scene", "show", "paper", "-o", str(tmp_path / "file.png"))[0] == 0
     assert got.read_bytes() == (tmp_path / "file.png").read_bytes()
+
+
+def test_the_rename_is_put_on_disk_with_its_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """After the rename from ``.partial``, the folder itself is synced: a power cut then cannot
+    bring back the partial name (or no name at all) for a file reported whole."""
+    synced: list[str] = []
+    real_fsync = os.fsync
+
+    def fsync(fd: int) -> None:
+        synced.append(os.readlink(f"/proc/self/fd/{fd}"))
+        real_fsync(fd)
+
+    monkeypatch.setattr(os, "fsync", fsync)
+    out = tmp_path / "out.bin"
+    with atomic_output(out) as tmp:
+        tmp.write_bytes(b"whole")
+        assert not synced
+    assert out.read_bytes() == b"whole"
+    assert synced == [str(tmp_path)]

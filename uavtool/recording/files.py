@@ -116,6 +116,7 @@ def atomic_output(
         if keep_on_error is not None and keep_on_error(exc) and tmp.exists():
             with contextlib.suppress(OSError):
                 tmp.replace(final)
+                sync_folder(final.parent)
         with contextlib.suppress(OSError):
             tmp.unlink()
         raise
@@ -125,3 +126,20 @@ def atomic_output(
         with contextlib.suppress(OSError):
             tmp.unlink()
         raise InputError(f"{output}: cannot write: {exc.strerror or exc}") from None
+    sync_folder(final.parent)
+
+
+def sync_folder(folder: Path) -> None:
+    """Put a rename in ``folder`` on disk (fsync of the folder itself: without it a power cut
+    soon after can bring back the old name). Best effort: a file system that cannot sync a
+    folder (some network ones, Windows) loses nothing more than it did before."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)

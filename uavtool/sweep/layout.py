@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from uavtool.recording.files import sync_folder
 from uavtool.sweep.plan import FlightSpec
 
 PER_FOLDER = 1000
@@ -104,3 +105,4 @@ def write_atomic(path: Path, data: bytes) -> None:
     part = part_path(path)
     part.write_bytes(data)
     part.replace(path)
+    sync_folder(path.parent)

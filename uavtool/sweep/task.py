@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from uavtool.errors import UavtoolError
+from uavtool.recording.files import sync_folder
 from uavtool.sweep.errors import FlightTimeoutError
 from uavtool.sweep.layout import SweepLayout, part_path, write_atomic
 from uavtool.sweep.plan import FlightSpec
@@ -59,6 +60,7 @@ def run_flight(
     write_atomic(layout.row(flight), json.dumps(row, sort_keys=True).encode())
     if part.exists():
         part.replace(recording)
+        sync_folder(recording.parent)
     return row
 
 
