@@ -28,7 +28,7 @@ def test_every_vision_command_has_an_example() -> None:
     for args in (["vision"], ["vision", "vectorize"], ["vision", "match"], ["vision", "model"]):
         result = runner.invoke(cli, [*args, "--help"])
         assert result.exit_code == 0
-        assert "Example:" in result.output
+        assert "Example:" in result.output or "Examples:" in result.output
 
 
 def test_vectorize_writes_shapes_and_overlay(tmp_path: Path) -> None:
@@ -164,3 +164,40 @@ def test_bad_input_is_a_one_line_error(tmp_path: Path) -> None:
     assert result.exit_code == 2
     assert result.output.strip().count("\n") == 0
     assert "bogus.png: not a decodable image" in result.output
+
+
+def test_model_from_the_frames_export_writes(tmp_path: Path) -> None:
+    """`uavtool export --frames` then `uavtool vision model` of its folder, or of three of its
+    photos (their sidecars give the poses), builds the golden flight's target again; a folder
+    without the three views, or two photos, is one line and exit 2."""
+    golden = Path(__file__).resolve().parents[2] / "recordings" / "golden" / "paper.mcap"
+    frames = tmp_path / "frames"
+    runner = CliRunner()
+    assert runner.invoke(cli, ["export", str(golden), "--frames", str(frames)]).exit_code == 0
+    by_folder = runner.invoke(cli, ["vision", "model", str(frames), "-o", str(tmp_path / "a.glb")])
+    assert by_folder.exit_code == 0, by_folder.output
+    assert "watertight True" in by_folder.output
+    tags = {json.loads(p.read_text())["tag"]: p.with_suffix(".png") for p in frames.glob("*.json")}
+    photos = [str(tags[name]) for name in ("top", "front", "right")]
+    by_photos = runner.invoke(cli, ["vision", "model", *photos, "-o", str(tmp_path / "b.glb")])
+    assert by_photos.exit_code == 0, by_photos.output
+    assert (tmp_path / "a.glb").read_bytes() == (tmp_path / "b.glb").read_bytes()
+    for args, says in (([str(tmp_path)], "no frame tagged"), (photos[:2], "give three photos")):
+        bad = runner.invoke(cli, ["vision", "model", *args, "-o", str(tmp_path / "c.glb")])
+        assert bad.exit_code == 2 and "Traceback" not in bad.output
+        assert says in bad.output, bad.output
+    assert not (tmp_path / "c.glb").exists()
+
+
+def test_export_takes_the_model_and_the_target_out_of_a_recording(tmp_path: Path) -> None:
+    golden = Path(__file__).resolve().parents[2] / "recordings" / "golden" / "paper.mcap"
+    model, target = tmp_path / "m.glb", tmp_path / "t.png"
+    result = CliRunner().invoke(
+        cli, ["export", str(golden), "--model", str(model), "--target", str(target)]
+    )
+    assert result.exit_code == 0, result.output
+    assert model.read_bytes()[:4] == b"glTF" and target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    import trimesh
+
+    mesh = trimesh.load(model, force="mesh")
+    assert 5.0 < mesh.bounds[1][2] - mesh.bounds[0][2] < 8.0  # red: 6.5 m tall

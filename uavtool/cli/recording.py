@@ -87,9 +87,24 @@ def info(rec: Path, verify: bool, recover: bool, output: Path | None, as_json: b
     help="Write a Foxglove / Lichtblick layout for the recording (JSON): a 3D view of the "
     "route, photo poses and model, the camera image, the target, attitude plots and the log.",
 )
-def export(rec: Path, tlog: Path | None, frames_dir: Path | None, layout: Path | None) -> None:
-    """Export a recording's MAVLink frames to a telemetry log, its camera frames to PNG, or
-    a Foxglove / Lichtblick layout that shows it.
+@click.option(
+    "--model", "model", type=_PATH, default=None, metavar="FILE.glb",
+    help="Write the 3D model the flight built (glTF binary, as recorded).",
+)  # fmt: skip
+@click.option(
+    "--target", "target", type=_PATH, default=None, metavar="FILE.png",
+    help="Write the target picture the flight searched for (PNG, as recorded).",
+)  # fmt: skip
+def export(
+    rec: Path,
+    tlog: Path | None,
+    frames_dir: Path | None,
+    layout: Path | None,
+    model: Path | None,
+    target: Path | None,
+) -> None:
+    """Export a recording's MAVLink frames to a telemetry log, its camera frames to PNG, a
+    Foxglove / Lichtblick layout that shows it, the model it built or its target picture.
 
     The .tlog opens in MAVProxy, MAVExplorer and mavlogdump.py. The layout is imported in
     Foxglove or Lichtblick with Layouts → Import from file; it switches on the 3D topics
@@ -100,9 +115,13 @@ def export(rec: Path, tlog: Path | None, frames_dir: Path | None, layout: Path |
       uavtool export flight.mcap --tlog flight.tlog && mavlogdump.py flight.tlog
       uavtool export flight.mcap --frames frames/     # frame_0000.png + frame_0000.json …
       uavtool export recordings/golden/paper.mcap --layout paper.layout.json
+      uavtool export flight.mcap --model model.glb --target target.png
     """
-    if tlog is None and frames_dir is None and layout is None:
-        raise click.UsageError("say what to export: --tlog FILE, --frames DIR and/or --layout FILE")
+    if (tlog, frames_dir, layout, model, target) == (None,) * 5:
+        raise click.UsageError(
+            "say what to export: --tlog FILE, --frames DIR, --layout FILE, --model FILE.glb "
+            "and/or --target FILE.png"
+        )
     if tlog is not None:
         from uavtool.recording.tlog import export_tlog
 
@@ -112,15 +131,24 @@ def export(rec: Path, tlog: Path | None, frames_dir: Path | None, layout: Path |
         from uavtool.recording.frames import export_frames
 
         frames = export_frames(rec, frames_dir)
-        target = " and target.png" if frames.target else ""
+        with_target = " and target.png" if frames.target else ""
         click.echo(
-            f"wrote {frames.frames} frames ({frames.with_pose} with a pose){target} to {frames_dir}"
+            f"wrote {frames.frames} frames ({frames.with_pose} with a pose){with_target} to "
+            f"{frames_dir}"
         )
     if layout is not None:
         from uavtool.recording.foxglove_layout import export_layout
 
         panels = export_layout(rec, layout)["configById"]
         click.echo(f"wrote a layout of {len(panels)} panels to {layout}")
+    if model is not None:
+        from uavtool.recording.artifacts import export_model
+
+        click.echo(f"wrote the model ({export_model(rec, model)} bytes of GLB) to {model}")
+    if target is not None:
+        from uavtool.recording.artifacts import export_target
+
+        click.echo(f"wrote the target picture ({export_target(rec, target)} bytes) to {target}")
 
 
 @click.command(name="import")

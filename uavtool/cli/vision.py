@@ -127,21 +127,24 @@ def match_cmd(target: Path, frame: Path, threshold: float | None, allow_mirror: 
 
 
 @vision.command("model", cls=Command, old_spellings=_OLD_SPELLINGS)
-@click.argument("top", type=_IMAGE)
-@click.argument("front", type=_IMAGE)
-@click.argument("right", type=_IMAGE)
+@click.argument("photos", nargs=-1, required=True, type=_IMAGE, metavar="TOP FRONT RIGHT | FOLDER")
 @click.option(
     "--poses",
     type=click.Path(dir_okay=False, path_type=Path),
-    required=True,
-    help="JSON file with each photo's camera pose and intrinsics (see below).",
+    default=None,
+    help="JSON file with each photo's camera pose and intrinsics (its format is above); "
+    "without it, each photo's .json sidecar beside it.",
 )
 @click.option("-o", "--output", "out", type=_OUT, required=True, help="Write the model here (GLB).")
-def model_cmd(top: Path, front: Path, right: Path, poses: Path, out: Path) -> None:
+def model_cmd(photos: tuple[Path, ...], poses: Path | None, out: Path) -> None:
     """Build the 3D model of the building in TOP, FRONT and RIGHT photos; write a GLB.
 
     The building is the shape the TOP photo (gimbal near nadir) is centred on; in FRONT and
     RIGHT (gimbal near horizontal, headings ~90° apart) every shape of its colour counts.
+
+    Each photo's camera comes from the .json sidecar beside it (frame_0006.png beside
+    frame_0006.json, as `uavtool export --frames` writes them), or from a poses file. Given a
+    FOLDER that `export --frames` wrote, the photos are the frames tagged top, front and right.
 
     \b
     The poses file gives each photo's camera in local ENU metres around home:
@@ -156,9 +159,24 @@ def model_cmd(top: Path, front: Path, right: Path, poses: Path, out: Path) -> No
     pitch (-90 = straight down); intrinsics take hfov_deg or fx_px, fy_px, cx_px, cy_px.
 
     \b
-    Example:
+    Examples:
+      uavtool export flight.mcap --frames f/ && uavtool vision model f/ -o model.glb
+      uavtool vision model f/frame_0006.png f/frame_0007.png f/frame_0008.png -o model.glb
       uavtool vision model top.png front.png right.png --poses poses.json -o model.glb
     """
+    if len(photos) == 1 and photos[0].is_dir():
+        from uavtool.vision.sidecars import views_in_folder
+
+        if poses is not None:
+            raise click.UsageError("a FOLDER's frames carry their poses: drop --poses")
+        top, front, right = views_in_folder(photos[0]).values()
+    elif len(photos) == 3:
+        top, front, right = photos
+    else:
+        raise click.UsageError(
+            f"give three photos (TOP FRONT RIGHT) or one folder of uavtool export --frames, "
+            f"not {len(photos)}"
+        )
     from uavtool.vision.commands import model_files
 
     model = model_files(top, front, right, poses=poses, out=out)

@@ -20,6 +20,7 @@ from uavtool.vision.overlay import draw_overlay
 from uavtool.vision.params import ModelParams, RecognizeParams, VectorizeParams
 from uavtool.vision.recognize import Match, best_match
 from uavtool.vision.shapes import Shape
+from uavtool.vision.sidecars import poses_from_sidecars
 from uavtool.vision.vectorize import U8Array, vectorize
 
 
@@ -128,25 +129,31 @@ def model_files(
     front: Path,
     right: Path,
     *,
-    poses: Path,
+    poses: Path | None,
     out: Path,
     vectorize_params: VectorizeParams | None = None,
     params: ModelParams | None = None,
     hue_tolerance_deg: float = 15.0,
 ) -> Model:
-    """Build the model from three photos and their poses file; write it as GLB.
+    """Build the model from three photos and their poses file (None: each photo's sidecar,
+    ``NAME.json`` beside ``NAME.png``, as ``uavtool export --frames`` writes them); write it as
+    GLB.
 
     The object is the shape the top photo is centred on (its roofs only); in the front and
     right photos, every shape of its colour is the object.
     """
-    try:
-        text = poses.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ShapeFileError(f"{poses}: cannot read: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise ShapeFileError(f"{poses}: not a JSON text file") from None
-    cams, ground = views_from_json(text, source=str(poses))
     images = {"top": top, "front": front, "right": right}
+    if poses is None:  # each photo's sidecar, as uavtool export --frames writes them
+        text, source = poses_from_sidecars(images), f"{top.parent}/<sidecars>"
+    else:
+        try:
+            text = poses.read_text(encoding="utf-8")
+        except OSError as exc:
+            raise ShapeFileError(f"{poses}: cannot read: {exc.strerror or exc}") from None
+        except UnicodeDecodeError:
+            raise ShapeFileError(f"{poses}: not a JSON text file") from None
+        source = str(poses)
+    cams, ground = views_from_json(text, source=source)
     shapes: dict[str, tuple[Shape, ...]] = {}
     for name, path in images.items():
         rgb = read_image(path)
