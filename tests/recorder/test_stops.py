@@ -275,3 +275,85 @@ def test_a_full_disk_names_the_file_that_keeps_the_recording(tmp_path: Path) -> 
     assert out.exists() and not list(tmp_path.glob("*.partial"))
     with RecordingReader(out) as reader:
         assert sum(1 for _ in reader.messages([TELEMETRY])) > 0
+
+
+class _StallingCamera:
+    """A live camera that gives two new frames, then the same one for ever (a stalled
+    MJPEG stream)."""
+
+    name = "stalling"
+
+    def __init__(self, intrinsics: Any) -> None:
+        self.intrinsics = intrinsics
+        self.captured_at_s: float | None = None
+        self._taken = 0
+
+    def capture(self, pose: Any) -> Any:
+        del pose
+        self._taken += 1
+        if self._taken <= 2:
+            self.captured_at_s = time.monotonic()
+        k = self.intrinsics
+        return np.full((k.height_px, k.width_px, 3), 90, np.uint8)
+
+    def close(self) -> None:
+        pass
+
+
+def test_a_link_that_dies_before_the_duration_is_said_on_the_last_line_and_exit_3(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`record --duration` over a link whose vehicle falls silent: the file is whole and
+    kept, its last line says what it lacks, and the exit code is 3 (not 0, "stopped")."""
+    from uavtool.recorder import session
+
+    monkeypatch.setattr(session, "LOST_S", 1.0)  # 10 s in real use
+    out = tmp_path / "dead.mcap"
+    scene = load_scene("paper")
+    port = free_udp_port()
+    sitl = vehicle(scene, endpoints=(f"udpout:127.0.0.1:{port}",)).__enter__()
+    threading.Timer(1.5, lambda: sitl.__exit__(None, None, None)).start()  # the radio dies
+    args = ["record", "--connect", f"udpin:127.0.0.1:{port}", "-o", str(out)]
+    result = CliRunner().invoke(cli, [*args, "--duration", "4", "--camera", "none"])
+    assert result.exit_code == 3, result.output
+    last = result.output.strip().splitlines()[-1]
+    assert last.startswith("incomplete: link: nothing heard from the vehicle for the last ")
+    assert summarize(out).whole
+    with RecordingReader(out) as reader:
+        kept = dict(reader.metadata)["record_result"]
+    assert kept["stopped"] == "duration" and kept["gaps"].startswith("link: nothing heard")
+
+
+def test_a_camera_that_stalls_is_said_on_the_last_line_and_exit_3(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from uavtool.runner import camera
+
+    monkeypatch.setitem(
+        camera.SOURCES,
+        "opencv",
+        lambda _arg, _scene, intrinsics, _seed: _StallingCamera(intrinsics),
+    )
+    out = tmp_path / "stalled.mcap"
+    scene = load_scene("paper")
+    with vehicle(scene, endpoints=("tcpin:127.0.0.1:0",)) as sitl:
+        args = ["record", "--connect", f"tcp:127.0.0.1:{sitl.ports[0]}", "-o", str(out)]
+        result = CliRunner().invoke(
+            cli, [*args, "--duration", "4", "--camera", "opencv:0", "--rate", "5"]
+        )
+    assert result.exit_code == 3, result.output
+    last = result.output.strip().splitlines()[-1]
+    assert last.startswith("incomplete: camera: nothing new for the last "), last
+    assert summarize(out).whole
+
+
+def test_a_recording_that_got_all_it_asked_for_exits_0(tmp_path: Path) -> None:
+    out = tmp_path / "whole.mcap"
+    scene = load_scene("paper")
+    with vehicle(scene, endpoints=("tcpin:127.0.0.1:0",)) as sitl:
+        args = ["record", "--connect", f"tcp:127.0.0.1:{sitl.ports[0]}", "-o", str(out)]
+        result = CliRunner().invoke(
+            cli, [*args, "--duration", "3", "--camera", "sim", "--scene", "paper", "--rate", "2"]
+        )
+    assert result.exit_code == 0, result.output
+    assert "incomplete" not in result.output

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import signal
+import sys
 import threading
 from pathlib import Path
 from types import FrameType
@@ -10,6 +11,10 @@ from types import FrameType
 import click
 
 from uavtool.terminal import counted
+
+INCOMPLETE_EXIT = 3
+"""``uavtool record`` wrote a whole file, but the vehicle fell silent or the camera stalled
+before the end that was asked for."""
 
 
 @click.command()
@@ -162,3 +167,7 @@ def record(
         f"{counted(summary.telemetry, 'telemetry sample')}, {counted(summary.frames, 'frame')}, "
         f"{counted(summary.photos, 'photo')}, {counted(summary.events, 'event')}"
     )
+    if summary.gaps:
+        # the file is whole and kept; what it holds is less than was asked for
+        click.echo(f"incomplete: {'; '.join(summary.gaps)}")
+        sys.exit(INCOMPLETE_EXIT)

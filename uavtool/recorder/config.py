@@ -65,3 +65,6 @@ class RecordSummary:
     events: int
     max_pose_dt_ms: int
     """The largest gap, in vehicle time, between a frame's capture and its pose's sample."""
+    gaps: tuple[str, ...] = ()
+    """What the file lacks of what was asked for, one line each: a link silent for the end
+    of the recording, a camera that stalled or failed. Empty: whole as asked."""

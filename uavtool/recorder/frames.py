@@ -83,6 +83,12 @@ class PoseTrack:
         return min(self.samples, key=lambda s: abs(s[0].time_boot_ms - time_boot_ms))[0]
 
 
+STALL_PERIODS = 3.0
+STALL_MIN_S = 2.0
+"""A live camera with nothing new for this many frame periods (and at least this long) at
+the end of a recording has stalled."""
+
+
 class FrameTaker:
     """Takes frames from ``camera`` every ``1/rate_hz`` s (0: never), a photo every
     ``photo_every_s`` (0: never) and on every trigger. ``renders``: the camera renders at the
@@ -105,6 +111,11 @@ class FrameTaker:
         self.frames = 0
         self.photos = 0
         self.events: list[Event] = []
+        self.due = 0
+        """Frames the rate asked for so far."""
+        self.failed_at_s: float | None = None
+        self.last_new_s: float | None = None
+        """When the camera last gave a new frame (``time.monotonic``)."""
         self._next_frame_s: float | None = None
         self._next_photo_s: float | None = None
         self._last_taken_s: float | None = None
@@ -126,6 +137,7 @@ class FrameTaker:
         due = self.period_s is not None and now_s >= self._next_frame_s
         if due and self.period_s is not None:
             self._next_frame_s = max(self._next_frame_s + self.period_s, now_s)
+            self.due += 1
         if trigger or due:
             self._capture(now_s, track, trigger)
         return self._resolve(now_s, track)
@@ -133,6 +145,26 @@ class FrameTaker:
     def finish(self, track: PoseTrack) -> list[Frame]:
         """The frames still waiting for a pose, with the best one known."""
         return self._resolve(float("inf"), track)
+
+    def gap(self, *, start_s: float, end_s: float) -> str | None:
+        """What the camera failed to give between ``start_s`` and ``end_s`` (monotonic
+        seconds): one line, or None when it kept up. A camera stalled for the last
+        :data:`STALL_PERIODS` frame periods (and at least :data:`STALL_MIN_S`), or that gave
+        under half the frames its rate asked for, did not."""
+        if self.failed_at_s is not None:
+            return f"camera: failed {self.failed_at_s - start_s:.1f} s in; no frames after"
+        if self.period_s is None or self.due < 3:
+            return None
+        since = self.last_new_s if self.last_new_s is not None else start_s
+        stalled_s = end_s - since
+        if stalled_s >= max(STALL_PERIODS * self.period_s, STALL_MIN_S):
+            return (
+                f"camera: nothing new for the last {stalled_s:.1f} s ({self.frames} of "
+                f"{self.due} frames due)"
+            )
+        if self.frames < self.due / 2:
+            return f"camera: {self.frames} of {self.due} frames due"
+        return None
 
     def _capture(self, now_s: float, track: PoseTrack, trigger: str) -> None:
         assert self.camera is not None
@@ -147,12 +179,14 @@ class FrameTaker:
         except CameraError as exc:
             self.events.append(Event(LogLevel.ERROR, f"{exc}; no more frames", "camera"))
             self.camera = None
+            self.failed_at_s = now_s
             return
         # A live camera's frame arrived on its own thread, maybe before this tick.
         taken_s = self.camera.captured_at_s
         if taken_s is not None and taken_s == self._last_taken_s and not trigger:
             return  # the same frame as last time: the camera is slower than the frame rate
         self._last_taken_s = taken_s
+        self.last_new_s = now_s
         taken_s = now_s if taken_s is None else taken_s
         photo = -1
         if trigger:

@@ -144,10 +144,21 @@ def _record(
             )
         say(f"recording to {config.output} (Ctrl-C to stop)")
         loop = _Loop(config, link, tap.watch, recorder, taker, origin, stop_now)
-        stop = loop.run()
+        try:
+            stop = loop.run()
+        except LinkError as exc:  # the vehicle closed the link: what came before is kept
+            recorder.event(Event(LogLevel.ERROR, f"recording stopped: {exc}", "recorder"))
+            kept_s = time.monotonic() - loop.start_s
+            raise LinkError(
+                f"{exc}; the {kept_s:.1f} s recorded until then are kept in {config.output}"
+            ) from None
         for f in taker.finish(loop.track) if taker is not None else []:
             recorder.frame(f)
-        duration_s = time.monotonic() - loop.start_s
+        end_s = time.monotonic()
+        duration_s = end_s - loop.start_s
+        gaps = loop.gaps(stop, end_s)
+        for gap in gaps:
+            recorder.event(Event(LogLevel.WARNING, f"recording incomplete: {gap}", "recorder"))
         recorder.event(Event(LogLevel.INFO, f"recording stopped: {stop.value}", "recorder"))
         c = recorder.counts
         writer.add_metadata(
@@ -158,6 +169,7 @@ def _record(
                 "frames": str(c["frames"]),
                 "photos": str(c["photos"]),
                 "max_pose_dt_ms": str(recorder.max_pose_dt_ms),
+                "gaps": "; ".join(gaps),
             },
         )
     return RecordSummary(
@@ -172,6 +184,7 @@ def _record(
         c["photos"],
         c["events"],
         recorder.max_pose_dt_ms,
+        gaps,
     )
 
 
@@ -198,6 +211,26 @@ class _Loop:
         self._vehicle_home = link.state.home
         self._last_hb_s: float | None = None
         self._requested = False
+        self.last_rx_s = self.start_s
+
+    def gaps(self, stop: Stop, end_s: float) -> tuple[str, ...]:
+        """What the recording lacks of what was asked for, one line each (the vehicle gone
+        silent before a --duration or --until-landed end, a camera that stalled or failed);
+        nothing for Ctrl-C, which ends it where the user wanted."""
+        if stop is Stop.INTERRUPTED:
+            return ()
+        found = []
+        silent_s = end_s - self.last_rx_s
+        if silent_s >= LOST_S:
+            found.append(
+                f"link: nothing heard from the vehicle for the last {silent_s:.1f} s "
+                f"(since {self.last_rx_s - self.start_s:.1f} s in)"
+            )
+        if self.taker is not None:
+            camera = self.taker.gap(start_s=self.start_s, end_s=end_s)
+            if camera is not None:
+                found.append(camera)
+        return tuple(found)
 
     def run(self) -> Stop:
         c, link, clock = self.config, self.link, time.monotonic
@@ -211,6 +244,7 @@ class _Loop:
                     if silent:
                         self._note(LogLevel.INFO, "link: the vehicle speaks again")
                     last_rx, silent = now, False
+                    self.last_rx_s = now
                 elif not silent and now - last_rx >= SILENCE_S:
                     silent = True
                     self._note(LogLevel.WARNING, f"link: nothing heard for {SILENCE_S:g} s")
