@@ -111,6 +111,7 @@ def _annotations(payload: Mapping[str, Any], t_ns: int) -> bytes:
             p.type = kind
             p.thickness = 2.0
             p.outline_color.r, p.outline_color.g, p.outline_color.b, p.outline_color.a = _COLOUR
+            p.fill_color.SetInParent()  # transparent: outlines only
             for x, y in points:
                 point = p.points.add()
                 point.x, point.y = x, y

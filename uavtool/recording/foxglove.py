@@ -110,6 +110,16 @@ def _png(image: RgbImage) -> bytes:
     return rgb_png(image.pixels, image.height_px, image.width_px)
 
 
+_MODEL_GREY = (0.8, 0.8, 0.8, 1.0)
+
+
+def _unknown_covariance(pb: Any) -> None:
+    """A fix without an accuracy estimate: nine zeros, COVARIANCE_TYPE_UNKNOWN (0), which
+    Foxglove's JSON schema asks for (exactly nine values)."""
+    pb.position_covariance.extend((0.0,) * 9)
+    pb.position_covariance_type = 0
+
+
 def _stamp(pb: Any, t_ns: int) -> None:
     pb.timestamp.seconds, pb.timestamp.nanos = divmod(t_ns, 1_000_000_000)
 
@@ -156,6 +166,7 @@ def encode(value: FoxgloveValue, t_ns: int) -> bytes:
         )
         c = pb.color
         c.r, c.g, c.b, c.a = value.color_rgba
+        _unknown_covariance(pb)
     elif isinstance(value, PosesInFrame):
         _stamp(pb, t_ns)
         pb.frame_id = value.frame_id
@@ -171,9 +182,12 @@ def encode(value: FoxgloveValue, t_ns: int) -> bytes:
         entity = pb.entities.add()
         _stamp(entity, t_ns)
         entity.frame_id, entity.id = value.frame_id, value.entity_id
+        entity.lifetime.SetInParent()  # 0: until replaced
         model = entity.models.add()
         _pose_pb(value.pose, model.pose)
         model.scale.x = model.scale.y = model.scale.z = 1.0
+        c = model.color  # used only with override_color (off): the model's own grey
+        c.r, c.g, c.b, c.a = _MODEL_GREY
         mesh = value.mesh
         glb = value.glb if mesh is None else mesh_glb(mesh.vertices_m, mesh.faces)
         model.media_type, model.data = _GLB_MEDIA_TYPE, glb
@@ -196,6 +210,7 @@ class VehicleEncoder:
         self._fix.frame_id = fix.frame_id
         c = self._fix.color
         c.r, c.g, c.b, c.a = fix.color_rgba
+        _unknown_covariance(self._fix)
 
     def pose(self, pos_enu_m: tuple[float, float, float], heading_deg: float, t_ns: int) -> bytes:
         """``encode(PosesInFrame((Pose.from_enu_heading(pos_enu_m, heading_deg),)), t_ns)``."""

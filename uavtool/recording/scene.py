@@ -31,8 +31,10 @@ def encode_markers(value: SceneMarkers, pb: Any, t_ns: int) -> None:
         entity = pb.entities.add()
         entity.timestamp.seconds, entity.timestamp.nanos = divmod(t_ns, 1_000_000_000)
         entity.frame_id, entity.id = e.frame_id, e.entity_id
+        entity.lifetime.SetInParent()  # 0: until replaced (Foxglove's JSON schema requires it)
         if e.line_m:
             line = entity.lines.add()
+            _pose(line.pose, Pose((0.0, 0.0, 0.0)))  # the points are in the entity's frame
             line.type, line.thickness, line.scale_invariant = _LINE_STRIP, 2.0, True
             _colour(line.color, e.colour_rgba)
             for p in e.line_m:
