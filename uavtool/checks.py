@@ -59,6 +59,9 @@ NON_NEGATIVE = Range(0.0)
 FRACTION = Range(0.0, 1.0)
 """[0, 1]"""
 DN = Range(0, 255)
+SEED_RANGE = Range(0, 2**63 - 1)
+"""Seeds: what numpy's and Python's generators take alike, and what a table's 64-bit integer
+column holds."""
 """An 8-bit pixel value (digital number)."""
 
 
@@ -230,6 +233,12 @@ def _example(hint: object) -> str:
 
 def _num(value: float) -> str:
     return str(int(value)) if float(value).is_integer() and abs(value) < 1e15 else str(value)
+
+
+def shown(value: object) -> str:
+    """``repr(value)`` cut to 60 characters: a hostile value stays a short line."""
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def _show(value: object) -> str:

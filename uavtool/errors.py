@@ -8,6 +8,12 @@ message on one line. Messages say what failed and where, e.g.
 
 from __future__ import annotations
 
+INCOMPLETE_EXIT = 3
+"""Exit code of a command that did its work on less than it was asked for: a recording that
+ended early (`record`) or a truncated file read up to its cut (`export`, `view`, `replay`).
+Its output is whole as far as it goes and is kept; the last line, ``incomplete: …``, says
+what is missing."""
+
 
 class UavtoolError(Exception):
     """Root of all uavtool errors."""

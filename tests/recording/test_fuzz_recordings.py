@@ -22,7 +22,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from uavtool.cli import cli
-from uavtool.errors import UavtoolError
+from uavtool.errors import INCOMPLETE_EXIT, UavtoolError
 from uavtool.recording import RecordingReader, RecordingWriter
 from uavtool.recording.info import summarize
 from uavtool.replay import load_flight, replay
@@ -166,3 +166,13 @@ def test_a_damaged_recording_never_passes_for_whole(
     assert not isinstance(replayed.exception, Exception) or isinstance(
         replayed.exception, SystemExit
     ), repr(replayed.exception)
+    if info.damage or not info.whole:  # messages lost: exported and shown only with a word
+        for args in (
+            ["export", "--tlog", str(work / "o.tlog")],
+            ["view", "--save", str(work / "v.rrd")],
+        ):
+            result = CliRunner().invoke(cli, [args[0], str(path), *args[1:]])
+            assert result.exit_code in (2, INCOMPLETE_EXIT), (args, result.output)
+            assert not isinstance(result.exception, Exception) or isinstance(
+                result.exception, SystemExit
+            ), repr(result.exception)

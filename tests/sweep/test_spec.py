@@ -109,7 +109,14 @@ def test_a_changed_input_is_a_new_flight_key(tmp_path: Path) -> None:
         ("[random]\nseed = { uniform = [0, 9] }\n", [], "random.seed: drew"),
         ('[sweep]\nformat = "xlsx"\n', [], "sweep.format: expected 'parquet' or 'csv'"),
         ("[grid\nseed = 1\n", [], "not valid TOML"),
-        ("", ["grid.seed=[-1]"], "grid.seed[0]: expected a whole number ≥ 0"),
+        ("", ["grid.seed=[-1]"], "grid.seed[0]: expected a whole number in [0, "),
+        # seeds beyond a 64-bit column: the attack run's 4,300 digits passed the spec before
+        (f"[grid]\nseed = [1, {'9' * 4300}]\n", [], "grid.seed[1]: expected a whole number in"),
+        ("[grid]\nseed = [9223372036854775808]\n", [], "grid.seed[0]: expected a whole number"),
+        (f"[[cases]]\nseed = {'9' * 4300}\n", [], "cases[0].seed: expected a whole number in"),
+        (f"[random]\nrng_seed = {'9' * 4300}\n", [], "random.rng_seed: expected a whole number"),
+        (f"[scenes.hard]\nseeds = [{'9' * 4300}]\n", [], "scenes.hard[0].seeds[0]: expected"),
+        ("[scenes.random]\nseeds = [-3]\n", [], "scenes.random[0].seeds[0]: expected a whole"),
         ("[grid]\nseed = [1]\n[random]\nseed = 3\n", [], "random.seed: already a grid dimension"),
         ("[[cases]]\nseed = 1\n[[cases]]\nwind = 3\n", [], "cases[1].wind: unknown flight input"),
         ("[[cases]]\nnoise = 1\n", [], "cases[0].noise: expected true or false"),
@@ -129,6 +136,7 @@ def test_a_bad_spec_exits_2_naming_the_key_path(
     assert result.exit_code == 2, result.output
     assert f"{path}: {where}" in result.output or where in result.output
     assert "Traceback" not in result.output
+    assert len(result.output.strip().splitlines()) == 1 and len(result.output) < 700
     assert not (tmp_path / "out").exists()
 
 

@@ -12,11 +12,8 @@ from typing import Any
 
 import click
 
-from uavtool.checks import ANY, Range, coerce
+from uavtool.checks import ANY, SEED_RANGE, Range, coerce
 from uavtool.errors import InputError
-
-SEED_RANGE = Range(0, 2**63 - 1)
-"""Seeds: what numpy's and Python's generators take alike."""
 
 
 class Number(click.ParamType[Any]):

@@ -10,9 +10,9 @@ from types import FrameType
 
 import click
 
+from uavtool.errors import INCOMPLETE_EXIT
 from uavtool.terminal import counted
 
-INCOMPLETE_EXIT = 3
 """``uavtool record`` wrote a whole file, but the vehicle fell silent or the camera stalled
 before the end that was asked for."""
 

@@ -3,11 +3,12 @@ recordings. Heavy imports happen inside the commands so ``uavtool --help`` stays
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import click
 
-from uavtool.errors import InputError
+from uavtool.errors import INCOMPLETE_EXIT, InputError
 
 # No dir_okay=False: click would answer a directory with a usage screen; the readers and
 # writers refuse one in a line of their own (what it is, and what was expected).
@@ -122,6 +123,9 @@ def export(
             "say what to export: --tlog FILE, --frames DIR, --layout FILE, --model FILE.glb "
             "and/or --target FILE.png"
         )
+    from uavtool.recording.info import truncation
+
+    cut = truncation(rec)  # a cut file is exported up to its cut, and said so last
     if tlog is not None:
         from uavtool.recording.tlog import export_tlog
 
@@ -149,6 +153,9 @@ def export(
         from uavtool.recording.artifacts import export_target
 
         click.echo(f"wrote the target picture ({export_target(rec, target)} bytes) to {target}")
+    if cut:
+        click.echo(f"incomplete: {cut}")
+        sys.exit(INCOMPLETE_EXIT)
 
 
 @click.command(name="import")

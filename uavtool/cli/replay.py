@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 from uavtool.cli.spelling import Command, OldSpelling
-from uavtool.errors import FailureError, InputError
+from uavtool.errors import INCOMPLETE_EXIT, FailureError, InputError
 from uavtool.terminal import counted
 
 _OLD_SPELLINGS = (
@@ -228,7 +228,10 @@ def replay(
             f"({len(flight.outputs)} recorded)"
         )
         if result.first_difference is None and result.divergence is None:
-            click.echo("identical: every output equals the recorded one")
+            if flight.truncated:
+                click.echo("the same up to the cut: every output equals the recorded one")
+            else:
+                click.echo("identical: every output equals the recorded one")
         elif result.first_difference is not None:
             click.echo(f"first difference: {result.first_difference.describe()}")
         if result.divergence is not None:
@@ -252,6 +255,11 @@ def replay(
                 click.echo(change.describe())
     if check and not vision_only and result.first_difference is not None:
         sys.exit(1)
+    if flight.truncated:
+        from uavtool.recording.info import truncation
+
+        click.echo(f"incomplete: {truncation(recording)}")
+        sys.exit(INCOMPLETE_EXIT)
 
 
 def _vision(recording: Path, spec: str, out: Path | None) -> None:

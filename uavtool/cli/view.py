@@ -12,7 +12,7 @@ import click
 
 from uavtool.cli.options import PORT, check_web_ports
 from uavtool.cli.spelling import Command, OldSpelling
-from uavtool.errors import InputError
+from uavtool.errors import INCOMPLETE_EXIT, InputError
 from uavtool.terminal import counted
 
 
@@ -89,6 +89,11 @@ def view(
     if save is None and not web and sys.platform.startswith("linux"):
         if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
             raise InputError("no display for the native viewer: use --web or --save OUT.rrd")
+    from uavtool.recording.info import truncation
+
+    # a cut file is shown up to its cut, and said so last (first when the viewer blocks)
+    cuts = [truncation(recording), truncation(compare) if compare is not None else ""]
+    cut = "; ".join(c for c in cuts if c)
     result = show(
         recording,
         save=save,
@@ -106,13 +111,18 @@ def view(
         + (f", {counted(c.pictures, 'picture')}" if c.pictures else "")
         + (f", {counted(c.detections, 'detection')}" if c.detections else "")
     )
-    if save is not None:
-        click.echo(f"wrote {save}: {summary}")
+    if save is not None or not web:
+        if save is not None:
+            click.echo(f"wrote {save}: {summary}")
+        else:
+            click.echo(f"sent to the Rerun viewer: {summary}")
+            result.viewer.close()
+        if cut:
+            click.echo(f"incomplete: {cut}")
+            sys.exit(INCOMPLETE_EXIT)
         return
-    if not web:
-        click.echo(f"sent to the Rerun viewer: {summary}")
-        result.viewer.close()
-        return
+    if cut:
+        click.echo(f"incomplete: {cut}")
     click.echo(f"web viewer: {result.url}")
     click.echo(f"({summary}; Ctrl-C to stop)")
     signal.signal(signal.SIGTERM, _stop)  # `kill` stops the servers too

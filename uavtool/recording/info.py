@@ -235,3 +235,20 @@ def _ending(info: RecordingInfo) -> str:
     )
     rest = [f"{k}={v}" for k, v in r.items() if k not in known]
     return text + (f" ({', '.join(rest)})" if rest else "")
+
+
+def truncation(path: str | Path) -> str:
+    """One line on where the file ``path`` was cut ("" when it is whole): what `export`,
+    `view` and `replay` say after reading what it holds. Raises `CorruptRecordingError` for a
+    damaged metadata record, or a data section that fails its CRC (a record outside the
+    chunks was changed: what the file says cannot be trusted, though every message may read)."""
+    with RecordingReader(path) as reader:
+        health = reader.health
+        reader.require_metadata({d.name for d in reader.damage if d.name})
+    if health.whole:
+        return ""
+    return (
+        f"{path} is truncated ({health.problem}): only what its first {health.readable_bytes} "
+        f"of {health.size_bytes} bytes hold was read; `uavtool info --recover {path} -o "
+        "fixed.mcap` makes it a whole file"
+    )

@@ -168,8 +168,7 @@ class RecordingReader:
             for block in layout.blocks:
                 if block.chunked and block.data is None and block.offset not in self._checked:
                     self._read_block(block, raise_damage=False)
-        crc = layout.data_crc
-        if crc and not self.damage and self._crc32(layout.data_end) != crc:
+        if not self.damage and not self.data_section_intact():
             self._found.append(
                 Damage(
                     "data section",
@@ -180,6 +179,12 @@ class RecordingReader:
             )
         return self.damage
 
+    def data_section_intact(self) -> bool:
+        """Whether the data section matches its CRC (True when the file has none): a cheap
+        check of the records outside the chunks, which carry no CRC of their own."""
+        layout = self._layout
+        return not layout.data_crc or self._crc32(layout.data_end) == layout.data_crc
+
     def _crc32(self, end: int) -> int:
         with memoryview(self._buf) as view, view[:end] as data:  # no copy of the file
             return zlib.crc32(data)
@@ -189,6 +194,15 @@ class RecordingReader:
         damage = self.verify()
         if damage:
             raise self._corrupt(damage[0])
+
+    def require_decodable(self) -> None:
+        """Decode every message of a schema we know; `RecordingError` names the first that
+        does not decode (content crafted or damaged before the file's checksums were made)."""
+        for message in self.messages():
+            try:
+                self.decode(message)
+            except UnknownSchemaError:
+                continue
 
     def require_metadata(self, names: Iterable[str]) -> None:
         """Raise `CorruptRecordingError` if a metadata record named in ``names`` (or one whose
@@ -391,9 +405,13 @@ class RecordingReader:
         if encoding == JSON_ENCODING:
             try:
                 payload = json.loads(message.data)
-            except ValueError as exc:
+            except ValueError as exc:  # not JSON, not UTF-8
                 raise RecordingError(
                     self.path, f"topic {channel.topic!r} #{message.sequence}: invalid JSON ({exc})"
+                ) from None
+            except RecursionError:
+                raise RecordingError(
+                    self.path, f"topic {channel.topic!r} #{message.sequence}: JSON nested too deep"
                 ) from None
             if not isinstance(payload, dict):
                 raise RecordingError(self.path, f"topic {channel.topic!r}: JSON is not an object")

@@ -95,6 +95,15 @@ def load_flight(path: str | Path, *, mission: str | None = None) -> RecordedFlig
                         f"{path}: output {len(outputs) + 1} on {OUTPUTS} has no whole-number "
                         "n and step"
                     )
+                if not isinstance(data.get("type"), str):
+                    raise ReplayInputError(
+                        f"{path}: output {len(outputs) + 1} on {OUTPUTS} names no type"
+                    )
+                if n != len(outputs) + 1:  # the replay compares them in this order
+                    raise ReplayInputError(
+                        f"{path}: output {len(outputs) + 1} on {OUTPUTS} is numbered {n}: "
+                        "the outputs were reordered, lost or altered"
+                    )
                 outputs.append(RecordedOutput(n, step, without_nulls(data)))
         truncated = not reader.health.whole
         _check_counts(reader, path, {OBSERVATIONS: len(raw_obs), OUTPUTS: len(outputs)})

@@ -71,6 +71,7 @@ def refly_config(path: Path, *, out: Path, workdir: Path, mission: str | None = 
     with RecordingReader(path) as reader:
         reader.require_metadata(("mission", "scene", "flight", "vehicle"))
         reader.require_intact()  # now, not after flying: the comparison needs all of it
+        reader.require_decodable()  # ... and a difference must be the flight's, not the file's
         meta = dict(reader.metadata)
         if not is_lockstep(path):
             raise ReflyInputError(
@@ -168,7 +169,10 @@ def _message_difference(was: Message, now: Message) -> str | None:
     if was.data == now.data:
         return None
     if was.channel.message_encoding == "json":
-        return _json_difference(json.loads(was.data), json.loads(now.data))
+        try:
+            return _json_difference(json.loads(was.data), json.loads(now.data))
+        except (ValueError, RecursionError):
+            pass  # not JSON on one side: compare the bytes
     offset = next(i for i, (x, y) in enumerate(zip_longest(was.data, now.data)) if x != y)
     return f"bytes differ from offset {offset} ({len(was.data)} recorded, {len(now.data)} re-flown)"
 

@@ -15,6 +15,7 @@ import math
 from collections.abc import Callable
 from typing import Any
 
+from uavtool.checks import SEED_RANGE, shown
 from uavtool.errors import InputError
 
 SET_PREFIX = "set."
@@ -26,39 +27,39 @@ Check = Callable[[Any], Any]
 
 def _number(value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ValueError(f"expected a number, got {value!r}")
+        raise ValueError(f"expected a number, got {shown(value)}")
     return float(value)
 
 
 def _non_negative(value: Any) -> float:
     number = _number(value)
     if number < 0:
-        raise ValueError(f"must be ≥ 0, got {value!r}")
+        raise ValueError(f"must be ≥ 0, got {shown(value)}")
     return number
 
 
 def _seed(value: Any) -> int:
-    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-        raise ValueError(f"expected a whole number ≥ 0, got {value!r}")
+    if isinstance(value, bool) or not isinstance(value, int) or value not in SEED_RANGE:
+        raise ValueError(f"expected a whole number {SEED_RANGE}, got {shown(value)}")
     return value
 
 
 def _flag(value: Any) -> bool:
     if not isinstance(value, bool):
-        raise ValueError(f"expected true or false, got {value!r}")
+        raise ValueError(f"expected true or false, got {shown(value)}")
     return value
 
 
 def _outages(value: Any) -> tuple[tuple[float, float], ...]:
     if not isinstance(value, list):
-        raise ValueError(f"expected a list of [start_s, duration_s] pairs, got {value!r}")
+        raise ValueError(f"expected a list of [start_s, duration_s] pairs, got {shown(value)}")
     out = []
     for pair in value:
         if not isinstance(pair, list) or len(pair) != 2:
-            raise ValueError(f"expected [start_s, duration_s], got {pair!r}")
+            raise ValueError(f"expected [start_s, duration_s], got {shown(pair)}")
         start_s, duration_s = _non_negative(pair[0]), _number(pair[1])
         if duration_s <= 0:
-            raise ValueError(f"an outage lasts > 0 s, got {pair!r}")
+            raise ValueError(f"an outage lasts > 0 s, got {shown(pair)}")
         out.append((start_s, duration_s))
     return tuple(out)
 
@@ -104,7 +105,7 @@ def check(key: str, value: Any, params_type: type | None = None) -> Any:
                 if close
                 else "see `uavtool missions NAME` for its parameters"
             )
-            raise KeyError(f"unknown mission parameter {name!r}; {hint}")
+            raise KeyError(f"unknown mission parameter {shown(name)}; {hint}")
         try:
             with_overrides(root(), {key[len(SET_PREFIX) :]: setting_text(value)}, source="set")
         except InputError as exc:
@@ -115,7 +116,7 @@ def check(key: str, value: Any, params_type: type | None = None) -> Any:
 
         name = key[len(PARAM_PREFIX) :]
         if name not in {s.name for s in PARAM_SPECS}:
-            raise KeyError(f"the built-in vehicle has no parameter {name!r}")
+            raise KeyError(f"the built-in vehicle has no parameter {shown(name)}")
         return _number(value)
     raise KeyError(
         f"unknown flight input; use one of {', '.join(BUILTIN_KEYS)}, "

@@ -47,6 +47,7 @@ from enum import Enum
 from pathlib import Path
 from typing import Any
 
+from uavtool.checks import SEED_RANGE, shown
 from uavtool.errors import UavtoolError
 from uavtool.plugins import resolve
 from uavtool.sweep import dimensions
@@ -143,16 +144,16 @@ def parse_spec(data: Mapping[str, Any], *, source: str, base: Path, default_out:
     _known(sweep, _SWEEP_KEYS, "sweep.", source)
     out = sweep.get("out")
     if out is not None and not isinstance(out, str):
-        raise SpecError(source, "sweep.out", f"expected a folder path, got {out!r}")
+        raise SpecError(source, "sweep.out", f"expected a folder path, got {shown(out)}")
     fmt = sweep.get("format", "parquet")
     if not isinstance(fmt, str) or fmt not in {f.value for f in TableFormat}:
-        raise SpecError(source, "sweep.format", f"expected 'parquet' or 'csv', got {fmt!r}")
+        raise SpecError(source, "sweep.format", f"expected 'parquet' or 'csv', got {shown(fmt)}")
     retries = sweep.get("retries", 2)
     if isinstance(retries, bool) or not isinstance(retries, int) or not 0 <= retries <= 10:
-        raise SpecError(source, "sweep.retries", f"expected 0..10, got {retries!r}")
+        raise SpecError(source, "sweep.retries", f"expected 0..10, got {shown(retries)}")
     mission = sweep.get("mission", "search")
     if not isinstance(mission, str):
-        raise SpecError(source, "sweep.mission", f"expected a mission's name, got {mission!r}")
+        raise SpecError(source, "sweep.mission", f"expected a mission's name, got {shown(mission)}")
     try:
         params_type = resolve(mission)[0].params_type
     except UavtoolError as exc:
@@ -185,7 +186,9 @@ def _timeout(value: Any, source: str) -> float | None:
     if value is None:
         return None
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
-        raise SpecError(source, "sweep.timeout_s", f"expected vehicle seconds > 0, got {value!r}")
+        raise SpecError(
+            source, "sweep.timeout_s", f"expected vehicle seconds > 0, got {shown(value)}"
+        )
     return float(value)
 
 
@@ -211,7 +214,7 @@ def _cases(
 def _apply_override(data: dict[str, Any], text: str, source: str) -> None:
     key, sep, raw = text.partition("=")
     if not sep or not key.strip():
-        raise SpecError(source, "", f"--set {text!r}: expected KEY.PATH=VALUE")
+        raise SpecError(source, "", f"--set {shown(text)}: expected KEY.PATH=VALUE")
     try:
         value = tomllib.loads(f"v = {raw}")["v"]
     except (tomllib.TOMLDecodeError, RecursionError):
@@ -221,7 +224,7 @@ def _apply_override(data: dict[str, Any], text: str, source: str) -> None:
     for part in parts[:-1]:
         child = node.setdefault(part, {})
         if not isinstance(child, dict):
-            raise SpecError(source, key, f"--set: {part!r} is not a table")
+            raise SpecError(source, key, f"--set: {shown(part)} is not a table")
         node = child
     node[parts[-1]] = value
 
@@ -237,7 +240,7 @@ def _known(table: Mapping[str, Any], keys: Sequence[str], prefix: str, source: s
 def _table(data: Mapping[str, Any], key: str, source: str) -> dict[str, Any]:
     value = data.get(key, {})
     if not isinstance(value, dict):
-        raise SpecError(source, key, f"expected a table, got {value!r}")
+        raise SpecError(source, key, f"expected a table, got {shown(value)}")
     return value
 
 
@@ -281,8 +284,12 @@ def _random(
     table = dict(table)
     draws = table.pop("draws", None)
     rng_seed = table.pop("rng_seed", 0)
-    if isinstance(rng_seed, bool) or not isinstance(rng_seed, int):
-        raise SpecError(source, "random.rng_seed", f"expected a whole number, got {rng_seed!r}")
+    if isinstance(rng_seed, bool) or not isinstance(rng_seed, int) or rng_seed not in SEED_RANGE:
+        raise SpecError(
+            source,
+            "random.rng_seed",
+            f"expected a whole number {SEED_RANGE}, got {shown(rng_seed)}",
+        )
     laws = []
     for key, raw in _flatten(table):
         try:
@@ -297,7 +304,7 @@ def _random(
     if draws is None:
         draws = 1 if laws else 0
     if isinstance(draws, bool) or not isinstance(draws, int) or not 0 <= draws <= 1_000_000:
-        raise SpecError(source, "random.draws", f"expected 0..1000000, got {draws!r}")
+        raise SpecError(source, "random.draws", f"expected 0..1000000, got {shown(draws)}")
     if laws and draws == 0:
         raise SpecError(source, "random.draws", "0 draws leave the random dimensions unused")
     return draws, rng_seed, tuple(laws)
@@ -309,7 +316,7 @@ def _entries(value: Any) -> list[Any]:
 
 def _scenes(value: Any, base: Path, source: str) -> Iterator[SceneSource]:
     if not isinstance(value, dict):
-        raise SpecError(source, "scenes", f"expected a table, got {value!r}")
+        raise SpecError(source, "scenes", f"expected a table, got {shown(value)}")
     _known(value, _SCENE_KEYS, "scenes.", source)
     from uavtool.world import builtin_scene_names, load_scene  # noqa: PLC0415
 
@@ -317,12 +324,14 @@ def _scenes(value: Any, base: Path, source: str) -> Iterator[SceneSource]:
     for i, name in enumerate(_entries(value.get("builtin", []))):
         if name not in names:
             where = f"scenes.builtin[{i}]"
-            raise SpecError(source, where, f"no built-in scene {name!r}; one of {', '.join(names)}")
+            raise SpecError(
+                source, where, f"no built-in scene {shown(name)}; one of {', '.join(names)}"
+            )
         yield SceneSource(SceneKind.BUILTIN, name=name)
     for i, name in enumerate(_entries(value.get("files", []))):
         where = f"scenes.files[{i}]"
         if not isinstance(name, str):
-            raise SpecError(source, where, f"expected a file path, got {name!r}")
+            raise SpecError(source, where, f"expected a file path, got {shown(name)}")
         path = base / name
         try:
             load_scene(path)
@@ -344,8 +353,12 @@ def _generated(kind: SceneKind, entry: Any, where: str, source: str) -> SceneSou
     except ValueError as exc:
         raise SpecError(source, f"{where}.seeds", str(exc)) from None
     for i, seed in enumerate(seeds):
-        if isinstance(seed, bool) or not isinstance(seed, int):
-            raise SpecError(source, f"{where}.seeds[{i}]", f"expected a whole number, got {seed!r}")
+        if isinstance(seed, bool) or not isinstance(seed, int) or seed not in SEED_RANGE:
+            raise SpecError(
+                source,
+                f"{where}.seeds[{i}]",
+                f"expected a whole number {SEED_RANGE}, got {shown(seed)}",
+            )
     if kind is SceneKind.HARD:
         from uavtool.world.hard import HardOptions  # noqa: PLC0415
 

@@ -14,10 +14,10 @@ from pathlib import Path
 from uavtool.errors import InputError
 from uavtool.flight import mission_of
 from uavtool.geo import GeoPoint
-from uavtool.recording import CompressedImage, JsonDocument, LogEntry, RecordingReader
+from uavtool.recording import CompressedImage, Entry, JsonDocument, LogEntry, RecordingReader
 from uavtool.recording.annotations import DETECTIONS
 from uavtool.recording.topics import EVENTS, IMAGE, OBSERVATIONS, OUTPUTS, PICTURES, TARGET
-from uavtool.view.errors import ViewError
+from uavtool.view.errors import ViewError, showing
 from uavtool.view.logger import MissionLogger
 from uavtool.view.recorded import is_recorded_flight, log_recorded_flight, log_scene
 
@@ -43,31 +43,34 @@ def log_recording(path: str | Path, logger: MissionLogger) -> None:
         wanted = [t for t in topics if t in present]
         images: deque[bytes] = deque()
         for entry in reader.entries(wanted):
-            value, t_ns = entry.value, entry.log_time_ns
-            if entry.topic == IMAGE and isinstance(value, CompressedImage):
-                images.append(value.data)
-            elif entry.topic == PICTURES and isinstance(value, CompressedImage):
-                logger.picture(value.frame_id, value.data, log_time_ns=t_ns)
-            elif isinstance(value, JsonDocument) and entry.topic == OBSERVATIONS:
-                obs = value.payload
-                png = images.popleft() if obs.get("type") == "Photo" and images else None
-                logger.observation(int(obs.get("step", 0)), obs, png, log_time_ns=t_ns)
-            elif isinstance(value, JsonDocument) and entry.topic == OUTPUTS:
-                out = value.payload
-                logger.output(int(out.get("n", 0)), out, log_time_ns=t_ns)
-            elif isinstance(value, JsonDocument) and entry.topic == DETECTIONS:
-                logger.detections(value.payload, log_time_ns=t_ns)
-            elif isinstance(value, JsonDocument) and entry.topic == STATUSTEXT:
-                msg = value.payload
-                logger.statustext(
-                    int(msg.get("severity", 6)), str(msg.get("text", "")), log_time_ns=t_ns
-                )
-            elif isinstance(value, LogEntry) and value.name == "runner":
-                # The mission's own events come from /mission/outputs and the vehicle's
-                # from STATUSTEXT; this topic repeats both, so only the runner's are new.
-                level = _LEVEL_NAMES.get(int(value.level), "info")
-                logger.note(level, value.message, source="runner", log_time_ns=t_ns)
+            with showing(path, entry):
+                _log_entry(entry, images, logger)
     logger.flush()
+
+
+def _log_entry(entry: Entry, images: deque[bytes], logger: MissionLogger) -> None:
+    value, t_ns = entry.value, entry.log_time_ns
+    if entry.topic == IMAGE and isinstance(value, CompressedImage):
+        images.append(value.data)
+    elif entry.topic == PICTURES and isinstance(value, CompressedImage):
+        logger.picture(value.frame_id, value.data, log_time_ns=t_ns)
+    elif isinstance(value, JsonDocument) and entry.topic == OBSERVATIONS:
+        obs = value.payload
+        png = images.popleft() if obs.get("type") == "Photo" and images else None
+        logger.observation(int(obs.get("step", 0)), obs, png, log_time_ns=t_ns)
+    elif isinstance(value, JsonDocument) and entry.topic == OUTPUTS:
+        out = value.payload
+        logger.output(int(out.get("n", 0)), out, log_time_ns=t_ns)
+    elif isinstance(value, JsonDocument) and entry.topic == DETECTIONS:
+        logger.detections(value.payload, log_time_ns=t_ns)
+    elif isinstance(value, JsonDocument) and entry.topic == STATUSTEXT:
+        msg = value.payload
+        logger.statustext(int(msg.get("severity", 6)), str(msg.get("text", "")), log_time_ns=t_ns)
+    elif isinstance(value, LogEntry) and value.name == "runner":
+        # The mission's own events come from /mission/outputs and the vehicle's
+        # from STATUSTEXT; this topic repeats both, so only the runner's are new.
+        level = _LEVEL_NAMES.get(int(value.level), "info")
+        logger.note(level, value.message, source="runner", log_time_ns=t_ns)
 
 
 def _setup(
@@ -92,7 +95,9 @@ def _setup(
         for entry in reader.entries([HOME_POSITION]):
             if isinstance(entry.value, JsonDocument):
                 msg = entry.value.payload
-                logger.home(
-                    GeoPoint(msg["latitude"] / 1e7, msg["longitude"] / 1e7, msg["altitude"] / 1e3)
-                )
+                with showing(path, entry):
+                    home = GeoPoint(
+                        msg["latitude"] / 1e7, msg["longitude"] / 1e7, msg["altitude"] / 1e3
+                    )
+                    logger.home(home)
             break
