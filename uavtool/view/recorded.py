@@ -16,7 +16,7 @@ from uavtool.geo import GeoPoint
 from uavtool.recording import CompressedImage, JsonDocument, LogEntry, RecordingReader
 from uavtool.recording.annotations import DETECTIONS
 from uavtool.recording.topics import FRAMES, IMAGE, TARGET, TELEMETRY, VEHICLE_EVENTS, VISION
-from uavtool.view.errors import ViewError
+from uavtool.view.errors import ViewError, showing
 from uavtool.view.logger import MissionLogger
 from uavtool.world import SceneError, scene_from_dict
 
@@ -35,35 +35,39 @@ def log_recorded_flight(path: str | Path, reader: RecordingReader, logger: Missi
     results: dict[int, list[dict[str, Any]]] = defaultdict(list)
     first = True
     for entry in reader.entries([t for t in (TARGET, VISION) if t in present]):
-        value = entry.value
-        if isinstance(value, CompressedImage) and first:
-            logger.target(value.data)
-            first = False
-        elif isinstance(value, JsonDocument):
-            out = dict(value.payload)
-            frame = int(out.get("frame_index", -1))
-            if frame == -1:
-                logger.output(0, out)  # the target's shapes
-            else:
-                results[frame].append(out)
+        with showing(path, entry):
+            value = entry.value
+            if isinstance(value, CompressedImage) and first:
+                logger.target(value.data)
+                first = False
+            elif isinstance(value, JsonDocument):
+                out = dict(value.payload)
+                frame = int(out.get("frame_index", -1))
+                if frame == -1:
+                    logger.output(0, out)  # the target's shapes
+                else:
+                    results[frame].append(out)
     wanted = [t for t in (TELEMETRY, FRAMES, IMAGE, DETECTIONS, VEHICLE_EVENTS) if t in present]
     images: deque[bytes] = deque()
     for entry in reader.entries(wanted):
-        value, t_ns = entry.value, entry.log_time_ns
-        if isinstance(value, CompressedImage):
-            images.append(value.data)
-        elif isinstance(value, JsonDocument) and entry.topic == TELEMETRY:
-            logger.observation(0, value.payload, log_time_ns=t_ns)
-        elif isinstance(value, JsonDocument) and entry.topic == DETECTIONS:
-            logger.detections(value.payload, log_time_ns=t_ns)  # replay --vision's
-        elif isinstance(value, JsonDocument) and entry.topic == FRAMES:
-            record = dict(value.payload)
-            logger.observation(0, record, images.popleft() if images else None, log_time_ns=t_ns)
-            for out in results.get(int(record.get("frame_index", -1)), []):
-                logger.output(0, out, log_time_ns=t_ns)
-        elif isinstance(value, LogEntry):
-            level = _LEVEL_NAMES.get(int(value.level), "info")
-            logger.note(level, value.message, source=value.name or "vehicle", log_time_ns=t_ns)
+        with showing(path, entry):
+            value, t_ns = entry.value, entry.log_time_ns
+            if isinstance(value, CompressedImage):
+                images.append(value.data)
+            elif isinstance(value, JsonDocument) and entry.topic == TELEMETRY:
+                logger.observation(0, value.payload, log_time_ns=t_ns)
+            elif isinstance(value, JsonDocument) and entry.topic == DETECTIONS:
+                logger.detections(value.payload, log_time_ns=t_ns)  # replay --vision's
+            elif isinstance(value, JsonDocument) and entry.topic == FRAMES:
+                record = dict(value.payload)
+                logger.observation(
+                    0, record, images.popleft() if images else None, log_time_ns=t_ns
+                )
+                for out in results.get(int(record.get("frame_index", -1)), []):
+                    logger.output(0, out, log_time_ns=t_ns)
+            elif isinstance(value, LogEntry):
+                level = _LEVEL_NAMES.get(int(value.level), "info")
+                logger.note(level, value.message, source=value.name or "vehicle", log_time_ns=t_ns)
     logger.flush()
 
 
