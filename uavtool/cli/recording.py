@@ -53,7 +53,7 @@ def info(rec: Path, verify: bool, recover: bool, output: Path | None, as_json: b
     else:
         click.echo(recording_info.format_info(summary))
     if recover and output is not None:
-        from uavtool.recording.recover import recover as do_recover
+        from uavtool.recording.recovery import recover as do_recover
 
         result = do_recover(rec, output)
         for dropped in result.dropped:

@@ -22,7 +22,7 @@ if TYPE_CHECKING:
     from uavtool.recording.info import RecordingInfo, summarize
     from uavtool.recording.process import ProcessWriter
     from uavtool.recording.reader import Message, RecordingReader
-    from uavtool.recording.recover import recover
+    from uavtool.recording.recovery import recover
     from uavtool.recording.tlog import export_tlog, import_tlog
     from uavtool.recording.values import (
         CameraCalibration,
@@ -56,7 +56,7 @@ _MODULE_OF = {
     "summarize": "info",
     "Message": "reader",
     "RecordingReader": "reader",
-    "recover": "recover",
+    "recover": "recovery",  # not the module's own name: importing it would shadow this
     "export_tlog": "tlog",
     "import_tlog": "tlog",
     "RecordingWriter": "writer",

@@ -16,7 +16,7 @@ from mcap_protobuf.schema import build_file_descriptor_set
 from uavtool.recording.errors import create_file, write_failed
 from uavtool.recording.files import atomic_output
 from uavtool.recording.reader import RecordingReader
-from uavtool.recording.recover import start_copy
+from uavtool.recording.recovery import start_copy
 
 ANNOTATIONS = "/vision/annotations"
 DETECTIONS = "/vision/detections"
