@@ -1,12 +1,14 @@
 """`ProcessWriter`: a `RecordingWriter` in a process of its own, off the flight's path.
 
 A lockstep flight runs as fast as one core allows, and Python's own cost per message (an MCAP
-record of each frame, its JSON view, the telemetry's Protobuf) took a third of it. The
-flight's thread now only checks each call and appends it, as a tuple of what it already holds
-(the frame's bytes, a time), to a batch; every `BATCH_NS` of log time (or `BATCH_CALLS`
-calls) the batch is pickled down a pipe to a child process, which makes the very calls on a
-`RecordingWriter` (decoding each frame again for its JSON view), so the file is the same,
-byte for byte, as one written in the flight's process.
+record of each frame, its JSON view, the Protobuf of every Foxglove value, a photo's PNG)
+took a third of it. The flight's thread now only checks each call and appends it, as a tuple
+of what it already holds (the frame's bytes, a time, the value's fields, a JSON template and
+its numbers), to a batch; every `BATCH_NS` of log time (or `BATCH_CALLS` calls) the batch is
+pickled down a pipe to a child process, which makes the very calls on a `RecordingWriter`
+(decoding each frame again for its JSON view, encoding each value), so the file is the same,
+byte for byte, as one written in the flight's process. The flight's process never imports
+Protobuf.
 
 What is kept:
 
@@ -39,7 +41,7 @@ import subprocess
 import sys
 import threading
 import weakref
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from types import TracebackType
 from typing import TYPE_CHECKING, Any, BinaryIO, NoReturn
@@ -48,7 +50,7 @@ from uavtool.recording.errors import RecordingError, create_file
 from uavtool.recording.protocol import check_metadata, check_topic, foxglove_module
 from uavtool.recording.schemas import DEFAULT_DIALECT, dialect_module, dumps
 from uavtool.recording.topics import FIX, POSE
-from uavtool.recording.values import Direction, LocationFix, PosesInFrame
+from uavtool.recording.values import FOXGLOVE_TYPES, Direction, LocationFix, PosesInFrame
 
 if TYPE_CHECKING:
     from uavtool.geo import GeoPoint
@@ -67,7 +69,7 @@ PIPE_BYTES = 1 << 20
     _MAV_IN,
     _MAV_OUT,
     _VEHICLE,
-    _PROTO,
+    _JSON_FORMAT,
     _JSON,
     _PROTO_TOPIC,
     _JSON_TOPIC,
@@ -263,6 +265,17 @@ class ProcessWriter:
                 raise ValueError(f"topic {topic!r} is not a JSON topic: call add_json_topic first")
             self._queue((_JSON, topic, data, log_time_ns, publish_time_ns), log_time_ns)
 
+    def write_json_format(
+        self, topic: str, template: str, values: tuple[Any, ...], *, log_time_ns: int
+    ) -> None:
+        """`RecordingWriter.write_json_format`: the child formats the JSON."""
+        _check_time(log_time_ns)
+        with self._lock:
+            self._check_open()
+            if topic not in self._json_topics:
+                raise ValueError(f"topic {topic!r} is not a JSON topic: call add_json_topic first")
+            self._queue((_JSON_FORMAT, topic, template, values, log_time_ns), log_time_ns)
+
     def write(
         self,
         topic: str,
@@ -274,10 +287,10 @@ class ProcessWriter:
         check_topic(topic)
         _check_times(log_time_ns, publish_time_ns)
         kind = type(value)
-        foxglove = foxglove_module()
-        # a frame's PNG and a model's GLB are made by the child, off the flight's path
-        deferred = foxglove.deferred(value)
-        data = None if deferred else foxglove.encode(value, log_time_ns)
+        if kind not in FOXGLOVE_TYPES:
+            raise ValueError(f"topic {topic!r}: {kind.__name__} is not a Foxglove value")
+        # the child encodes every value (a frame's PNG and a model's GLB too), off the
+        # flight's path: the flight's process never imports Protobuf
         with self._lock:
             self._check_open()
             if topic not in self._protobuf_topics:
@@ -287,8 +300,7 @@ class ProcessWriter:
                 self._batch.append((_PROTO_TOPIC, topic, kind))
             elif self._topic_kind[topic] is not kind:
                 raise ValueError(f"topic {topic!r} carries {self._topic_kind[topic]!r}, not {kind}")
-            op, payload = (_ENCODE, value) if deferred else (_PROTO, data)
-            self._queue((op, topic, payload, log_time_ns, publish_time_ns), log_time_ns)
+            self._queue((_ENCODE, topic, value, log_time_ns, publish_time_ns), log_time_ns)
 
     def write_mavlink(
         self,
@@ -315,6 +327,28 @@ class ProcessWriter:
             batch.append((op, frame, log_time_ns, publish_time_ns))
             if log_time_ns >= self._ship_at or len(batch) >= BATCH_CALLS:
                 self._ship(log_time_ns)
+
+    def mavlink_tap(self, clock_ns: Callable[[], int]) -> Callable[[str, bytes, Any], None]:
+        """`write_mavlink` as a link's tap, each frame stamped ``clock_ns()``; the decoded
+        message is not used (the child decodes the frame on another core)."""
+        ops = {"in": _MAV_IN, "out": _MAV_OUT}
+        lock = self._lock
+
+        def tap(direction: str, frame: bytes, _decoded: Any) -> None:
+            t = clock_ns()
+            if type(t) is not int or not 0 < t < _END_NS:
+                _check_time(t)
+            if type(frame) is not bytes:
+                frame = bytes(frame)
+            with lock:
+                if self._closed or self._failure is not None:
+                    self._check_open()
+                batch = self._batch
+                batch.append((ops[direction], frame, t, None))
+                if t >= self._ship_at or len(batch) >= BATCH_CALLS:
+                    self._ship(t)
+
+        return tap
 
     def write_vehicle(
         self,
@@ -491,16 +525,18 @@ def _serve(writer: Any, source: Any, reply: Any) -> None:
                 )
             elif op == _VEHICLE:
                 writer.write_vehicle(call[1], call[2], call[3], log_time_ns=call[4])
-            elif op in (_PROTO, _ENCODE):
+            elif op == _ENCODE:
                 name, schema = protobuf[call[1]]
                 write_protobuf(
                     call[1],
-                    call[2] if op == _PROTO else foxglove_module().encode(call[2], call[3]),
+                    foxglove_module().encode(call[2], call[3]),
                     schema_name=name,
                     schema=schema,
                     log_time_ns=call[3],
                     publish_time_ns=call[4],
                 )
+            elif op == _JSON_FORMAT:
+                write_json(call[1], (call[2] % call[3]).encode(), log_time_ns=call[4])
             elif op == _JSON:
                 write_json(call[1], call[2], log_time_ns=call[3], publish_time_ns=call[4])
             elif op == _PROTO_TOPIC:

@@ -5,7 +5,7 @@ both make. A flight that writes in a process of its own imports this, not the MC
 from __future__ import annotations
 
 import importlib
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from functools import cache
 from types import ModuleType
 from typing import TYPE_CHECKING, Any, Protocol
@@ -48,6 +48,13 @@ class MessageWriter(Protocol):
         self, topic: str, data: bytes, *, log_time_ns: int, publish_time_ns: int | None = None
     ) -> None: ...
 
+    def write_json_format(
+        self, topic: str, template: str, values: tuple[Any, ...], *, log_time_ns: int
+    ) -> None:
+        """`write_json_bytes` of ``(template % values).encode()``: the caller vouches that it
+        is JSON as `dumps` writes it; a writer process formats it, off the flight's path."""
+        ...
+
     def write(
         self,
         topic: str,
@@ -66,6 +73,12 @@ class MessageWriter(Protocol):
         publish_time_ns: int | None = None,
         decoded: Any = None,
     ) -> None: ...
+
+    def mavlink_tap(self, clock_ns: Callable[[], int]) -> Callable[[str, bytes, Any], None]:
+        """A link's tap (``("in" | "out", frame, decoded message or None)``) that writes each
+        frame as `write_mavlink` does, stamped ``clock_ns()``: the same file, made with less
+        work per frame (a flight taps tens of thousands)."""
+        ...
 
     def write_vehicle(
         self,

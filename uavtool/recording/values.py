@@ -245,6 +245,20 @@ class SceneMarkers:
     entities: tuple[SceneEntity, ...]
 
 
+FOXGLOVE_TYPES: frozenset[type] = frozenset(
+    {
+        CompressedImage,
+        CameraCalibration,
+        FrameTransform,
+        LocationFix,
+        PosesInFrame,
+        LogEntry,
+        Model3D,
+        SceneMarkers,
+    }
+)
+"""The values written as Foxglove messages (`uavtool.recording.foxglove` encodes them)."""
+
 Value = (
     MavlinkFrame
     | JsonDocument

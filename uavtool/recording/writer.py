@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import struct
 import threading
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from types import TracebackType
 from typing import TYPE_CHECKING, Any, BinaryIO
@@ -207,6 +207,12 @@ class RecordingWriter:
                 raise ValueError(f"topic {topic!r} is not a JSON topic: call add_json_topic first")
             self._add(channel_id, log_time_ns, publish_time_ns, data)
 
+    def write_json_format(
+        self, topic: str, template: str, values: tuple[Any, ...], *, log_time_ns: int
+    ) -> None:
+        """`write_json_bytes` of ``(template % values).encode()`` (see `MessageWriter`)."""
+        self.write_json_bytes(topic, (template % values).encode(), log_time_ns=log_time_ns)
+
     def write(
         self,
         topic: str,
@@ -310,6 +316,16 @@ class RecordingWriter:
             add(channel_id, sequence[channel_id], log_time_ns, publish, data)
             sequence[channel_id] += 1
             self._message_count += 1
+
+    def mavlink_tap(self, clock_ns: Callable[[], int]) -> Callable[[str, bytes, Any], None]:
+        """`write_mavlink` as a link's tap, each frame stamped ``clock_ns()``."""
+        directions = {"in": Direction.IN, "out": Direction.OUT}
+        write = self.write_mavlink
+
+        def tap(direction: str, frame: bytes, decoded: Any) -> None:
+            write(frame, direction=directions[direction], log_time_ns=clock_ns(), decoded=decoded)
+
+        return tap
 
     # --- internals (called with the lock held) -----------------------------------------------
 

@@ -31,7 +31,6 @@ from uavtool.mission.schema import observation_schema, output_schema
 from uavtool.recording import (
     CameraCalibration,
     CompressedImage,
-    Direction,
     FrameTransform,
     LogEntry,
     LogLevel,
@@ -92,15 +91,8 @@ class MissionRecorder:
         writer.add_json_topic(OUTPUTS, schema_name="uavtool.Output", schema=output_schema())
         self._outputs = 0
         self._markers = RouteMarkers()
-
-    def mavlink(self, direction: str, frame: bytes, decoded: Any = None) -> None:
-        """The link's tap (:data:`~uavtool.link.client.Tap`)."""
-        self.writer.write_mavlink(
-            frame,
-            direction=Direction.IN if direction == "in" else Direction.OUT,
-            log_time_ns=self.clock_ns(),
-            decoded=decoded,
-        )
+        self.mavlink = writer.mavlink_tap(clock_ns)
+        """The link's tap (:data:`~uavtool.link.client.Tap`): every frame, as it crossed."""
 
     def target(self, png: bytes) -> None:
         self.writer.write(
@@ -118,9 +110,9 @@ class MissionRecorder:
         elif isinstance(obs, Telemetry):
             self._markers.telemetry(obs.pos_enu_m)
             self.writer.write_vehicle(obs.pos_enu_m, obs.heading_deg, self.home, log_time_ns=t)
-        data = telemetry_json(step, obs) if isinstance(obs, Telemetry) else None
-        if data is not None:
-            self.writer.write_json_bytes(OBSERVATIONS, data, log_time_ns=t)
+        values = telemetry_values(step, obs) if isinstance(obs, Telemetry) else None
+        if values is not None:
+            self.writer.write_json_format(OBSERVATIONS, TELEMETRY_TEMPLATE, values, log_time_ns=t)
             return
         payload = {"step": step, **encode_observation(obs)}
         self.writer.write_json(OBSERVATIONS, payload, log_time_ns=t)
@@ -189,7 +181,7 @@ _TELEMETRY_FIELDS = (
     "gimbal_yaw_deg",
     "battery_pct",
 )
-_TELEMETRY = (
+TELEMETRY_TEMPLATE = (
     '{"step":%d,"type":"Telemetry","time_boot_ms":%d,"pos_enu_m":[%r,%r,%r],'
     '"vel_enu_m_s":[%r,%r,%r],"heading_deg":%r,"mode":%s,"armed":%s,"landed":%s,'
     '"gimbal_pitch_deg":%r,"gimbal_yaw_deg":%r,"battery_pct":%d}'
@@ -203,6 +195,13 @@ def telemetry_json(step: int, t: Telemetry) -> bytes | None:
     (a flight records thousands of samples), or None when a value is not of the plain type
     the template writes (a numpy number, a NaN: the general path then decides) or
     `Telemetry`'s fields are not the ones it knows."""
+    values = telemetry_values(step, t)
+    return None if values is None else (TELEMETRY_TEMPLATE % values).encode()
+
+
+def telemetry_values(step: int, t: Telemetry) -> tuple[Any, ...] | None:
+    """What `TELEMETRY_TEMPLATE` formats into `telemetry_json`'s bytes (a writer process
+    does the formatting, off the flight's path), or None where `telemetry_json` is None."""
     p, v = t.pos_enu_m, t.vel_enu_m_s
     if _FIELDS_NOW != _TELEMETRY_FIELDS or len(p) != 3 or len(v) != 3:
         return None
@@ -218,7 +217,7 @@ def telemetry_json(step: int, t: Telemetry) -> bytes | None:
         and math.isfinite(sum(floats))
     ):
         return None
-    text = _TELEMETRY % (
+    return (
         step,
         t.time_boot_ms,
         *p,
@@ -231,7 +230,6 @@ def telemetry_json(step: int, t: Telemetry) -> bytes | None:
         t.gimbal_yaw_deg,
         t.battery_pct,
     )
-    return text.encode()
 
 
 _FIELDS_NOW = tuple(f.name for f in dataclasses.fields(Telemetry))
