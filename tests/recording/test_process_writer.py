@@ -7,6 +7,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -28,6 +29,7 @@ from uavtool.recording import (
     RecordingWriter,
     RgbImage,
     TriangleMesh,
+    process,
     summarize,
 )
 from uavtool.recording.process import BATCH_NS
@@ -230,3 +232,79 @@ def test_a_raw_frame_is_written_as_its_png(tmp_path: Path, kind: Any) -> None:
     with RecordingReader(as_raw) as reader:
         (entry,) = reader.entries(["/camera/image"])
     assert np.array_equal(png_decode(entry.value.data), rgb)
+
+
+def test_the_child_drains_the_pipe_while_its_writer_is_busy(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Batches are read ahead of the writer, up to `BACKLOG_BYTES`: a photo the child is
+    compressing does not keep the flight waiting on a full pipe, and a flight that outruns
+    the writer by more does wait."""
+    monkeypatch.setattr(process, "BACKLOG_BYTES", 4 << 20)
+    read, write = os.pipe()
+    try:
+        backlog = process._Backlog(read)
+        photo = bytes(range(256)) * 4096  # 1 MiB, as big as the pipe
+        sent: list[int] = []
+
+        def send() -> None:
+            for i in range(8):
+                os.write(write, b"".join(process._framed([(i, photo)])))
+                sent.append(i)
+
+        sender = threading.Thread(target=send, daemon=True)
+        sender.start()
+        deadline = time.monotonic() + 10
+        while len(sent) < 4 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        time.sleep(0.2)
+        # nobody has taken a batch: four are held, the fifth waits for room, the pipe fills
+        assert 4 <= len(sent) < 8
+        for i in range(8):
+            batch = backlog.next()
+            assert batch is not None
+            assert batch[0][0] == i
+            assert batch[0][1] == photo
+        sender.join(10)
+        assert sent == list(range(8))
+    finally:
+        os.close(write)
+    assert backlog.next() is None  # the pipe's end
+    os.close(read)
+
+
+@pytest.mark.parametrize(
+    ("others_busy_cores", "span_s", "load", "spare"),
+    [
+        (0.1, 0.2, 9.0, True),  # others idle now: a load average a minute old does not count
+        (1.0, 0.2, 0.0, False),  # another process keeps a core busy
+        (0.4, 0.2, 9.0, True),
+        (0.6, 0.2, 0.0, False),
+        (0.0, 60.0, 1.9, False),  # the window too old: the load average decides
+        (0.0, 60.0, 0.3, True),
+        (0.0, 0.001, 1.9, False),  # too short to tell
+    ],
+)
+def test_a_writer_process_is_chosen_when_other_processes_leave_a_core(
+    monkeypatch: pytest.MonkeyPatch,
+    others_busy_cores: float,
+    span_s: float,
+    load: float,
+    spare: bool,
+) -> None:
+    """The flight takes a core; the writer is given one only when others leave half of the
+    other core free, measured since the last call (the load average when that is too old)."""
+    monkeypatch.setattr(os, "sched_getaffinity", lambda _pid: {0, 1})
+    monkeypatch.setattr(os, "cpu_count", lambda: 2)
+    monkeypatch.setattr(os, "getloadavg", lambda: (load, load, load))
+    mine_s = 0.9 * span_s  # this process: busy most of the window (its start-up)
+    monkeypatch.setattr(process, "_last_sample", (100.0, 50.0, 3.0))
+    now = (100.0 + span_s, 50.0 + mine_s + others_busy_cores * span_s, 3.0 + mine_s)
+    monkeypatch.setattr(process, "_cpu_sample", lambda: now)
+    assert process.core_to_spare() is spare
+    assert process._last_sample == now  # the next call measures from here
+
+
+def test_one_core_never_gets_a_writer_process(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(os, "sched_getaffinity", lambda _pid: {0})
+    assert process.core_to_spare() is False

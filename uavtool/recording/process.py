@@ -21,7 +21,10 @@ What is kept:
   only the batch not yet sent is lost, at most `BATCH_NS` of log time. Ctrl-C does not reach
   the child (a session of its own): the flight's process decides, as before, what to write
   last and when to close.
-- **Back pressure.** The pipe holds 1 MiB; a flight that outruns its writer waits for it.
+- **Back pressure.** The child reads the pipe in a thread of its own, so a photo it is
+  compressing never keeps the flight waiting on a full pipe (it did: ~60 ms a flight); what
+  it has read and not yet written is held to `BACKLOG_BYTES`, and a flight that outruns its
+  writer by more waits for it.
 
 The child is a fresh interpreter (`subprocess`, never a fork: the flight may run threads,
 and in a Dask worker it is a daemon) with the parent's ``sys.path``; it imports the writer,
@@ -37,9 +40,12 @@ import fcntl
 import json
 import os
 import pickle
+import queue
+import struct
 import subprocess
 import sys
 import threading
+import time
 import weakref
 from collections.abc import Callable, Mapping
 from pathlib import Path
@@ -63,6 +69,10 @@ sends ~230 batches, not ~900 as it would every quarter second."""
 BATCH_CALLS = 2048
 """Calls a batch may hold before it is sent."""
 PIPE_BYTES = 1 << 20
+BACKLOG_BYTES = 64 << 20
+"""Batches the child may hold read but not yet written: a flight that outruns its writer by
+more waits at the pipe."""
+_HEADER = struct.Struct("<Q")  # each batch on the pipe: its pickle's length, then the pickle
 
 # the calls, as the first item of each tuple in a batch (most frequent first)
 (
@@ -85,16 +95,56 @@ _CHILD = (
 )
 
 
+def _cpu_sample() -> tuple[float, float, float] | None:
+    """(now, seconds of CPU the whole machine spent busy, seconds this process spent) from
+    ``/proc/stat``, or None where there is none."""
+    try:
+        with Path("/proc/stat").open("rb") as stat:
+            fields = stat.readline().split()
+        ticks = [int(v) for v in fields[1:9]]  # user nice system idle iowait irq softirq steal
+    except (OSError, ValueError):
+        return None
+    if fields[:1] != [b"cpu"] or len(ticks) < 5:
+        return None
+    busy_s = (sum(ticks) - ticks[3] - ticks[4]) / os.sysconf("SC_CLK_TCK")
+    mine = os.times()
+    return time.monotonic(), busy_s, mine.user + mine.system
+
+
+_last_sample = _cpu_sample()  # from this module's import: what the machine did meanwhile
+SAMPLE_S = (0.05, 10.0)
+"""The window `core_to_spare` measures the machine over: from its last call (or this
+module's import, early in a command's start-up) to now, when that is this many seconds;
+else the load average decides."""
+
+
 def core_to_spare() -> bool:
     """Whether a writer process would find a core of its own: at least two cores for this
-    process, and a load average (last minute) below their number less one half. Otherwise
-    it only adds its work to a busy machine, and the flight waits for it at the end."""
+    process, and other processes busy for less than the cores less one and a half (the
+    flight takes one; half a core is left for the writer) since the last call or this
+    module's import, 0.05-10 s ago; without that measure, a load average of the last minute
+    below the cores less one half. A load average lags a minute: after a burst of commands
+    it still counts those that ended. Without a spare core a writer process only adds its
+    work to a busy machine, and the flight waits for it at the end."""
+    global _last_sample  # noqa: PLW0603 - the window runs from call to call
     try:
         cores = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return False
+    if cores < 2:
+        return False
+    before, now = _last_sample, _cpu_sample()
+    _last_sample = now
+    if before is not None and now is not None:
+        span_s = now[0] - before[0]
+        if SAMPLE_S[0] <= span_s <= SAMPLE_S[1]:
+            others = ((now[1] - before[1]) - (now[2] - before[2])) / span_s  # cores, busy
+            return others < (os.cpu_count() or cores) - 1.5
+    try:
         load = os.getloadavg()[0]
     except (AttributeError, OSError):
         return False
-    return cores >= 2 and load < cores - 0.5
+    return load < cores - 0.5
 
 
 def _check_time(t: Any, what: str = "log_time_ns") -> None:
@@ -132,7 +182,8 @@ class ProcessWriter:
         self._lock = threading.Lock()
         self._batch: list[tuple[Any, ...]] = []
         self._ship_at = 0  # log time from which the next call sends the batch
-        self._pending = bytearray()  # pickled batches not yet in the pipe (Ctrl-C mid-write)
+        # framed batches not yet in the pipe (Ctrl-C mid-write), as views: never copied
+        self._pending: list[memoryview] = []
         self._json_topics: set[str] = set()
         self._topic_kind: dict[str, Any] = {}  # topic -> value type or JSON schema name
         self._protobuf_topics: set[str] = set()  # topics whose schema the child was sent
@@ -160,7 +211,7 @@ class ProcessWriter:
         self._replies = self._proc.stdout
         # dropped without close(): the child still ends (and keeps what it was sent)
         self._finalizer = weakref.finalize(self, _abandon, self._proc)
-        self._send(pickle.dumps(init, protocol=pickle.HIGHEST_PROTOCOL))
+        self._send(init)
 
     # --- lifecycle ---------------------------------------------------------------------------
 
@@ -394,14 +445,20 @@ class ProcessWriter:
         shows as a broken pipe."""
         batch, self._batch = self._batch, []
         self._ship_at = log_time_ns + BATCH_NS
-        self._send(pickle.dumps(batch, protocol=pickle.HIGHEST_PROTOCOL))
+        self._send(batch)
 
-    def _send(self, data: bytes) -> None:
+    def _send(self, value: Any) -> None:
+        """Pickle ``value`` and write it to the pipe, framed, without copying it again."""
         pending = self._pending
-        pending += data
+        pending.extend(map(memoryview, _framed(value)))
         try:
             while pending:
-                del pending[: os.write(self._out, pending)]
+                written = os.writev(self._out, pending)
+                while written:  # drop what was written from the front
+                    if written < len(pending[0]):
+                        pending[0] = pending[0][written:]
+                        break
+                    written -= len(pending.pop(0))
         except BrokenPipeError:
             self._child_ended()
         except OSError as exc:
@@ -431,6 +488,32 @@ class ProcessWriter:
         if self._failure is None:
             self._failure = RecordingError(path or self.path, problem)
         raise self._failure
+
+
+def _framed(value: Any) -> tuple[bytes, bytes]:
+    """``value`` as it travels down the pipe: its pickle's length, then the pickle."""
+    data = pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL)
+    return _HEADER.pack(len(data)), data
+
+
+def _read_framed(fd: int) -> tuple[Any, int]:
+    """One framed value from the pipe ``fd``, and its size; `EOFError` at the pipe's end
+    (or a frame cut short). Plain reads: no buffered stream's lock for a daemon thread to
+    hold when the interpreter ends."""
+    (size,) = _HEADER.unpack(_read_exactly(fd, _HEADER.size))
+    return pickle.loads(_read_exactly(fd, size)), size
+
+
+def _read_exactly(fd: int, size: int) -> bytearray:
+    data = bytearray(size)
+    view = memoryview(data)
+    done = 0
+    while done < size:
+        n = os.readv(fd, [view[done:]])
+        if n == 0:
+            raise EOFError
+        done += n
+    return data
 
 
 def _spawn(file: BinaryIO) -> subprocess.Popen[bytes]:
@@ -467,19 +550,20 @@ def _abandon(proc: subprocess.Popen[bytes]) -> None:
 
 def serve() -> None:
     """The child's loop: an init tuple, then batches of calls on stdin; replies on stdout."""
-    # the MCAP writer, imported here: the flight's process, which imports this module too,
-    # never needs it
-    from uavtool.recording.writer import RecordingWriter  # noqa: PLC0415
-
     replies = os.fdopen(os.dup(1), "wb", buffering=0)
     sys.stdout = sys.stderr  # stdout carries replies only
-    source = sys.stdin.buffer
+    source = sys.stdin.fileno()
 
     def reply(*answer: Any) -> None:
         replies.write(pickle.dumps(answer, protocol=pickle.HIGHEST_PROTOCOL))
 
-    path, fd, metadata, dialect, interval_ns, budget, fsync = pickle.load(source)
+    (path, fd, metadata, dialect, interval_ns, budget, fsync), _ = _read_framed(source)
+    batches = _Backlog(source)  # the pipe drained from now on, while the writer is imported
     try:
+        # the MCAP writer, imported here: the flight's process, which imports this module
+        # too, never needs it
+        from uavtool.recording.writer import RecordingWriter  # noqa: PLC0415
+
         writer = RecordingWriter(
             path,
             metadata=metadata,
@@ -489,7 +573,7 @@ def serve() -> None:
             fsync=fsync,
             file=os.fdopen(fd, "wb"),
         )
-        _serve(writer, source, reply)
+        _serve(writer, batches, reply)
     except RecordingError as exc:
         reply("error", exc.path, exc.problem)
     except Exception as exc:  # whatever it is, the flight must hear of it
@@ -500,7 +584,43 @@ def serve() -> None:
         os._exit(0)
 
 
-def _serve(writer: Any, source: Any, reply: Any) -> None:
+class _Backlog:
+    """Batches read from the pipe by a thread of the child's own, for its main thread to
+    write: the pipe is drained while a photo is compressed (zlib and zstd let go of the
+    GIL). At most `BACKLOG_BYTES` are held; `None` marks the pipe's end."""
+
+    def __init__(self, source: int) -> None:
+        self._source = source
+        self._batches: queue.SimpleQueue[tuple[list[tuple[Any, ...]], int] | None] = (
+            queue.SimpleQueue()
+        )
+        self._room = threading.Semaphore(BACKLOG_BYTES >> 16)  # in 64 KiB units
+        threading.Thread(target=self._read, name="uavtool-recording-reader", daemon=True).start()
+
+    def _read(self) -> None:
+        while True:
+            try:
+                batch, size = _read_framed(self._source)
+            except (EOFError, pickle.UnpicklingError, OSError):
+                self._batches.put(None)
+                return
+            units = min(BACKLOG_BYTES, size) >> 16
+            for _ in range(units):
+                self._room.acquire()
+            self._batches.put((batch, units))
+
+    def next(self) -> list[tuple[Any, ...]] | None:
+        """The next batch, or `None` at the pipe's end."""
+        item = self._batches.get()
+        if item is None:
+            return None
+        batch, units = item
+        if units:
+            self._room.release(units)
+        return batch
+
+
+def _serve(writer: Any, source: _Backlog, reply: Any) -> None:
     protobuf: dict[str, tuple[str, bytes]] = {}  # topic -> (schema name, schema)
     write_mavlink, write_json, write_protobuf = (
         writer.write_mavlink,
@@ -509,9 +629,8 @@ def _serve(writer: Any, source: Any, reply: Any) -> None:
     )
     inbound, outbound = Direction.IN, Direction.OUT
     while True:
-        try:
-            batch = pickle.load(source)
-        except (EOFError, pickle.UnpicklingError, OSError):
+        batch = source.next()
+        if batch is None:
             # the flight's process ended without closing: keep what it sent, leave the file
             # unfinished (uavtool info --recover reads it)
             writer.flush()
