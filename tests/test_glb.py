@@ -4,7 +4,6 @@ Khronos Group's own glTF validator (npm's ``gltf-validator``, when node and npm 
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import struct
 import subprocess
@@ -15,6 +14,7 @@ import numpy as np
 import pytest
 import trimesh
 
+from tests.npm_cache import installing, npm_cache
 from uavtool.glb import mesh_glb
 
 VALIDATOR = "gltf-validator@2.0.0-dev.3.10"
@@ -116,16 +116,16 @@ def _validator() -> Path | None:
     ``$UAVTOOL_NPM_CACHE``, default ``~/.cache/uavtool/npm``); None without node or npm."""
     if shutil.which("node") is None or shutil.which("npm") is None:
         return None
-    default = Path.home() / ".cache" / "uavtool" / "npm"
-    folder = Path(os.environ.get("UAVTOOL_NPM_CACHE", default)) / VALIDATOR.replace("@", "-")
+    folder = npm_cache() / VALIDATOR.replace("@", "-")
     package = folder / "node_modules" / "gltf-validator"
-    if not (package / "package.json").is_file():
-        folder.mkdir(parents=True, exist_ok=True)
-        subprocess.run(
-            ["npm", "install", "--no-save", "--no-audit", "--no-fund", "--ignore-scripts",
-             "--prefix", str(folder), VALIDATOR],
-            check=True, capture_output=True, timeout=300,
-        )  # fmt: skip
+    with installing(folder):
+        if not (package / "package.json").is_file():
+            folder.mkdir(parents=True, exist_ok=True)
+            subprocess.run(
+                ["npm", "install", "--no-save", "--no-audit", "--no-fund", "--ignore-scripts",
+                 "--prefix", str(folder), VALIDATOR],
+                check=True, capture_output=True, timeout=300,
+            )  # fmt: skip
     return package
 
 

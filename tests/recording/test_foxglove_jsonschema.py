@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import base64
 import json
-import os
 import shutil
 import subprocess
 from collections import Counter
@@ -24,6 +23,7 @@ import pytest
 from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
+from tests.npm_cache import installing, npm_cache
 from uavtool.recording import RecordingReader
 from uavtool.recording.foxglove import _PB_CLASS
 
@@ -38,15 +38,15 @@ def _schemas() -> dict[str, Any] | None:
     node or npm."""
     if shutil.which("node") is None or shutil.which("npm") is None:
         return None
-    default = Path.home() / ".cache" / "uavtool" / "npm"
-    folder = Path(os.environ.get("UAVTOOL_NPM_CACHE", default)) / PACKAGE.replace("/", "-")
-    if not (folder / "node_modules" / "@foxglove" / "schemas" / "package.json").is_file():
-        folder.mkdir(parents=True, exist_ok=True)
-        subprocess.run(
-            ["npm", "install", "--no-save", "--no-audit", "--no-fund", "--ignore-scripts",
-             "--prefix", str(folder), PACKAGE],
-            check=True, capture_output=True, timeout=300,
-        )  # fmt: skip
+    folder = npm_cache() / PACKAGE.replace("/", "-")
+    with installing(folder):
+        if not (folder / "node_modules" / "@foxglove" / "schemas" / "package.json").is_file():
+            folder.mkdir(parents=True, exist_ok=True)
+            subprocess.run(
+                ["npm", "install", "--no-save", "--no-audit", "--no-fund", "--ignore-scripts",
+                 "--prefix", str(folder), PACKAGE],
+                check=True, capture_output=True, timeout=300,
+            )  # fmt: skip
     script = "console.log(JSON.stringify(require('@foxglove/schemas/jsonschema')))"
     out = subprocess.run(
         ["node", "-e", script],

@@ -139,14 +139,14 @@ def test_speeds_asked_for_stay_within_the_speed_parameters_ranges(client: Client
             0, 1, 1, M.MAV_FRAME_LOCAL_NED, position_only, 2000, 0, -5, 0, 0, 0, 0, 0, 0, 0, 0
         )
     )
-    client.pump(15.0)
-    for _ in range(15):  # a stream, as an attacker would send it
+    client.pump(3.0)  # 60 s of vehicle time: long past reaching its top speed
+    for _ in range(15):  # a stream, as an attacker would send it, 3 s of vehicle time apart
         client.send(
             M.MAVLink_set_position_target_local_ned_message(
                 0, 1, 1, M.MAV_FRAME_LOCAL_NED, velocity_only, 0, 0, 0, 1e6, 0, 0, 0, 0, 0, 0, 0
             )
         )
-        client.pump(1.0)
+        client.pump(0.15)
     speeds = [m.groundspeed for m in client.received if m.get_type() == "VFR_HUD"]
     assert 9.5 < max(speeds) < 11.0  # as fast as a 30° lean goes, within 20 m/s
 

@@ -19,6 +19,7 @@ import pytest
 from click.testing import CliRunner
 
 from tests.sitl.client import Client
+from tests.sitl.udp import settle
 from uavtool.cli import cli
 from uavtool.mavlink import mavlink as M
 from uavtool.mavlink import new_encoder
@@ -102,7 +103,7 @@ def test_a_ground_station_is_answered_at_once_after_a_flood_of_2000_peers() -> N
         for _ in range(2000):  # one HEARTBEAT from each of 2,000 source ports
             with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
                 s.sendto(_SPOOF_HB, ("127.0.0.1", sitl.ports[0]))
-        time.sleep(0.2)
+        settle(udp)
         assert len(udp.links) == MAX_UDP_PEERS
         gcs = _udp_gcs(sitl.ports[0])
         try:

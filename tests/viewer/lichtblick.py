@@ -19,6 +19,8 @@ import subprocess
 from pathlib import Path
 from typing import Any
 
+from tests.npm_cache import installing, npm_cache
+
 HARNESS = Path(__file__).with_name("lichtblick_parse.ts")
 _SRC = "packages/mcap-support"
 
@@ -36,13 +38,17 @@ def cache_folder(repo: Path, kind: str) -> Path:
     """Where ``kind`` built from ``repo``'s HEAD is kept (``$UAVTOOL_NPM_CACHE``, default
     ``~/.cache/uavtool/npm``)."""
     head = (git(repo, "rev-parse", "--short", "HEAD") or b"").decode().strip()
-    default = Path.home() / ".cache" / "uavtool" / "npm"
-    return Path(os.environ.get("UAVTOOL_NPM_CACHE", default)) / f"{kind}-{head}"
+    return npm_cache() / f"{kind}-{head}"
 
 
 def build(repo: Path) -> Path:
     """The bundled harness for ``repo``'s HEAD (built on first use)."""
     folder = cache_folder(repo, "lichtblick")
+    with installing(folder):
+        return _build(repo, folder)
+
+
+def _build(repo: Path, folder: Path) -> Path:
     bundle = folder / "lichtblick_parse.cjs"
     if bundle.is_file():
         return bundle

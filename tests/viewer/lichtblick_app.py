@@ -28,6 +28,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from tests.npm_cache import installing
 from tests.viewer.lichtblick import cache_folder, git
 
 DRIVER = Path(__file__).with_name("lichtblick_app.cjs")
@@ -67,6 +68,11 @@ class LichtblickApp:
 def build_app(repo: Path) -> LichtblickApp:
     """The web app of ``repo``'s HEAD, built on first use (a few minutes)."""
     folder = cache_folder(repo, "lichtblick-app")
+    with installing(folder):
+        return _build_app(repo, folder)
+
+
+def _build_app(repo: Path, folder: Path) -> LichtblickApp:
     app = LichtblickApp(folder / "web" / ".webpack", folder / "node_modules")
     if (app.web / "index.html").is_file():
         return app

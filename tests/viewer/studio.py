@@ -11,11 +11,12 @@ code Lichtblick forked. It is installed once into a cache folder outside the rep
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import subprocess
 from pathlib import Path
 from typing import Any
+
+from tests.npm_cache import installing, npm_cache
 
 PACKAGE = "@foxglove/studio-base"
 VERSION = "1.48.0"
@@ -23,8 +24,7 @@ HARNESS = Path(__file__).with_name("foxglove_source.cjs")
 
 
 def cache_dir() -> Path:
-    default = Path.home() / ".cache" / "uavtool" / "npm"
-    return Path(os.environ.get("UAVTOOL_NPM_CACHE", default)) / f"studio-base-{VERSION}"
+    return npm_cache() / f"studio-base-{VERSION}"
 
 
 def assets() -> Path | None:
@@ -34,13 +34,14 @@ def assets() -> Path | None:
         return None
     folder = cache_dir()
     found = folder / "node_modules" / PACKAGE / "assets"
-    if not (found / "index.js").is_file():
-        folder.mkdir(parents=True, exist_ok=True)
-        subprocess.run(
-            ["npm", "install", "--no-save", "--no-audit", "--no-fund", "--ignore-scripts",
-             "--prefix", str(folder), f"{PACKAGE}@{VERSION}"],
-            check=True, capture_output=True, timeout=600,
-        )  # fmt: skip
+    with installing(folder):
+        if not (found / "index.js").is_file():
+            folder.mkdir(parents=True, exist_ok=True)
+            subprocess.run(
+                ["npm", "install", "--no-save", "--no-audit", "--no-fund", "--ignore-scripts",
+                 "--prefix", str(folder), f"{PACKAGE}@{VERSION}"],
+                check=True, capture_output=True, timeout=600,
+            )  # fmt: skip
     return found
 
 

@@ -72,6 +72,34 @@ def _host_port(text: str, option: str, example: str, *, shown: str | None = None
         )
 
 
+def _refused(scheduler: str) -> None:
+    """Raise InputError at once when nothing listens at a tcp:// or tls:// scheduler's
+    address (the machine answers "refused"): Dask would try again for its whole timeout.
+    Anything else (no answer at all, a name that does not resolve) is left to Dask."""
+    import socket  # noqa: PLC0415
+
+    from distributed.comm.addressing import parse_address, parse_host_port  # noqa: PLC0415
+
+    try:
+        scheme, location = parse_address(scheduler)
+        if scheme not in ("tcp", "tls"):
+            return
+        host, port = parse_host_port(location)
+    except (ValueError, TypeError):
+        return  # Dask says what is wrong with it
+    try:
+        with socket.create_connection((host, port), timeout=5.0):
+            return
+    except ConnectionRefusedError:
+        raise InputError(
+            f"--scheduler {scheduler}: cannot connect: nothing listens on {host}:{port} "
+            "(connection refused); start the scheduler there (dask scheduler) or give its "
+            "address"
+        ) from None
+    except OSError:
+        return
+
+
 @contextmanager
 def open_client(
     scheduler: str | None = None, *, workers: int | None = None, dashboard: str | None = None
@@ -94,6 +122,7 @@ def open_client(
             # Checked first: a Client that fails in its constructor for want of them can
             # hang when it is collected (distributed's LoopRunner lock).
             raise no_credentials
+        _refused(scheduler)
         try:
             client = Client(scheduler, timeout="10s")
         except (OSError, TimeoutError, ValueError) as exc:
