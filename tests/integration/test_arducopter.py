@@ -14,7 +14,9 @@ from pathlib import Path
 import pytest
 
 from tests.integration.peers import ARDUCOPTER, arducopter, check_photo_poses, fly
-from uavtool.recording import RecordingReader
+from uavtool.geo import GeoPoint, enu_from_geo
+from uavtool.recording import LocationFix, RecordingReader
+from uavtool.recording.topics import FIX
 
 pytestmark = pytest.mark.skipif(
     not ARDUCOPTER or not Path(ARDUCOPTER).is_file(),
@@ -65,3 +67,25 @@ def test_a_vehicle_elsewhere_flies_the_scene_at_its_home(tmp_path: Path) -> None
     with RecordingReader(tmp_path / "f.mcap") as reader:
         vehicle = dict(reader.metadata)["vehicle"]
     assert vehicle["scene_origin"] == "vehicle-home"
+
+
+def test_beside_the_date_line_the_mission_flies_across_it(tmp_path: Path) -> None:
+    """Home 8 m west of the 180th meridian: the target stands across it, at longitudes near
+    -180°. ArduCopter takes positions there (its own longitude arithmetic wraps), and uavtool
+    must send them so: the mission completes and every fix recorded is beside home."""
+    home = GeoPoint(50.0647, 179.999888, 219.0)
+    with arducopter(tmp_path, params=MOUNT_PARM, home="50.0647,179.999888,219,0") as port:
+        result = _fly(port, tmp_path)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "outcome        completed" in result.stdout
+    assert "correct: the target is 'red'" in result.stdout
+    west = east = 0
+    with RecordingReader(tmp_path / "f.mcap") as reader:
+        for entry in reader.entries([FIX]):
+            fix = entry.value
+            assert isinstance(fix, LocationFix)
+            e, n, _ = enu_from_geo(home, GeoPoint(fix.latitude_deg, fix.longitude_deg, 0.0))
+            assert abs(e) < 100.0 and abs(n) < 100.0
+            west += fix.longitude_deg > 0
+            east += fix.longitude_deg < 0  # across the line
+    assert west and east
