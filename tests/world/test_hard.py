@@ -16,6 +16,7 @@ from shapely import affinity
 
 from tests.world.bodies import body_count
 from uavtool.cli import cli
+from uavtool.geo import GeoPoint, enu_from_geo
 from uavtool.world import SceneError, load_scene
 from uavtool.world.hard import (
     HardOptions,
@@ -139,6 +140,26 @@ def test_a_random_home_moves_and_turns_home_and_keeps_the_buildings() -> None:
     assert len(set(homes)) == len(SEEDS)
     headings = sorted(h for _, _, h in homes)
     assert headings[0] < 90.0 and headings[-1] > 270.0  # spread all round
+
+
+def test_anywhere_puts_home_anywhere_to_85_degrees_and_a_third_across_the_date_line() -> None:
+    """`--anywhere`: the seed's own buildings around a home to 85° of latitude, a third of
+    them within the spread of the 180th meridian, so the town straddles it; drawn last."""
+    lats, straddling = [], 0
+    for seed in range(1, 61):
+        plain, info = generate_hard_scene_with_info(seed=seed)
+        moved, moved_info = generate_hard_scene_with_info(
+            seed=seed, options=HardOptions(anywhere=True)
+        )
+        assert moved.buildings == plain.buildings and moved_info == info
+        assert -85.0 <= moved.home.lat_deg <= 85.0 and -180.0 <= moved.home.lon_deg <= 180.0
+        assert 0.0 <= moved.home_heading_deg < 360.0
+        to_line = enu_from_geo(moved.home, GeoPoint(moved.home.lat_deg, 180.0, 0.0))[0]
+        straddling += abs(to_line) <= HardOptions().spread_m + 1e-6
+        lats.append(moved.home.lat_deg)
+        assert "--anywhere" in moved.description
+    assert 10 <= straddling <= 30  # a third of 60, give or take
+    assert min(lats) < -60.0 and max(lats) > 60.0  # past --random-home's 60 degrees
 
 
 # --------------------------------------------------------------------------- every scene

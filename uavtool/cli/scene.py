@@ -247,6 +247,13 @@ def show(scene_ref: str, size: str, output: Path) -> None:
     "(the buildings around home are the seed's own).",
 )
 @click.option(
+    "--anywhere",
+    is_flag=True,
+    help="With --hard: home anywhere on Earth to 85° of latitude, in a third of the scenes "
+    "with the 180th meridian through the buildings; the vehicle facing any way (wins over "
+    "--random-home).",
+)
+@click.option(
     "-o",
     "--output",
     required=True,
@@ -262,6 +269,7 @@ def random_scene(
     overhang: bool,
     town: bool,
     random_home: bool,
+    anywhere: bool,
     output: Path,
 ) -> None:
     """Generate a random scene file from a seed.
@@ -286,7 +294,9 @@ def random_scene(
     if suffix not in (".yaml", ".yml", ".json"):
         raise InputError(f"{output}: output must end in .yaml, .yml or .json")
     if hard:
-        s, info = _hard_scene(seed, buildings, margin, spread, overhang, town, random_home)
+        s, info = _hard_scene(
+            seed, buildings, margin, spread, overhang, town, random_home, anywhere
+        )
     else:
         from uavtool.world.generator import generate_scene
 
@@ -295,6 +305,7 @@ def random_scene(
             ("--overhang", overhang),
             ("--town", town),
             ("--random-home", random_home),
+            ("--anywhere", anywhere),
         ):
             if given:
                 raise InputError(f"{flag} needs --hard")
@@ -319,6 +330,7 @@ def _hard_scene(
     overhang: bool,
     town: bool,
     random_home: bool,
+    anywhere: bool,
 ) -> tuple[Scene, HardSceneInfo]:
     from dataclasses import replace
 
@@ -338,5 +350,6 @@ def _hard_scene(
         spread_m=default.spread_m if spread is None else spread,
         home_overhang_p=1.0 if overhang else default.home_overhang_p,
         random_home=random_home,
+        anywhere=anywhere,
     )
     return generate_hard_scene_with_info(seed=seed, options=options)

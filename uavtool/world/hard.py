@@ -51,7 +51,7 @@ import random
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, fields, replace
 
-from uavtool.geo import GeoPoint
+from uavtool.geo import GeoPoint, geo_from_enu
 from uavtool.world.errors import SceneError
 from uavtool.world.generator import _hsv_rgb, _index
 from uavtool.world.hard_geometry import (
@@ -113,6 +113,9 @@ class HardOptions:
     home_overhang_p: float = 0.0  # an arch over home; wins over home_beside_p
     random_home: bool = False  # home anywhere within ±60° latitude, the vehicle turned any
     # way (drawn after everything else: the buildings around home are the seed's own)
+    anywhere: bool = False  # home anywhere on Earth to ±85° latitude, in a third of the
+    # scenes within `spread_m` of the 180th meridian (the buildings straddle it); the vehicle
+    # turned any way. Wins over random_home; drawn after everything else, as it is
     # The town classes (HardOptions.town() turns them all on); each is drawn once per scene,
     # and only when its knob is above 0, so scenes without them are as they always were.
     grey_p: float = 0.0  # 1–3 other buildings concrete grey, white, black or grey-blue
@@ -442,7 +445,17 @@ def generate_hard_scene_with_info(
         dense_gap_m=town.dense_gap_m,
     )
     home, heading_deg = HOME, 0.0
-    if o.random_home:
+    if o.anywhere:
+        lat = uniform(rng, -85.0, 85.0)
+        if rng.random() < 1.0 / 3.0:  # the 180th meridian through the town
+            on_line = GeoPoint(lat, 180.0, HOME.alt_amsl_m)
+            off_line = geo_from_enu(on_line, uniform(rng, -o.spread_m, o.spread_m), 0.0, 0.0)
+            lon = off_line.lon_deg
+        else:
+            lon = uniform(rng, -180.0, 180.0)
+        home = GeoPoint(round(lat, 7), round(lon, 7), HOME.alt_amsl_m)
+        heading_deg = round(uniform(rng, 0.0, 360.0), 1) % 360.0
+    elif o.random_home:
         lat, lon = uniform(rng, -60.0, 60.0), uniform(rng, -180.0, 180.0)
         home = GeoPoint(round(lat, 7), round(lon, 7), HOME.alt_amsl_m)
         heading_deg = round(uniform(rng, 0.0, 360.0), 1) % 360.0
@@ -724,6 +737,8 @@ def hard_command(seed: int, options: HardOptions = HardOptions()) -> str:
             words.append("--overhang")
         elif f.name == "random_home":
             words.append("--random-home")
+        elif f.name == "anywhere":
+            words.append("--anywhere")
         else:
             rest.append(f"{f.name}={value:g}")
     line = " ".join(words)
@@ -735,5 +750,5 @@ _TOWN_ONLY = tuple(
     f.name
     for f in fields(HardOptions)
     if f.name not in ("min_buildings", "max_buildings", "margin_m", "spread_m", "home_overhang_p")
-    and f.name != "random_home"
+    and f.name not in ("random_home", "anywhere")
 )
