@@ -60,6 +60,13 @@ def test_an_unreachable_scheduler_leaves_no_output_folder(tmp_path: Path) -> Non
     assert f"cannot connect: nothing listens on 127.0.0.1:{port} (connection refused)" in output
     assert took < 5.0  # at once: Dask alone tries again for its whole 10 s timeout
     assert not out.exists()
+    spec = tmp_path / "spec.toml"  # without -q: no progress bar before the one line
+    result = CliRunner().invoke(
+        cli,
+        ["sweep", str(spec), "-o", str(tmp_path / "o2"), "--scheduler", f"tcp://127.0.0.1:{port}"],
+    )
+    assert result.exit_code == 2
+    assert result.output.strip().splitlines() == [output.strip()], result.output
 
 
 def test_an_enormous_grid_is_refused_before_planning_it(tmp_path: Path) -> None:

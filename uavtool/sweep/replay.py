@@ -211,9 +211,9 @@ def replay_many(
     report = progress or (lambda _p: None)
     rows: dict[int, dict[str, Any]] = {}
     interrupted = False
-    report(Progress(0, len(paths)))
     try:
         with open_client(scheduler, workers=workers) as client:
+            report(Progress(0, len(paths)))  # once connected: a refusal is its one line
             t0 = time.perf_counter()
             errors = 0
             for task in run_tasks(

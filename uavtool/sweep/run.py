@@ -181,10 +181,10 @@ def _fly_all(
 ) -> None:
     total, skipped = len(todo) + len(rows), len(rows)
     report = progress or (lambda _p: None)
-    report(Progress(0, total, skipped))
     root = str(tasks.layout.root.resolve())
     scheduler, workers, dashboard = cluster
     with open_client(scheduler, workers=workers, dashboard=dashboard) as client:
+        report(Progress(0, total, skipped))  # once connected: a refusal is its one line
         t0 = time.perf_counter()
         errors = 0
         finished = run_tasks(

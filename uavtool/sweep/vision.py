@@ -77,9 +77,9 @@ def vision_many(
     names = _out_names(paths)
     rows: dict[int, dict[str, Any]] = {}
     interrupted = False
-    report(Progress(0, len(paths)))
     try:
         with open_client(scheduler, workers=workers) as client:
+            report(Progress(0, len(paths)))  # once connected: a refusal is its one line
             t0, errors = time.perf_counter(), 0
             items = [
                 (str(p), spec, str(out_dir / n), code_dir)
