@@ -22,7 +22,7 @@ as a PNG. Pairs are seeded (``--seed``) and scored on ``--workers`` processes; t
 not depend on their number.
 
     python benchmarks/bench_near_shapes.py [--quick] [--pairs 10000] [--seed 45]
-        [--workers 2] [--png roc.png]
+        [--workers 2] [--png ROC.png]
 
 ``--quick``: 500 pairs of each kind.
 """
@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import tempfile
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -232,7 +233,12 @@ def main() -> None:
     parser.add_argument("--pairs", type=int, default=10_000, help="of each kind (true, near)")
     parser.add_argument("--seed", type=int, default=45)
     parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--png", type=Path, default=Path("near_shapes_roc.png"))
+    parser.add_argument(
+        "--png",
+        type=Path,
+        default=Path(tempfile.gettempdir()) / "near_shapes_roc.png",
+        help="where the ROC goes (default: %(default)s)",
+    )
     args = parser.parse_args()
     n = 500 if args.quick else args.pairs
     jobs: list[tuple[int, str | None]] = [(i, None) for i in range(n)]
