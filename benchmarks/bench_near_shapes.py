@@ -114,15 +114,21 @@ def _near(
         cut = rng.uniform(0.15, 0.30) * short
         corners = [p for p in shape.exterior.coords[:-1] if _convex(shape, p)]
         cx, cy = corners[int(rng.integers(len(corners)))]
-        sx = 1.0 if cx <= shape.centroid.x else -1.0
-        sy = 1.0 if cy <= shape.centroid.y else -1.0
-        if near == "chamfer":
-            piece = Polygon([(cx, cy), (cx + sx * cut, cy), (cx, cy + sy * cut)])
-        else:
-            piece = Polygon(
-                [(cx, cy), (cx + sx * cut, cy), (cx + sx * cut, cy + sy * cut), (cx, cy + sy * cut)]
-            )
-        return shapely.difference(shape, piece).simplify(1e-6)
+        pieces = []
+        for sx, sy in ((1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)):
+            if near == "chamfer":
+                piece = Polygon([(cx, cy), (cx + sx * cut, cy), (cx, cy + sy * cut)])
+            else:
+                piece = Polygon(
+                    [(cx, cy), (cx + sx * cut, cy), (cx + sx * cut, cy + sy * cut),
+                     (cx, cy + sy * cut)]
+                )  # fmt: skip
+            pieces.append((shapely.intersection(piece, shape).area, piece))
+        # the quarter the corner's inside is in: the piece the shape holds most of
+        piece = max(pieces, key=lambda t: t[0])[1]
+        cut_shape = shapely.difference(shape, piece).simplify(1e-6)
+        assert cut_shape.area < shape.area - 0.4 * piece.area, "the corner was not cut"
+        return cut_shape
     # an arm 15 % shorter
     a, b, arm = nums["a"], nums["b"], nums["arm"]
     if kind == "L":
