@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import fcntl
 import os
+import subprocess
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -25,3 +26,17 @@ def installing(folder: Path) -> Iterator[None]:
     with (folder.parent / f"{folder.name}.lock").open("w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         yield
+
+
+def npm_installed(folder: Path, spec: str, marker: Path, *, timeout_s: float = 300.0) -> None:
+    """Install ``spec`` (``name@version``) from npm into ``folder`` unless ``marker`` (a file
+    the package holds) is there already; under ``folder``'s lock."""
+    with installing(folder):
+        if marker.is_file():
+            return
+        folder.mkdir(parents=True, exist_ok=True)
+        subprocess.run(
+            ["npm", "install", "--no-save", "--no-audit", "--no-fund", "--ignore-scripts",
+             "--prefix", str(folder), spec],
+            check=True, capture_output=True, timeout=timeout_s,
+        )  # fmt: skip

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from tests.npm_cache import installing, npm_cache
+from tests.npm_cache import npm_cache, npm_installed
 from uavtool.glb import mesh_glb
 
 VALIDATOR = "gltf-validator@2.0.0-dev.3.10"
@@ -118,14 +118,7 @@ def _validator() -> Path | None:
         return None
     folder = npm_cache() / VALIDATOR.replace("@", "-")
     package = folder / "node_modules" / "gltf-validator"
-    with installing(folder):
-        if not (package / "package.json").is_file():
-            folder.mkdir(parents=True, exist_ok=True)
-            subprocess.run(
-                ["npm", "install", "--no-save", "--no-audit", "--no-fund", "--ignore-scripts",
-                 "--prefix", str(folder), VALIDATOR],
-                check=True, capture_output=True, timeout=300,
-            )  # fmt: skip
+    npm_installed(folder, VALIDATOR, package / "package.json")
     return package
 
 

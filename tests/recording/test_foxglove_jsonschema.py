@@ -23,7 +23,7 @@ import pytest
 from google.protobuf.descriptor import FieldDescriptor
 from google.protobuf.message import Message
 
-from tests.npm_cache import installing, npm_cache
+from tests.npm_cache import npm_cache, npm_installed
 from uavtool.recording import RecordingReader
 from uavtool.recording.foxglove import _PB_CLASS
 
@@ -39,14 +39,9 @@ def _schemas() -> dict[str, Any] | None:
     if shutil.which("node") is None or shutil.which("npm") is None:
         return None
     folder = npm_cache() / PACKAGE.replace("/", "-")
-    with installing(folder):
-        if not (folder / "node_modules" / "@foxglove" / "schemas" / "package.json").is_file():
-            folder.mkdir(parents=True, exist_ok=True)
-            subprocess.run(
-                ["npm", "install", "--no-save", "--no-audit", "--no-fund", "--ignore-scripts",
-                 "--prefix", str(folder), PACKAGE],
-                check=True, capture_output=True, timeout=300,
-            )  # fmt: skip
+    npm_installed(
+        folder, PACKAGE, folder / "node_modules" / "@foxglove" / "schemas" / "package.json"
+    )
     script = "console.log(JSON.stringify(require('@foxglove/schemas/jsonschema')))"
     out = subprocess.run(
         ["node", "-e", script],

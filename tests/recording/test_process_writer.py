@@ -308,3 +308,12 @@ def test_a_writer_process_is_chosen_when_other_processes_leave_a_core(
 def test_one_core_never_gets_a_writer_process(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(os, "sched_getaffinity", lambda _pid: {0})
     assert process.core_to_spare() is False
+
+
+def test_the_flight_knows_every_value_the_writer_encodes() -> None:
+    """`FOXGLOVE_TYPES` (the flight's process checks values by it, without Protobuf) is what
+    the Foxglove encoder encodes: a value added to one is added to the other."""
+    from uavtool.recording.foxglove import _PB_CLASS
+    from uavtool.recording.values import FOXGLOVE_TYPES
+
+    assert set(_PB_CLASS) == FOXGLOVE_TYPES

@@ -16,7 +16,7 @@ import subprocess
 from pathlib import Path
 from typing import Any
 
-from tests.npm_cache import installing, npm_cache
+from tests.npm_cache import npm_cache, npm_installed
 
 PACKAGE = "@foxglove/studio-base"
 VERSION = "1.48.0"
@@ -34,14 +34,7 @@ def assets() -> Path | None:
         return None
     folder = cache_dir()
     found = folder / "node_modules" / PACKAGE / "assets"
-    with installing(folder):
-        if not (found / "index.js").is_file():
-            folder.mkdir(parents=True, exist_ok=True)
-            subprocess.run(
-                ["npm", "install", "--no-save", "--no-audit", "--no-fund", "--ignore-scripts",
-                 "--prefix", str(folder), f"{PACKAGE}@{VERSION}"],
-                check=True, capture_output=True, timeout=600,
-            )  # fmt: skip
+    npm_installed(folder, f"{PACKAGE}@{VERSION}", found / "index.js", timeout_s=600)
     return found
 
 

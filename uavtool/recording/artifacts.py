@@ -17,29 +17,38 @@ from uavtool.recording.values import CompressedImage, Model3D
 def export_model(rec: str | Path, out: str | Path) -> int:
     """Write the last model ``rec`` holds (a GLB) to ``out``; its size in bytes. Raises
     `RecordingError` when the flight built no model."""
-    glb = _last(
+    return _export(
         rec,
+        out,
         MODEL,
         lambda v: v.glb if isinstance(v, Model3D) and v.glb else None,
         "holds no built model (/mission/model): its flight built none",
     )
-    with atomic_output(out, inputs=[rec]) as tmp:
-        _write(tmp, glb, out)
-    return len(glb)
 
 
 def export_target(rec: str | Path, out: str | Path) -> int:
     """Write the recording's target picture (a PNG) to ``out``; its size in bytes. Raises
     `RecordingError` when it holds none."""
-    png = _last(
+    return _export(
         rec,
+        out,
         TARGET,
         lambda v: v.data if isinstance(v, CompressedImage) and v.data else None,
         "holds no target picture (/mission/target)",
     )
+
+
+def _export(
+    rec: str | Path,
+    out: str | Path,
+    topic: str,
+    pick: Callable[[object], bytes | None],
+    missing: str,
+) -> int:
+    data = _last(rec, topic, pick, missing)
     with atomic_output(out, inputs=[rec]) as tmp:
-        _write(tmp, png, out)
-    return len(png)
+        _write(tmp, data, out)
+    return len(data)
 
 
 def _last(
