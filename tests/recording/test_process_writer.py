@@ -129,10 +129,16 @@ def test_a_writer_process_that_dies_is_a_recording_error(tmp_path: Path) -> None
 
 
 def _until_it_fails(writer: ProcessWriter, frames: list[tuple[Direction, bytes]]) -> None:
-    """Write frames, 0.1 s of log time apart (a batch each), until a write raises."""
-    for i in range(100_000):  # the child's failure is heard at a later send
+    """Write frames, 0.1 s of log time apart (a batch each), until a write raises. The
+    child's failure is heard at a later send: how much later depends on how long the child
+    takes to start (its reader holds up to `BACKLOG_BYTES`), so the bound is wall time, not
+    a count of frames (a loaded machine once took more than 100,000)."""
+    deadline = time.monotonic() + 60
+    i = 0
+    while time.monotonic() < deadline:
         direction, frame = frames[i % len(frames)]
         writer.write_mavlink(frame, direction=direction, log_time_ns=T0_NS + i * 10**8)
+        i += 1
 
 
 _FLIGHT = """
