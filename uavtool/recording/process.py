@@ -3,8 +3,10 @@
 A lockstep flight runs as fast as one core allows, and Python's own cost per message (an MCAP
 record of each frame, its JSON view, the Protobuf of every Foxglove value, a photo's PNG)
 took a third of it. The flight's thread now only checks each call and appends it, as a tuple
-of what it already holds (the frame's bytes, a time, the value's fields, a JSON template and
-its numbers), to a batch; every `BATCH_NS` of log time (or `BATCH_CALLS` calls) the batch is
+of what it already holds (a time, the value's fields, a JSON template and its numbers), to a
+batch (a MAVLink frame, the most frequent call by far, goes to columns of their own: one
+string of their bytes, not a tuple each; a photo's pixels go down the pipe beside the
+pickle, not copied into it); every `BATCH_NS` of log time (or `BATCH_CALLS` calls) the batch is
 pickled down a pipe to a child process, which makes the very calls on a `RecordingWriter`
 (decoding each frame again for its JSON view, encoding each value), so the file is the same,
 byte for byte, as one written in the flight's process. The flight's process never imports
@@ -24,7 +26,9 @@ What is kept:
 - **Back pressure.** The child reads the pipe in a thread of its own, so a photo it is
   compressing never keeps the flight waiting on a full pipe (it did: ~60 ms a flight); what
   it has read and not yet written is held to `BACKLOG_BYTES`, and a flight that outruns its
-  writer by more waits for it.
+  writer by more waits for it. That thread looks at the pipe every millisecond or so
+  (`POLL_S`) instead of waiting in ``read``: a waiting reader is woken by every batch, at
+  the flight's cost.
 
 The child is a fresh interpreter (`subprocess`, never a fork: the flight may run threads,
 and in a Dask worker it is a daemon) with the parent's ``sys.path``; it imports the writer,
@@ -47,6 +51,7 @@ import sys
 import threading
 import time
 import weakref
+from array import array
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from types import TracebackType
@@ -56,7 +61,14 @@ from uavtool.recording.errors import RecordingError, create_file
 from uavtool.recording.protocol import check_metadata, check_topic, foxglove_module
 from uavtool.recording.schemas import DEFAULT_DIALECT, dialect_module, dumps
 from uavtool.recording.topics import FIX, POSE
-from uavtool.recording.values import FOXGLOVE_TYPES, Direction, LocationFix, PosesInFrame
+from uavtool.recording.values import (
+    FOXGLOVE_TYPES,
+    CompressedImage,
+    Direction,
+    LocationFix,
+    PosesInFrame,
+    RgbImage,
+)
 
 if TYPE_CHECKING:
     from uavtool.geo import GeoPoint
@@ -72,13 +84,22 @@ PIPE_BYTES = 1 << 20
 BACKLOG_BYTES = 64 << 20
 """Batches the child may hold read but not yet written: a flight that outruns its writer by
 more waits at the pipe."""
-_HEADER = struct.Struct("<Q")  # each batch on the pipe: its pickle's length, then the pickle
+POLL_S = (0.001, 0.02)
+"""How long the child's reader sleeps when the pipe is empty: from the shortest, doubling
+while it stays empty, to the longest. A reader asleep in ``read`` would be woken by each
+batch, and the flight's process pays for the waking (~20 us a batch in a virtual machine);
+a reader that looks every millisecond costs it nothing, and a few hundred wake-ups a second
+of its own on the other core. The longest is what a flush or a close may wait more."""
+_HEADER = struct.Struct("<QI")  # each value on the pipe: its pickle's size, its buffers' count
 
 # the calls, as the first item of each tuple in a batch (most frequent first)
 (
     _MAV_IN,
     _MAV_OUT,
+    _MAV_PUBLISHED_IN,
+    _MAV_PUBLISHED_OUT,
     _VEHICLE,
+    _ORIGIN,
     _JSON_FORMAT,
     _JSON,
     _PROTO_TOPIC,
@@ -87,8 +108,12 @@ _HEADER = struct.Struct("<Q")  # each batch on the pipe: its pickle's length, th
     _FLUSH,
     _CLOSE,
     _ENCODE,
-) = range(11)
+    _ENCODE_RAW,
+) = range(15)
 _END_NS = 1 << 64
+_Batch = tuple[list[tuple[Any, ...]], "array[int]", bytes, "array[int]", bytes, bytes]
+"""What a batch is on the pipe: its calls other than tapped frames, how many frames come
+before each, then the frames: their bytes joined, their sizes, directions and times."""
 _CHILD = (
     "import sys, json; sys.path[:] = json.loads(sys.argv[1]); "
     "from uavtool.recording.process import serve; serve()"
@@ -181,6 +206,13 @@ class ProcessWriter:
         self.path = Path(path)
         self._lock = threading.Lock()
         self._batch: list[tuple[Any, ...]] = []
+        # the batch's MAVLink frames apart, in columns (one pickled string of them all, not
+        # a tuple each: a flight taps ~14,000), and where each call of the batch falls among
+        # them (how many frames come before it)
+        self._at = array("I")
+        self._frames: list[bytes] = []
+        self._frame_ops = bytearray()
+        self._frame_times = array("Q")
         self._ship_at = 0  # log time from which the next call sends the batch
         # framed batches not yet in the pipe (Ctrl-C mid-write), as views: never copied
         self._pending: list[memoryview] = []
@@ -188,6 +220,7 @@ class ProcessWriter:
         self._topic_kind: dict[str, Any] = {}  # topic -> value type or JSON schema name
         self._protobuf_topics: set[str] = set()  # topics whose schema the child was sent
         self._vehicle = False  # write_vehicle was called
+        self._origin: GeoPoint | None = None  # the origin of write_vehicle's last call
         self._failure: RecordingError | None = None
         self._closed = False
         self._message_count = 0
@@ -240,7 +273,7 @@ class ProcessWriter:
         disk (`RecordingWriter.flush`)."""
         with self._lock:
             self._check_open()
-            self._batch.append((_FLUSH,))
+            self._add((_FLUSH,))
             self._ship(0)
             self._reply()
 
@@ -254,7 +287,7 @@ class ProcessWriter:
             self._closed = True
             try:
                 if self._failure is None:
-                    self._batch.append((_CLOSE,))
+                    self._add((_CLOSE,))
                     self._ship(0)
                     reply = self._reply()
                     self._message_count = int(reply[1])
@@ -269,7 +302,7 @@ class ProcessWriter:
         check_metadata(name, record)
         with self._lock:
             self._check_open()
-            self._batch.append((_METADATA, name, dict(record)))
+            self._add((_METADATA, name, dict(record)))
             self._ship(0)
 
     def add_json_topic(self, topic: str, *, schema_name: str, schema: Mapping[str, Any]) -> None:
@@ -283,7 +316,7 @@ class ProcessWriter:
                 return
             self._topic_kind[topic] = schema_name
             self._json_topics.add(topic)
-            self._batch.append((_JSON_TOPIC, topic, schema_name, json.loads(dumps(schema))))
+            self._add((_JSON_TOPIC, topic, schema_name, json.loads(dumps(schema))))
 
     # --- writes ------------------------------------------------------------------------------
 
@@ -348,10 +381,20 @@ class ProcessWriter:
                 self._check_kind(topic, kind)
                 self._protobuf_topics.add(topic)
                 # the child makes the schema, off the flight's path
-                self._batch.append((_PROTO_TOPIC, topic, kind))
+                self._add((_PROTO_TOPIC, topic, kind))
             elif self._topic_kind[topic] is not kind:
                 raise ValueError(f"topic {topic!r} carries {self._topic_kind[topic]!r}, not {kind}")
-            self._queue((_ENCODE, topic, value, log_time_ns, publish_time_ns), log_time_ns)
+            raw = value.raw if kind is CompressedImage else None  # type: ignore[union-attr]
+            if raw is None:
+                self._queue((_ENCODE, topic, value, log_time_ns, publish_time_ns), log_time_ns)
+                return
+            # a frame's pixels go down the pipe as they are, not copied into the pickle
+            image = value  # a CompressedImage
+            pixels = pickle.PickleBuffer(raw.pixels)
+            fields = (image.data, image.format, image.frame_id, raw.height_px, raw.width_px)  # type: ignore[union-attr]
+            self._queue(
+                (_ENCODE_RAW, topic, fields, pixels, log_time_ns, publish_time_ns), log_time_ns
+            )
 
     def write_mavlink(
         self,
@@ -370,20 +413,29 @@ class ProcessWriter:
             _check_time(publish_time_ns, "publish_time_ns")
         if type(frame) is not bytes:
             frame = bytes(frame)
-        op = _MAV_IN if direction is Direction.IN else _MAV_OUT
         with self._lock:
             if self._closed or self._failure is not None:
                 self._check_open()
-            batch = self._batch
-            batch.append((op, frame, log_time_ns, publish_time_ns))
-            if log_time_ns >= self._ship_at or len(batch) >= BATCH_CALLS:
-                self._ship(log_time_ns)
+            if publish_time_ns is None:
+                self._frames.append(frame)
+                self._frame_ops.append(_MAV_IN if direction is Direction.IN else _MAV_OUT)
+                self._frame_times.append(log_time_ns)
+                if log_time_ns >= self._ship_at or len(self._frames) >= BATCH_CALLS:
+                    self._ship(log_time_ns)
+                return
+            op = _MAV_PUBLISHED_IN if direction is Direction.IN else _MAV_PUBLISHED_OUT
+            self._queue((op, frame, log_time_ns, publish_time_ns), log_time_ns)
 
     def mavlink_tap(self, clock_ns: Callable[[], int]) -> Callable[[str, bytes, Any], None]:
         """`write_mavlink` as a link's tap, each frame stamped ``clock_ns()``; the decoded
         message is not used (the child decodes the frame on another core)."""
         ops = {"in": _MAV_IN, "out": _MAV_OUT}
-        lock = self._lock
+        lock, frames, frame_ops, frame_times = (
+            self._lock,
+            self._frames,
+            self._frame_ops,
+            self._frame_times,
+        )
 
         def tap(direction: str, frame: bytes, _decoded: Any) -> None:
             t = clock_ns()
@@ -394,9 +446,10 @@ class ProcessWriter:
             with lock:
                 if self._closed or self._failure is not None:
                     self._check_open()
-                batch = self._batch
-                batch.append((ops[direction], frame, t, None))
-                if t >= self._ship_at or len(batch) >= BATCH_CALLS:
+                frames.append(frame)
+                frame_ops.append(ops[direction])
+                frame_times.append(t)
+                if t >= self._ship_at or len(frames) >= BATCH_CALLS:
                     self._ship(t)
 
         return tap
@@ -417,7 +470,10 @@ class ProcessWriter:
                 self._vehicle = True
                 self._check_kind(POSE, PosesInFrame)
                 self._check_kind(FIX, LocationFix)
-            self._queue((_VEHICLE, pos_enu_m, heading_deg, origin, log_time_ns), log_time_ns)
+            if origin is not self._origin:  # the child keeps the origin until it moves
+                self._origin = origin
+                self._add((_ORIGIN, origin))
+            self._queue((_VEHICLE, pos_enu_m, heading_deg, log_time_ns), log_time_ns)
 
     # --- internals (called with the lock held) -----------------------------------------------
 
@@ -433,17 +489,33 @@ class ProcessWriter:
         if self._closed:
             raise ValueError(f"{self.path}: the recording is closed")
 
+    def _add(self, item: tuple[Any, ...]) -> None:
+        """Add one call to the batch, after the frames tapped so far."""
+        self._batch.append(item)
+        self._at.append(len(self._frames))
+
     def _queue(self, item: tuple[Any, ...], log_time_ns: int) -> None:
         """Add one call to the batch; ship the batch once a batch's log time or size is
         reached."""
-        self._batch.append(item)
+        self._add(item)
         if log_time_ns >= self._ship_at or len(self._batch) >= BATCH_CALLS:
             self._ship(log_time_ns)
 
     def _ship(self, log_time_ns: int) -> None:
         """Send the batch down the pipe (waiting if the pipe is full); a child that ended
-        shows as a broken pipe."""
-        batch, self._batch = self._batch, []
+        shows as a broken pipe. The columns are emptied in place: a tap holds them."""
+        frames, times = self._frames, self._frame_times
+        batch = (
+            self._batch,
+            self._at,
+            b"".join(frames),
+            array("I", map(len, frames)),
+            bytes(self._frame_ops),
+            times.tobytes(),
+        )
+        self._batch, self._at = [], array("I")
+        frames.clear()
+        del self._frame_ops[:], times[:]
         self._ship_at = log_time_ns + BATCH_NS
         self._send(batch)
 
@@ -490,29 +562,46 @@ class ProcessWriter:
         raise self._failure
 
 
-def _framed(value: Any) -> tuple[bytes, bytes]:
-    """``value`` as it travels down the pipe: its pickle's length, then the pickle."""
-    data = pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL)
-    return _HEADER.pack(len(data)), data
+def _framed(value: Any) -> list[bytes | memoryview]:
+    """``value`` as it travels down the pipe: the sizes of its pickle and of the buffers
+    kept out of it (a frame's pixels, as `pickle.PickleBuffer`), then the pickle, then
+    those buffers, not copied."""
+    buffers: list[pickle.PickleBuffer] = []
+    data = pickle.dumps(value, protocol=5, buffer_callback=buffers.append)
+    raws = [buffer.raw() for buffer in buffers]
+    sizes = struct.pack(f"<{len(raws)}Q", *(raw.nbytes for raw in raws))
+    return [_HEADER.pack(len(data), len(raws)) + sizes, data, *raws]
 
 
 def _read_framed(fd: int) -> tuple[Any, int]:
     """One framed value from the pipe ``fd``, and its size; `EOFError` at the pipe's end
     (or a frame cut short). Plain reads: no buffered stream's lock for a daemon thread to
     hold when the interpreter ends."""
-    (size,) = _HEADER.unpack(_read_exactly(fd, _HEADER.size))
-    return pickle.loads(_read_exactly(fd, size)), size
+    size, count = _HEADER.unpack(_read_exactly(fd, _HEADER.size))
+    sizes = struct.unpack(f"<{count}Q", _read_exactly(fd, 8 * count))
+    data = _read_exactly(fd, size)
+    buffers = [_read_exactly(fd, n) for n in sizes]
+    return pickle.loads(data, buffers=buffers), size + sum(sizes)
 
 
 def _read_exactly(fd: int, size: int) -> bytearray:
+    """``size`` bytes from ``fd``; on a non-blocking ``fd``, sleeping `POLL_S` between
+    looks while it is empty."""
     data = bytearray(size)
     view = memoryview(data)
     done = 0
+    pause = POLL_S[0]
     while done < size:
-        n = os.readv(fd, [view[done:]])
+        try:
+            n = os.readv(fd, [view[done:]])
+        except BlockingIOError:
+            time.sleep(pause)
+            pause = min(2 * pause, POLL_S[1])
+            continue
         if n == 0:
             raise EOFError
         done += n
+        pause = POLL_S[0]
     return data
 
 
@@ -591,13 +680,12 @@ class _Backlog:
 
     def __init__(self, source: int) -> None:
         self._source = source
-        self._batches: queue.SimpleQueue[tuple[list[tuple[Any, ...]], int] | None] = (
-            queue.SimpleQueue()
-        )
+        self._batches: queue.SimpleQueue[tuple[_Batch, int] | None] = queue.SimpleQueue()
         self._room = threading.Semaphore(BACKLOG_BYTES >> 16)  # in 64 KiB units
         threading.Thread(target=self._read, name="uavtool-recording-reader", daemon=True).start()
 
     def _read(self) -> None:
+        os.set_blocking(self._source, False)  # looked at, not waited on: `POLL_S`
         while True:
             try:
                 batch, size = _read_framed(self._source)
@@ -609,7 +697,7 @@ class _Backlog:
                 self._room.acquire()
             self._batches.put((batch, units))
 
-    def next(self) -> list[tuple[Any, ...]] | None:
+    def next(self) -> _Batch | None:
         """The next batch, or `None` at the pipe's end."""
         item = self._batches.get()
         if item is None:
@@ -620,6 +708,35 @@ class _Backlog:
         return batch
 
 
+class _Frames:
+    """A batch's MAVLink frames, in its columns, written in turn between its other calls."""
+
+    def __init__(
+        self, data: bytes, lengths: array[int], ops: bytes, times: array[int], write: Any
+    ) -> None:
+        self._data, self._lengths, self._ops, self._times = data, lengths, ops, times
+        self._write = write
+        self._next = self._offset = 0  # the next frame, and where it starts in data
+
+    def write_to(self, stop: int) -> None:
+        """Write the frames up to (not including) frame ``stop``."""
+        data, lengths, ops, times, write = (
+            self._data,
+            self._lengths,
+            self._ops,
+            self._times,
+            self._write,
+        )
+        inbound, outbound = Direction.IN, Direction.OUT
+        frame, offset = self._next, self._offset
+        while frame < stop:
+            end = offset + lengths[frame]
+            direction = inbound if ops[frame] == _MAV_IN else outbound
+            write(data[offset:end], direction=direction, log_time_ns=times[frame])
+            frame, offset = frame + 1, end
+        self._next, self._offset = frame, offset
+
+
 def _serve(writer: Any, source: _Backlog, reply: Any) -> None:
     protobuf: dict[str, tuple[str, bytes]] = {}  # topic -> (schema name, schema)
     write_mavlink, write_json, write_protobuf = (
@@ -628,6 +745,7 @@ def _serve(writer: Any, source: _Backlog, reply: Any) -> None:
         writer.write_protobuf,
     )
     inbound, outbound = Direction.IN, Direction.OUT
+    origin = None  # write_vehicle's, as the flight's last _ORIGIN set it
     while True:
         batch = source.next()
         if batch is None:
@@ -635,15 +753,36 @@ def _serve(writer: Any, source: _Backlog, reply: Any) -> None:
             # unfinished (uavtool info --recover reads it)
             writer.flush()
             return
-        for call in batch:
+        calls, at, data, lengths, ops, times_bytes = batch
+        times = array("Q")
+        times.frombytes(times_bytes)
+        frames = _Frames(data, lengths, ops, times, write_mavlink)
+        for call, before in zip(calls, at, strict=True):
+            frames.write_to(before)
             op = call[0]
-            if op <= _MAV_OUT:  # _MAV_IN or _MAV_OUT
-                direction = inbound if op == _MAV_IN else outbound
+            if op <= _MAV_PUBLISHED_OUT:  # _MAV_PUBLISHED_IN or _MAV_PUBLISHED_OUT
+                direction = inbound if op == _MAV_PUBLISHED_IN else outbound
                 write_mavlink(
                     call[1], direction=direction, log_time_ns=call[2], publish_time_ns=call[3]
                 )
             elif op == _VEHICLE:
-                writer.write_vehicle(call[1], call[2], call[3], log_time_ns=call[4])
+                writer.write_vehicle(call[1], call[2], origin, log_time_ns=call[3])
+            elif op == _ORIGIN:
+                origin = call[1]
+            elif op == _ENCODE_RAW:
+                data, fmt, frame_id, height, width = call[2]
+                image = CompressedImage(
+                    data, fmt, frame_id, RgbImage(bytes(call[3]), height, width)
+                )
+                name, schema = protobuf[call[1]]
+                write_protobuf(
+                    call[1],
+                    foxglove_module().encode(image, call[4]),
+                    schema_name=name,
+                    schema=schema,
+                    log_time_ns=call[4],
+                    publish_time_ns=call[5],
+                )
             elif op == _ENCODE:
                 name, schema = protobuf[call[1]]
                 write_protobuf(
@@ -672,3 +811,4 @@ def _serve(writer: Any, source: _Backlog, reply: Any) -> None:
                 writer.close()
                 reply("closed", writer.message_count)
                 return
+        frames.write_to(len(lengths))
