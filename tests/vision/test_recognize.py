@@ -5,6 +5,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from uavtool.vision import RecognizeParams, Shape, best_match, match, match_shapes, vectorize
+from uavtool.vision.params import VectorizeParams
+from uavtool.vision.verify import (
+    outline_accuracy_px,
+    outline_fits,
+    outline_gap,
+    outline_tolerance,
+)
 
 from .synth import FAMILIES, draw, family_shape, place
 
@@ -41,6 +48,7 @@ def test_a_rotated_scaled_render_matches_its_original(
     m = match_shapes(ref, cand)
     assert m.score >= THRESHOLD
     assert abs(m.scale - cand_px / ref_px) < 0.05 * cand_px / ref_px
+    assert outline_fits(ref, cand, m)  # and its outline lies on the original's
 
 
 @settings(max_examples=40, deadline=None)
@@ -67,7 +75,38 @@ def test_shapes_of_different_families_do_not_match(
         ),
         500,
     )
-    assert match_shapes(a, b).score < THRESHOLD
+    m = match_shapes(a, b)
+    # the recognizer's verdict: the corners alike (the score) and the outline on the other's
+    assert not (m.score >= THRESHOLD and outline_fits(a, b, m))
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    aspect=aspects,
+    top=st.floats(0.60, 0.95),
+    angle=st.floats(0.0, 360.0),
+    size=st.floats(120.0, 400.0),
+)
+def test_a_trapezoid_is_not_taken_for_the_rectangle_it_nearly_is_where_the_photos_tell_them_apart(
+    aspect: float, top: float, angle: float, size: float
+) -> None:
+    """The class of the counterexample that once scored 0.807 against a 0.8 threshold: a
+    rectangle and a trapezoid of its base and height whose top is 60-95 % of its base, at
+    any turn. The corners may agree; wherever the true outlines lie further apart than twice
+    what the two photos' accuracy allows (`outline_tolerance`), the verdict is no match.
+    Closer than that, these photos cannot tell the two apart (a closer look can)."""
+    inset = (1.0 - top) / 2.0
+    trapezoid = np.array([(0, 0), (1, 0), (1 - inset, aspect), (inset, aspect)], np.float64)
+    rectangle = np.array([(0, 0), (1, 0), (1, aspect), (0, aspect)], np.float64)
+    a = _vectorized(place(rectangle - 0.5, angle_deg=0, size_px=size, centre=(250, 250)), 500)
+    b = _vectorized(place(trapezoid - 0.5, angle_deg=angle, size_px=size, centre=(250, 250)), 500)
+    m = match_shapes(a, b)
+    r, t = _exact(rectangle), _exact(trapezoid)
+    exact = outline_gap(r, t, match_shapes(r, t))  # the footprints themselves
+    accuracy = outline_accuracy_px(VectorizeParams())
+    if exact <= 2.0 * outline_tolerance(a, b, accuracy, accuracy):
+        return  # finer than these photos show
+    assert not (m.score >= THRESHOLD and outline_fits(a, b, m))
 
 
 def test_exact_polygons_match_under_rotation_scale_and_start_corner() -> None:
@@ -144,3 +183,7 @@ def test_a_step_in_an_edge_costs_its_depth_whatever_corner_it_is_read_from() -> 
     # A real wing dropped is no step: an L against the rectangle round it.
     box = np.array([[0, 0], [200, 0], [200, 200], [0, 200]], float)
     assert match(ell, box).score < THRESHOLD
+
+
+def _exact(ring: np.ndarray) -> Shape:
+    return Shape.from_rings(colour_rgb=RED, polygon_px=ring * 1000.0)

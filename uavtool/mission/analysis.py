@@ -24,6 +24,7 @@ from uavtool.vision import Shape, best_match, mirror_score, vectorize
 from uavtool.vision.merge import merge_touching
 from uavtool.vision.model3d import central_shape
 from uavtool.vision.vectorize import ground_mask, hue_distance_deg, inner_walls
+from uavtool.vision.verify import outline_accuracy_px, outline_gap, outline_tolerance
 
 
 def nadir_shapes(params: Params, image_rgb: U8Array) -> tuple[Shape, ...]:
@@ -68,6 +69,16 @@ class Judgement:
     """The candidate's score against the target's mirror image."""
     not_mirror: bool = True
     """Whether the mirror rule holds."""
+    outline_gap: float = 0.0
+    """How far the candidate's outline lies from the target's, put on it (at unit area:
+    :func:`uavtool.vision.verify.outline_gap`); 0 when not measured (no syntactic match)."""
+    outline_tolerance: float = 0.0
+    """The largest gap two outlines of one footprint show in these two photos."""
+
+    @property
+    def outline_fits(self) -> bool:
+        """Whether the outline lies on the target's within the photos' accuracy."""
+        return self.outline_gap <= self.outline_tolerance
 
 
 def aimed_shape(
@@ -113,7 +124,26 @@ def judge(
     gap = 1.0 - mirror_score(target, target, rp)  # how unlike its mirror image the target is
     not_mirror = score - mirrored >= rp.mirror_margin * gap - rp.mirror_tolerance
     matched = judgeable and same_hue and not_mirror and score >= rp.threshold
-    return Judgement(scores, candidate, score, matched, judgeable, same_hue, mirrored, not_mirror)
+    outline, tolerance = 0.0, 0.0
+    if matched:
+        # the corners agree; the outline must also lie on the target's: a near shape (a
+        # trapezoid, a notched corner, an arm shorter) has the target's corners too
+        accuracy = outline_accuracy_px(params.vectorize)
+        outline = outline_gap(target, centre, matches[candidate])
+        tolerance = outline_tolerance(target, centre, accuracy, accuracy)
+        matched = outline <= tolerance
+    return Judgement(
+        scores,
+        candidate,
+        score,
+        matched,
+        judgeable,
+        same_hue,
+        mirrored,
+        not_mirror,
+        outline,
+        tolerance,
+    )
 
 
 def placed_roof(a: Shape, photo_a: Photo, b: Shape, photo_b: Photo) -> float | None:

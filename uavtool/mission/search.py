@@ -319,6 +319,12 @@ def _look(
         why = "; outline cut by the image border, not judged"
     elif not j.not_mirror and j.score >= m.params.recognize.threshold:
         why = f"; as much like the target's mirror image: {j.mirror_score:.3f}"
+    elif j.outline_tolerance > 0.0:
+        fits = "within" if j.outline_fits else "beyond"
+        why = (
+            f"; outline {j.outline_gap * 100:.1f} % of its size off the target's, {fits} "
+            f"the photos' {j.outline_tolerance * 100:.1f} %"
+        )
     m.event(
         Level.INFO,
         f"point of interest {k}{'' if n == 1 else f', look {n}'}: "
@@ -340,7 +346,7 @@ def _closer_look(
     told."""
     p = m.params.mission
     j, photo = look.judgement, look.photo
-    if j.matched or j.candidate < 0 or not (j.same_hue and j.judgeable):
+    if j.matched or j.candidate < 0 or not (j.same_hue and j.judgeable) or _other_outline(j):
         return None
     if j.score < p.recheck_min_score:
         return None
@@ -364,6 +370,13 @@ def _closer_look(
     u, v = shape.centroid_px
     x, y = ground_point(u, v, photo.pose, k, plane_z_m=min(roof, look.alt_m - 1))
     return (x, y, max(lower, m.floor_at(x, y))), roof
+
+
+def _other_outline(j: Judgement) -> bool:
+    """Whether the look was conclusive all the same: the candidate's corners are the
+    target's, but its outline lies further from the target's than the two photos' accuracy
+    allows (a near shape). Another look, higher or closer, measures the same footprint."""
+    return j.outline_tolerance > 0.0 and not j.outline_fits
 
 
 def _farthest_pair(
@@ -397,7 +410,7 @@ def _look_again(
     candidate, a candidate of another hue, or a clear miss centred in the photo."""
     p = m.params.mission
     j, photo = look.judgement, look.photo
-    if j.matched or j.candidate < 0 or not j.same_hue:
+    if j.matched or j.candidate < 0 or not j.same_hue or _other_outline(j):
         return None
     shape = look.shapes[j.candidate]
     u, v = shape.centroid_px

@@ -1,0 +1,120 @@
+"""Metric verification of a syntactic match: does the candidate's outline *lie on* the
+target's, once turned and scaled, or does it only have the same sequence of corners?
+
+The syntactic matcher (:mod:`uavtool.vision.recognize`) compares corners' turns and edges'
+relative lengths, and forgives a great deal by design (corners merged, edges stretched): a
+trapezoid whose top is 70 % of its base, a rectangle with one corner notched or an L with one
+arm shorter all score like the target itself. Here the two outer outlines are put on each
+other — centroids together, each scaled to unit area, the candidate turned by the match's
+rotation (refined) and mirrored if the match was — and their largest distance apart is
+measured (the symmetric Hausdorff distance).
+
+How far apart two outlines of the *same* footprint may lie follows from how exactly each was
+drawn: a vectorized outline lies within `outline_accuracy_px` of the true one in its own
+photo's pixels (the pixel grid's half pixel, the denoising that moves a boundary, the
+simplification's tolerance). At unit area, a photo whose shape covers ``A`` square pixels
+draws it to ``accuracy / sqrt(A)``: the tolerance is the two photos' sum. Two footprints that
+differ by less than that cannot be told apart in these photos — a closer look can; never a
+lower bar.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import shapely
+
+from uavtool.vision.align import Match
+from uavtool.vision.params import VectorizeParams
+from uavtool.vision.shapes import FloatArray, Shape
+
+__all__ = ["outline_accuracy_px", "outline_fits", "outline_gap", "outline_tolerance"]
+
+_REFINE_DEG = (4.0, 1.0, 0.25, 0.0625)  # the rotation searched around the match's, finer each pass
+_DENSIFY = 0.02  # Hausdorff's densification: segments split into 2 % pieces
+
+
+def outline_accuracy_px(params: VectorizeParams) -> float:
+    """How far (pixels) a vectorized outline may lie from the true one: half a pixel of
+    grid, half the denoising kernel (its opening and closing move a boundary by up to that
+    much), and the simplification's tolerance."""
+    return 0.5 + params.denoise_px / 2.0 + params.rdp_epsilon_px
+
+
+def outline_tolerance(
+    reference: Shape, candidate: Shape, accuracy_px: float, reference_accuracy_px: float
+) -> float:
+    """The largest gap (at unit area) two vectorized outlines of one footprint may show: each
+    outline's accuracy in its own pixels, at its own scale."""
+    return reference_accuracy_px / math.sqrt(max(reference.area_px, 1.0)) + accuracy_px / (
+        math.sqrt(max(candidate.area_px, 1.0))
+    )
+
+
+def outline_fits(
+    reference: Shape,
+    candidate: Shape,
+    match: Match,
+    params: VectorizeParams | None = None,
+    reference_params: VectorizeParams | None = None,
+) -> bool:
+    """Whether ``candidate`` (vectorized with ``params``) lies on ``reference`` (vectorized
+    with ``reference_params``, by default the same) as closely as one footprint photographed
+    twice can: `outline_gap` within `outline_tolerance`."""
+    p = params if params is not None else VectorizeParams()
+    q = reference_params if reference_params is not None else p
+    tolerance = outline_tolerance(
+        reference, candidate, outline_accuracy_px(p), outline_accuracy_px(q)
+    )
+    return outline_gap(reference, candidate, match) <= tolerance
+
+
+def outline_gap(reference: Shape, candidate: Shape, match: Match) -> float:
+    """The symmetric Hausdorff distance between the two outer outlines at unit area, with
+    centroids together and the candidate turned (mirrored if the match was) onto the
+    reference as well as any turn near the match's allows; ``inf`` when either is
+    degenerate."""
+    ref = _unit(reference.polygon_px)
+    cand = _unit(candidate.polygon_px)
+    if ref is None or cand is None:
+        return math.inf
+    if match.mirrored:
+        cand = cand * np.array([-1.0, 1.0])
+    ref_line = shapely.LinearRing(ref)
+    best_deg, best = 0.0, math.inf
+    # the match's rotation turns the reference into the candidate: undo it; which sense the
+    # angle is counted in is settled by trying both
+    for start in (-match.rotation_deg, match.rotation_deg):
+        gap = _gap(ref_line, cand, start)
+        if gap < best:
+            best_deg, best = start, gap
+    for step in _REFINE_DEG:
+        centre = best_deg
+        for k in (-2, -1, 1, 2):
+            deg = centre + k * step
+            gap = _gap(ref_line, cand, deg)
+            if gap < best:
+                best_deg, best = deg, gap
+    return best
+
+
+def _gap(ref_line: shapely.LinearRing, cand: FloatArray, deg: float) -> float:
+    t = math.radians(deg)
+    c, s = math.cos(t), math.sin(t)
+    turned = cand @ np.array([[c, s], [-s, c]])
+    return float(shapely.hausdorff_distance(ref_line, shapely.LinearRing(turned), _DENSIFY))
+
+
+def _unit(ring: FloatArray) -> FloatArray | None:
+    """``ring`` with its area centroid at the origin and its area 1."""
+    pts = np.asarray(ring, dtype=np.float64)
+    if len(pts) < 3:
+        return None
+    polygon = shapely.Polygon(pts)
+    area = polygon.area
+    if not area > 0.0:
+        return None
+    c = polygon.centroid
+    unit: FloatArray = (pts - (c.x, c.y)) / math.sqrt(area)
+    return unit
