@@ -28,6 +28,8 @@ MAX_FOOTPRINT_VERTICES = 256
 MAX_SCENE_VERTICES = 4096
 """Footprint vertices of all blocks together: the renderer's set-up compares every pair of
 convex pieces, so this bounds its time and memory."""
+MAX_GROUND_AREAS = 256
+"""Flat ground areas (lawns, roads, fields); their vertices count with the footprints'."""
 MAX_EXTENT_M = 10_000.0
 """Footprint coordinates lie within this many metres of home, east and north."""
 MAX_HEIGHT_M = 1_000.0

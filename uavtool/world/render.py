@@ -20,6 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from uavtool.camera import CameraPose, Intrinsics
+from uavtool.world.ground_render import area_spans, texture_frame
 from uavtool.world.raster import (
     Prepared,
     ScreenFace,
@@ -69,11 +70,29 @@ def _pack(rgb: tuple[int, int, int]) -> np.uint32:
 
 
 def background(scene: Scene, pose: CameraPose, intrinsics: Intrinsics) -> npt.NDArray[np.uint32]:
-    """Sky above the horizon, ground below, as packed RGBA (H, W) uint32."""
-    buf = np.empty((intrinsics.height_px, intrinsics.width_px), dtype=np.uint32)
+    """Sky above the horizon, ground below with its areas and texture, as packed RGBA (H, W)
+    uint32: what every building is painted over (nothing on the ground hides one)."""
+    h, w = intrinsics.height_px, intrinsics.width_px
+    buf = np.empty((h, w), dtype=np.uint32)
     horizon = ground_rows(pose, intrinsics)
     buf[:horizon] = _pack(scene.sky_rgb)
-    buf[horizon:] = _pack(scene.ground_rgb)
+    texture = None
+    if scene.ground_texture is not None:
+        texture = texture_frame(scene.ground_texture, pose, intrinsics, first_row=horizon)
+    if texture is None:
+        buf[horizon:] = _pack(scene.ground_rgb)
+    else:
+        texture.fill(scene.ground_rgb, buf[horizon:])
+    if scene.ground_areas:
+        cols = np.arange(w, dtype=np.int64)
+        for sp, rgb in area_spans(scene, pose, intrinsics):
+            rows = slice(sp.row0, sp.row0 + len(sp.left))
+            where = buf[rows, sp.col0 : sp.col1]
+            if texture is None:
+                np.copyto(where, _pack(rgb), where=_mask(sp, cols))
+            else:
+                colour = texture.paint(rgb, rows, slice(sp.col0, sp.col1))
+                np.copyto(where, colour, where=_mask(sp, cols))
     return buf
 
 

@@ -5,7 +5,7 @@ A scene file (YAML, TOML or JSON) holds the same data as :func:`scene_to_dict`::
     version: 1
     name: paper
     origin: {lat_deg: 50.06, lon_deg: 19.94, alt_amsl_m: 220.0, heading_deg: 0.0}
-    ground: {color: [128, 128, 128]}
+    ground: {color: [128, 128, 128]}   # areas and a texture too: see uavtool.world.ground
     sky: {color: [205, 218, 232]}
     lighting: {sun_azimuth_deg: 150.0, sun_elevation_deg: 60.0, ambient: 0.55}
     target: red
@@ -37,6 +37,7 @@ import yaml
 from uavtool.geo import GeoPoint
 from uavtool.world import limits
 from uavtool.world.errors import SceneError
+from uavtool.world.ground import GroundArea, GroundTexture, ground_to_dict, read_ground
 from uavtool.world.polygon import normalise_ring, signed_area
 from uavtool.world.scene_file import KeyPath, format_path, parse_text
 
@@ -90,6 +91,8 @@ class Scene:
     sky_rgb: RGB = DEFAULT_SKY_RGB
     lighting: Lighting = Lighting()
     description: str = ""
+    ground_areas: tuple[GroundArea, ...] = ()  # drawn in order over the ground colour
+    ground_texture: GroundTexture | None = None
 
     def building(self, name: str) -> Building:
         """The building called ``name``; raises SceneError if there is none."""
@@ -118,7 +121,7 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
             "alt_amsl_m": scene.home.alt_amsl_m,
             "heading_deg": scene.home_heading_deg,
         },
-        "ground": {"color": list(scene.ground_rgb)},
+        "ground": ground_to_dict(scene.ground_rgb, scene.ground_areas, scene.ground_texture),
         "sky": {"color": list(scene.sky_rgb)},
         "lighting": {
             "sun_azimuth_deg": scene.lighting.sun_azimuth_deg,
@@ -162,7 +165,7 @@ class _Reader:
     def __init__(self, source: str, lines: Mapping[KeyPath, int]) -> None:
         self.source = source
         self.lines = lines
-        self.vertices = 0  # footprint vertices read so far, against MAX_SCENE_VERTICES
+        self.vertices = 0  # footprint and area vertices read so far, against MAX_SCENE_VERTICES
 
     def fail(self, path: KeyPath, message: str) -> NoReturn:
         line = None
@@ -230,6 +233,44 @@ class _Reader:
             self.fail(path, f"expected [r, g, b] with integers 0-255, got {_shown(value)}")
         return (items[0], items[1], items[2])
 
+    def whole(self, value: object, path: KeyPath, lo: int, hi: int) -> int:
+        if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
+            self.fail(path, f"expected a whole number {lo}..{hi}, got {_shown(value)}")
+        return value
+
+    def ring(self, value: object, path: KeyPath, *, what: str) -> tuple[tuple[float, float], ...]:
+        """A simple polygon of [east_m, north_m] points (a footprint, a ground area),
+        counter-clockwise; every point counts against MAX_SCENE_VERTICES."""
+        raw = self.sequence(value, path, most=limits.MAX_FOOTPRINT_VERTICES)
+        self.vertices += len(raw)
+        if self.vertices > limits.MAX_SCENE_VERTICES:
+            self.fail(
+                path,
+                f"the scene has more than {limits.MAX_SCENE_VERTICES} footprint vertices "
+                "(ground areas' included)",
+            )
+        pts: list[tuple[float, float]] = []
+        for k, p in enumerate(raw):
+            xy = self.sequence(p, (*path, k))
+            if len(xy) != 2:
+                self.fail((*path, k), f"expected [east_m, north_m], got {_shown(p)}")
+            x_m, y_m = self.number(xy[0], (*path, k, 0)), self.number(xy[1], (*path, k, 1))
+            if max(abs(x_m), abs(y_m)) > limits.MAX_EXTENT_M:
+                self.fail((*path, k), f"more than {limits.MAX_EXTENT_M:g} m from home")
+            pts.append((x_m, y_m))
+        if len(pts) > 1 and pts[0] == pts[-1]:
+            pts.pop()
+        if len(pts) < 3:
+            self.fail(path, f"a {what} needs at least 3 vertices, got {len(pts)}")
+        for k in range(len(pts)):
+            if pts[k] == pts[k - 1]:
+                self.fail((*path, k), "repeated vertex")
+        if abs(signed_area(pts)) < _MIN_AREA_M2:
+            self.fail(path, "polygon has zero area")
+        if not shapely.LinearRing(pts).is_simple:
+            self.fail(path, "self-intersecting polygon")
+        return normalise_ring(pts)
+
 
 def _plain_key(key: object) -> bool:
     """A key worth naming in an error: a short word such as ``colour`` or ``top-m``, not a line
@@ -289,9 +330,10 @@ def _scene_from(data: object, r: _Reader, *, default_name: str) -> Scene:
     home = GeoPoint(lat, lon, r.number(origin.get("alt_amsl_m", 0.0), ("origin", "alt_amsl_m")))
     heading = r.number(origin.get("heading_deg", 0.0), ("origin", "heading_deg"))
 
-    ground = r.mapping(top.get("ground", {}), ("ground",), (), ("color",))
+    ground_rgb, areas, texture = read_ground(
+        top.get("ground", {}), r, default_rgb=DEFAULT_GROUND_RGB
+    )
     sky = r.mapping(top.get("sky", {}), ("sky",), (), ("color",))
-    ground_rgb = r.color(ground.get("color", list(DEFAULT_GROUND_RGB)), ("ground", "color"))
     sky_rgb = r.color(sky.get("color", list(DEFAULT_SKY_RGB)), ("sky", "color"))
     lighting = _lighting_from(top.get("lighting", {}), r)
 
@@ -318,6 +360,8 @@ def _scene_from(data: object, r: _Reader, *, default_name: str) -> Scene:
         sky_rgb=sky_rgb,
         lighting=lighting,
         description=description,
+        ground_areas=areas,
+        ground_texture=texture,
     )
 
 
@@ -361,32 +405,7 @@ def _building_from(value: object, path: KeyPath, r: _Reader) -> Building:
 
 def _block_from(value: object, path: KeyPath, r: _Reader) -> Block:
     d = r.mapping(value, path, ("footprint", "top_m"), ("base_m",))
-    fp_path: KeyPath = (*path, "footprint")
-    raw = r.sequence(d["footprint"], fp_path, most=limits.MAX_FOOTPRINT_VERTICES)
-    r.vertices += len(raw)
-    if r.vertices > limits.MAX_SCENE_VERTICES:
-        r.fail(fp_path, f"the scene has more than {limits.MAX_SCENE_VERTICES} footprint vertices")
-    pts: list[tuple[float, float]] = []
-    for k, p in enumerate(raw):
-        xy = r.sequence(p, (*fp_path, k))
-        if len(xy) != 2:
-            r.fail((*fp_path, k), f"expected [east_m, north_m], got {_shown(p)}")
-        x_m, y_m = r.number(xy[0], (*fp_path, k, 0)), r.number(xy[1], (*fp_path, k, 1))
-        if max(abs(x_m), abs(y_m)) > limits.MAX_EXTENT_M:
-            r.fail((*fp_path, k), f"more than {limits.MAX_EXTENT_M:g} m from home")
-        pts.append((x_m, y_m))
-    if len(pts) > 1 and pts[0] == pts[-1]:
-        pts.pop()
-    if len(pts) < 3:
-        r.fail(fp_path, f"a footprint needs at least 3 vertices, got {len(pts)}")
-    for k in range(len(pts)):
-        if pts[k] == pts[k - 1]:
-            r.fail((*fp_path, k), "repeated vertex")
-    if abs(signed_area(pts)) < _MIN_AREA_M2:
-        r.fail(fp_path, "polygon has zero area")
-    if not shapely.LinearRing(pts).is_simple:
-        r.fail(fp_path, "self-intersecting polygon")
-    ring = normalise_ring(pts)
+    ring = r.ring(d["footprint"], (*path, "footprint"), what="footprint")
     base = r.number(d.get("base_m", 0.0), (*path, "base_m"))
     top = r.number(d["top_m"], (*path, "top_m"))
     if base < 0.0:
