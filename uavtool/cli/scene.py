@@ -254,6 +254,38 @@ def show(scene_ref: str, size: str, output: Path) -> None:
     "--random-home).",
 )
 @click.option(
+    "--world",
+    is_flag=True,
+    help="With --hard: every world class below on (any light, ground colour, ground areas, "
+    "texture, near shapes).",
+)
+@click.option(
+    "--light",
+    is_flag=True,
+    help="With --hard: the sun 5-90° up from any azimuth, ambient 0.15-0.8.",
+)
+@click.option(
+    "--ground-colour",
+    is_flag=True,
+    help="With --hard: ground of any colour (greens, browns), its hue away from the target's by "
+    "the vectorizer's hue tolerance.",
+)
+@click.option(
+    "--ground-areas",
+    is_flag=True,
+    help="With --hard: 2-6 lawns, roads, car parks and fields around home (flat, not buildings).",
+)
+@click.option(
+    "--texture", is_flag=True, help="With --hard: seeded grain or noise on the ground, 4-14 DN."
+)
+@click.option(
+    "--near-shapes",
+    is_flag=True,
+    help="With --hard: 1-2 buildings of the target's colour and height whose outline is almost "
+    "the target's (aspect 5-10 % off, a trapezoid, a chamfered or notched corner, an arm 15 % "
+    "shorter).",
+)
+@click.option(
     "-o",
     "--output",
     required=True,
@@ -270,6 +302,12 @@ def random_scene(
     town: bool,
     random_home: bool,
     anywhere: bool,
+    world: bool,
+    light: bool,
+    ground_colour: bool,
+    ground_areas: bool,
+    texture: bool,
+    near_shapes: bool,
     output: Path,
 ) -> None:
     """Generate a random scene file from a seed.
@@ -279,7 +317,8 @@ def random_scene(
     photo from 45 m covers; the file's description names the decoys. --town adds what a
     town has and the search was not tuned on: grey roofs, darker shades, same-colour
     decoys with a yard or a wing more or less, courtyards, small targets, tall towers,
-    home beside a tower, dense blocks.
+    home beside a tower, dense blocks. --world adds any light, any ground (colour, areas,
+    texture) and near shapes of the target in its colour; each of them has its own flag.
 
     \b
     Examples:
@@ -287,15 +326,25 @@ def random_scene(
       uavtool scene show random7.yaml -o random7.png
       uavtool scene random --hard --seed 7 -o hard7.yaml
       uavtool scene random --hard --town --seed 7 -o town7.yaml
+      uavtool scene random --hard --town --world --seed 7 -o world7.yaml
     """
     from uavtool.world.scene import dump_scene
 
     suffix = output.suffix.lower()
     if suffix not in (".yaml", ".yml", ".json"):
         raise InputError(f"{output}: output must end in .yaml, .yml or .json")
+    knobs = {
+        "any_light": light,
+        "any_ground": ground_colour,
+        "ground_areas": ground_areas,
+        "ground_texture": texture,
+        "near_shapes": near_shapes,
+    }
+    if world:
+        knobs = dict.fromkeys(knobs, True)
     if hard:
         s, info = _hard_scene(
-            seed, buildings, margin, spread, overhang, town, random_home, anywhere
+            seed, buildings, margin, spread, overhang, town, random_home, anywhere, knobs
         )
     else:
         from uavtool.world.generator import generate_scene
@@ -306,6 +355,12 @@ def random_scene(
             ("--town", town),
             ("--random-home", random_home),
             ("--anywhere", anywhere),
+            ("--world", world),
+            ("--light", light),
+            ("--ground-colour", ground_colour),
+            ("--ground-areas", ground_areas),
+            ("--texture", texture),
+            ("--near-shapes", near_shapes),
         ):
             if given:
                 raise InputError(f"{flag} needs --hard")
@@ -331,6 +386,7 @@ def _hard_scene(
     town: bool,
     random_home: bool,
     anywhere: bool,
+    knobs: dict[str, bool],
 ) -> tuple[Scene, HardSceneInfo]:
     from dataclasses import replace
 
@@ -351,5 +407,6 @@ def _hard_scene(
         home_overhang_p=1.0 if overhang else default.home_overhang_p,
         random_home=random_home,
         anywhere=anywhere,
+        **knobs,
     )
     return generate_hard_scene_with_info(seed=seed, options=options)

@@ -79,8 +79,17 @@ from uavtool.world.hard_shapes import (
     wing_copy,
     yard_copy,
 )
+from uavtool.world.hard_world import World, draw_world
 from uavtool.world.polygon import normalise_ring
-from uavtool.world.scene import Block, Building, Scene, scene_from_dict, scene_to_dict
+from uavtool.world.scene import (
+    DEFAULT_GROUND_RGB,
+    Block,
+    Building,
+    Lighting,
+    Scene,
+    scene_from_dict,
+    scene_to_dict,
+)
 
 MAX_HARD_BUILDINGS = 16  # hue slots stay >= 22.5° apart, so the mirror decoy's hue is nearest
 HOME = GeoPoint(50.0647, 19.945, 219.0)  # the paper scene's home
@@ -116,6 +125,13 @@ class HardOptions:
     anywhere: bool = False  # home anywhere on Earth to ±85° latitude, in a third of the
     # scenes within `spread_m` of the 180th meridian (the buildings straddle it); the vehicle
     # turned any way. Wins over random_home; drawn after everything else, as it is
+    # The world classes (issue 45; `--world` turns them all on), each drawn after all of
+    # the above, home included, and only when on (see uavtool.world.hard_world):
+    any_light: bool = False  # the sun 5–90° up from any azimuth, ambient 0.15–0.8
+    any_ground: bool = False  # ground of any colour, its hue away from the target's
+    ground_areas: bool = False  # 2–6 lawns, roads, car parks and fields around home
+    ground_texture: bool = False  # seeded grain or noise on the ground, 4–14 DN
+    near_shapes: bool = False  # 1–2 near shapes of the target, in its colour and height
     # The town classes (HardOptions.town() turns them all on); each is drawn once per scene,
     # and only when its knob is above 0, so scenes without them are as they always were.
     grey_p: float = 0.0  # 1–3 other buildings concrete grey, white, black or grey-blue
@@ -148,6 +164,10 @@ class HardOptions:
             value = getattr(self, f.name)
             if f.name.endswith("_p") and not 0.0 <= value <= 1.0:
                 raise SceneError(f"{f.name} is a probability in [0, 1], got {value}")
+
+    def with_world(self) -> HardOptions:
+        """These options with every world class on (`--world`)."""
+        return replace(self, **dict.fromkeys(WORLD_KNOBS, True))
 
     @classmethod
     def town(cls) -> HardOptions:
@@ -195,6 +215,9 @@ class HardSceneInfo:
     grey: tuple[str, ...] = ()  # saturation under 70/255: concrete, white, black, grey-blue
     darker: tuple[tuple[str, str], ...] = ()  # (building, the brighter one of its hue)
     dense_gap_m: float | None = None  # a dense block: least gap between footprints
+    # the world classes (HardOptions' world knobs); empty when off
+    near_shapes: tuple[tuple[str, str], ...] = ()  # (building, class): target's colour
+    world: tuple[str, ...] = ()  # light, ground, areas, texture, as the description says
 
     @property
     def decoys(self) -> tuple[str, ...]:
@@ -206,7 +229,7 @@ class HardSceneInfo:
             self.hole_decoy,
             self.wing_decoy,
         )
-        return tuple(n for n in found if n is not None)
+        return tuple(n for n in found if n is not None) + tuple(n for n, _ in self.near_shapes)
 
     @property
     def classes(self) -> tuple[str, ...]:
@@ -257,6 +280,9 @@ class HardSceneInfo:
             out.append("darker " + " ".join(f"{a} (of {b})" for a, b in self.darker))
         if self.dense_gap_m is not None:
             out.append(f"dense, {self.dense_gap_m:g} m gaps")
+        if self.near_shapes:
+            out.append("near shapes " + " ".join(f"{n} ({c})" for n, c in self.near_shapes))
+        out.extend(self.world)
         return "; ".join(out)
 
 
@@ -459,13 +485,26 @@ def generate_hard_scene_with_info(
         lat, lon = uniform(rng, -60.0, 60.0), uniform(rng, -180.0, 180.0)
         home = GeoPoint(round(lat, 7), round(lon, 7), HOME.alt_amsl_m)
         heading_deg = round(uniform(rng, 0.0, 360.0), 1) % 360.0
+    world = draw_world(rng, o, target=target, target_rgb=colours[0], buildings=buildings)
+    if world != World():
+        info = replace(
+            info,
+            near_shapes=tuple(
+                (b.name, c) for b, c in zip(world.near_shapes, world.near_classes, strict=True)
+            ),
+            world=world.labels(),
+        )
     scene = Scene(
         name=f"hard-{seed}",
         home=home,
         home_heading_deg=heading_deg,
-        buildings=buildings,
+        buildings=buildings + world.near_shapes,
         target=info.target,
         description=f"{hard_command(seed, o)}: {info.summary()}",
+        ground_rgb=world.ground_rgb or DEFAULT_GROUND_RGB,
+        lighting=world.lighting or Lighting(),
+        ground_areas=world.areas,
+        ground_texture=world.texture,
     )
     # what we write must load: run the file validation on it
     return scene_from_dict(scene_to_dict(scene), source=scene.name), info
@@ -727,9 +766,16 @@ def hard_command(seed: int, options: HardOptions = HardOptions()) -> str:
         else:
             rest += [f"min_buildings={counts[0]}", f"max_buildings={counts[1]}"]
     flags = {"margin_m": "--margin", "spread_m": "--spread"}
+    every_world = all(getattr(options, f) for f in WORLD_KNOBS)
     for f in fields(options):
         value, was = getattr(options, f.name), getattr(default, f.name)
         if f.name in ("min_buildings", "max_buildings") or value == was:
+            continue
+        if f.name in WORLD_KNOBS:
+            if not every_world:
+                words.append(WORLD_KNOBS[f.name])
+            elif f.name == next(iter(WORLD_KNOBS)):
+                words.append("--world")
             continue
         if f.name in flags:
             words.append(f"{flags[f.name]} {value:g}")
@@ -745,10 +791,19 @@ def hard_command(seed: int, options: HardOptions = HardOptions()) -> str:
     return f"{line} (HardOptions: {', '.join(rest)})" if rest else line
 
 
+WORLD_KNOBS = {
+    "any_light": "--light",
+    "any_ground": "--ground-colour",
+    "ground_areas": "--ground-areas",
+    "ground_texture": "--texture",
+    "near_shapes": "--near-shapes",
+}
+"""The world classes' HardOptions fields and their flags (``--world``: all of them)."""
+
 # what `--town` sets that no other flag of the command does
 _TOWN_ONLY = tuple(
     f.name
     for f in fields(HardOptions)
     if f.name not in ("min_buildings", "max_buildings", "margin_m", "spread_m", "home_overhang_p")
-    and f.name not in ("random_home", "anywhere")
+    and f.name not in ("random_home", "anywhere", *WORLD_KNOBS)
 )

@@ -446,12 +446,12 @@ def wing_copy(rng: random.Random, plan: Plan) -> Plan | None:
         shorten = arm - 2.0 >= _ARM_LEFT_M
         remove = off and (not shorten or g < 0.35)
         by_m = 2.0 + f * (min(4.0, arm - _ARM_LEFT_M) - 2.0)
-        out = normalise_ring(_moved_wing(ring, k, by_m, remove=remove))
+        out = normalise_ring(moved_wing(ring, k, by_m, remove=remove))
         if not well_formed(out) or signed_area(out) >= signed_area(ring) - 0.5:
             continue
         if plan.yard is None:
             return Plan(plan.shape, "plain", out, (Part(out, 0.0, top),))
-        yard = normalise_ring(_moved_wing(plan.yard, k, by_m, remove=False))
+        yard = normalise_ring(moved_wing(plan.yard, k, by_m, remove=False))
         if len(out) == n and len(yard) == n and well_formed(yard, edge_m=2.5, gap_m=2.5):
             parts = yard_parts(out, yard, 0.0, top)
             if parts is not None:
@@ -459,7 +459,7 @@ def wing_copy(rng: random.Random, plan: Plan) -> Plan | None:
     return None
 
 
-def _moved_wing(ring: Ring, k: int, by_m: float, *, remove: bool) -> list[Point]:
+def moved_wing(ring: Ring, k: int, by_m: float, *, remove: bool) -> list[Point]:
     """``ring`` with edge k–k+1 moved ``by_m`` back along its neighbouring edges (both run
     along one axis), or (``remove``) back to where the shorter of them ends: that coordinate
     exactly, so the repeated and straight vertices left are dropped by normalise_ring."""
