@@ -42,13 +42,17 @@ import shapely
 from shapely import affinity
 from shapely.geometry import Polygon
 
+from uavtool.mission.params import MissionParams
 from uavtool.vision import RecognizeParams, Shape, VectorizeParams, match_shapes, vectorize
-from uavtool.vision.verify import outline_fits
+from uavtool.vision.align import Match
+from uavtool.vision.verify import outline_accuracy_px, outline_fits, outline_gap
 
 ROOF = (210, 40, 40)
 GROUND = (128, 128, 128)
-REFERENCE_PX_PER_M = 12.0
 FOCAL_PX = 320.0 / math.tan(math.radians(30.0))  # 640 px across 60°
+REFERENCE_PX_PER_M = FOCAL_PX / 30.0  # `uavtool scene target`: 30 m above the roof
+LOOK_FILL = MissionParams().look_fill
+ACCURACY_SEED = 7
 NOISE_DN = 3.0
 NEAR_CLASSES = ("aspect", "trapezoid", "chamfer", "notch", "arm")
 GOAL_FALSE, GOAL_TRUE = 0.001, 0.995
@@ -180,8 +184,7 @@ def _picture(
         w = 1.0 + along * math.sin(tilt) / FOCAL_PX
         along, across = along * math.cos(tilt) / w, across / w
         pts = np.stack([along * u - across * v, along * v + across * u], axis=1)
-    span = float(np.abs(pts).max())
-    half = int(span + 40)
+    half = _half(pts)
     pts += half
     image = np.empty((2 * half, 2 * half, 3), np.uint8)
     image[:] = GROUND
@@ -190,6 +193,28 @@ def _picture(
         noisy = image.astype(np.float64) + rng.normal(0.0, NOISE_DN, image.shape)
         image = np.clip(np.round(noisy), 0, 255).astype(np.uint8)
     return image
+
+
+def _half(pts: np.ndarray) -> int:
+    """Half the side of the square picture ``pts`` (centred on 0) are drawn in."""
+    return int(float(np.abs(pts).max()) + 40)
+
+
+def _rectified(shape: Shape, half: int, tilt_deg: float, tilt_axis_deg: float) -> Shape:
+    """``shape`` with the perspective of `_picture`'s tilt undone: the roof's outline as a
+    camera square to it would draw it (what a mission does with its photo's pose)."""
+    if not tilt_deg:
+        return shape
+    pts = np.asarray(shape.polygon_px, dtype=np.float64) - half
+    axis = math.radians(tilt_axis_deg)
+    u, v = math.cos(axis), math.sin(axis)
+    along = pts[:, 0] * u + pts[:, 1] * v
+    across = -pts[:, 0] * v + pts[:, 1] * u
+    tilt = math.radians(tilt_deg)
+    along = along / (math.cos(tilt) - along * math.sin(tilt) / FOCAL_PX)
+    across = across * (1.0 + along * math.sin(tilt) / FOCAL_PX)
+    flat = np.stack([along * u - across * v, along * v + across * u], axis=1) + half
+    return Shape.from_rings(colour_rgb=shape.colour_rgb, polygon_px=flat)
 
 
 def _roof(image: np.ndarray) -> Shape | None:
@@ -214,20 +239,83 @@ def _pair(seed: int, index: int, near: str | None) -> tuple[str, str, float, boo
     reference, nums = _base(rng, kind)
     candidate = reference if near is None else _near(rng, near, kind, reference, nums)
     ref_shape = _roof(_picture(reference, REFERENCE_PX_PER_M, 0.0, 0.0, 0.0, None))
-    tilt = rng.uniform(0.0, 20.0)
+    tilt, axis = rng.uniform(0.0, 20.0), rng.uniform(0.0, 360.0)
     photo = _picture(
-        candidate,
-        rng.uniform(8.0, 18.0),
-        rng.uniform(0.0, 360.0),
-        tilt,
-        rng.uniform(0.0, 360.0),
-        rng,
+        candidate, _look_px_per_m(rng, candidate), rng.uniform(0.0, 360.0), tilt, axis, rng
     )
     cand_shape = _roof(photo)
     if ref_shape is None or cand_shape is None:
         return kind, near or "true", 0.0, False, tilt
     m = match_shapes(ref_shape, cand_shape, RecognizeParams())
-    return kind, near or "true", m.score, outline_fits(ref_shape, cand_shape, m), tilt
+    flat = _rectified(cand_shape, photo.shape[0] // 2, tilt, axis)
+    return kind, near or "true", m.score, outline_fits(ref_shape, flat, m), tilt
+
+
+def _look_px_per_m(rng: np.random.Generator, footprint: Polygon) -> float:
+    """A look's scale: the mission flies where the footprint's longest extent spans
+    ``look_fill`` of the photo's 480 rows, for the roof height it assumes; a roof lower than
+    assumed (up to half the distance) shows smaller."""
+    pts = np.asarray(footprint.exterior.coords[:-1])
+    extent = max(math.dist(a, b) for a in pts for b in pts)
+    return LOOK_FILL * 480.0 / extent * rng.uniform(0.6, 1.0)
+
+
+def _accuracy_one(index: int) -> tuple[float, float]:
+    """(how far the vectorized outline lies from the true one, put on it at unit area, in
+    pixels of the picture; the shape's sqrt(area) in pixels) for one drawn footprint."""
+    rng = np.random.default_rng([ACCURACY_SEED, index])
+    footprint, _ = _base(rng, str(rng.choice(("rect", "L", "T", "U"))))
+    image, truth_px = _drawn(footprint, rng.uniform(4.0, 40.0), rng.uniform(0.0, 360.0), rng)
+    shape = _roof(image)
+    if shape is None:
+        return math.inf, 0.0
+    truth = Shape.from_rings(colour_rgb=ROOF, polygon_px=truth_px)
+    same = Match(1.0, 0.0, (), 0.0, 1.0, False)  # drawn unturned: the gap's search refines
+    size = math.sqrt(shape.area_px)
+    return outline_gap(truth, shape, same) * size, size
+
+
+def _drawn(
+    footprint: Polygon, px_per_m: float, turn_deg: float, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray]:
+    """`_picture` without tilt, and the true outline in the picture's pixels (the fill's
+    sub-pixel vertices, shifted by a random fraction of a pixel)."""
+    c = footprint.centroid
+    pts = np.asarray(footprint.exterior.coords[:-1], dtype=np.float64) - (c.x, c.y)
+    t = math.radians(turn_deg)
+    rot = np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
+    pts = pts @ rot.T * px_per_m
+    pts[:, 1] = -pts[:, 1]
+    half = _half(pts)
+    pts += half + rng.uniform(0.0, 1.0, 2)
+    image = np.empty((2 * half + 2, 2 * half + 2, 3), np.uint8)
+    image[:] = GROUND
+    cv2.fillPoly(image, [np.round(pts * 16).astype(np.int32)], ROOF, lineType=cv2.LINE_8, shift=4)
+    noisy = image.astype(np.float64) + rng.normal(0.0, NOISE_DN, image.shape)
+    return np.clip(np.round(noisy), 0, 255).astype(np.uint8), pts
+
+
+def accuracy(n: int, workers: int) -> None:
+    """The vectorizer's outline accuracy, measured, against `outline_accuracy_px`."""
+    with ProcessPoolExecutor(workers) as pool:
+        rows = list(pool.map(_accuracy_one, range(n), chunksize=50))
+    gaps = np.array([g for g, _ in rows])
+    bound = outline_accuracy_px(VectorizeParams())
+    print(f"outline accuracy: {n} footprints (rect, L, T, U), 4-40 px/m, any turn, σ {NOISE_DN} DN")
+    print(
+        f"  from the true outline at unit area: median {np.median(gaps):.2f} px, 99th "
+        f"percentile {np.percentile(gaps, 99):.2f} px, 99.9th {np.percentile(gaps, 99.9):.2f} "
+        f"px, worst {gaps.max():.2f} px"
+    )
+    met = np.mean(gaps <= bound) * 100
+    print(f"  outline_accuracy_px (defaults) {bound:.2f} px: met by {met:.2f} % of outlines")
+    for lo, hi in ((0, 100), (100, 200), (200, 400), (400, 10**6)):
+        part = np.array([g for g, size in rows if lo <= size < hi])
+        if len(part):
+            print(
+                f"    {lo:>4}-{hi if hi < 10**6 else '':<4} px across: {len(part):>5}, "
+                f"99th percentile {np.percentile(part, 99):.2f} px, worst {part.max():.2f} px"
+            )
 
 
 def _chunk(
@@ -251,8 +339,14 @@ def main() -> None:
         default=Path(tempfile.gettempdir()) / "near_shapes_roc.png",
         help="where the ROC goes (default: %(default)s)",
     )
+    parser.add_argument(
+        "--accuracy", action="store_true", help="instead: measure the vectorizer's accuracy"
+    )
     args = parser.parse_args()
     n = 500 if args.quick else args.pairs
+    if args.accuracy:
+        accuracy(n, args.workers)
+        return
     jobs: list[tuple[int, str | None]] = [(i, None) for i in range(n)]
     jobs += [(i, NEAR_CLASSES[i % len(NEAR_CLASSES)]) for i in range(n)]
     chunks = [(args.seed, jobs[k : k + 200]) for k in range(0, len(jobs), 200)]

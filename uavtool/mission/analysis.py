@@ -74,6 +74,10 @@ class Judgement:
     :func:`uavtool.vision.verify.outline_gap`); 0 when not measured (no syntactic match)."""
     outline_tolerance: float = 0.0
     """The largest gap two outlines of one footprint show in these two photos."""
+    stepped: bool = False
+    """The corners matched, but the target picture shows parts of the building at several
+    heights (walls inside its roof's outline): each photo's perspective draws them apart by
+    its own distance, so the outlines are not compared."""
 
     @property
     def outline_fits(self) -> bool:
@@ -100,15 +104,27 @@ def aimed_shape(
     return central_shape(shapes, intrinsics)
 
 
+def stepped(image_rgb: U8Array, shape: Shape, nadir: tuple[float, float] | None = None) -> bool:
+    """Whether ``shape`` (a roof in a photo from above) shows walls inside its outline: parts
+    of the building at several heights (`inner_walls`; ``nadir``: the photo's point straight
+    below the camera, when known)."""
+    return bool(inner_walls(image_rgb, shape, nadir_px=nadir))
+
+
 def judge(
     params: Params,
     target: Shape,
     shapes: tuple[Shape, ...],
     intrinsics: Intrinsics,
     aimed_rgb: tuple[int, int, int] | None = None,
+    *,
+    target_stepped: bool = False,
 ) -> Judgement:
     """The photo's shapes against the target; the candidate is :func:`aimed_shape`'s (the
-    photo was aimed at a building of ``aimed_rgb``, None when not known)."""
+    photo was aimed at a building of ``aimed_rgb``, None when not known). A syntactic match
+    must also lie on the target's outline (`uavtool.vision.verify`), unless the target
+    picture shows parts at several heights (``target_stepped``): each photo's perspective
+    then draws them apart by its own distance."""
     centre = aimed_shape(params, shapes, intrinsics, aimed_rgb)
     candidate = next((i for i, s in enumerate(shapes) if s is centre), -1)
     if centre is None or candidate < 0:
@@ -124,14 +140,18 @@ def judge(
     gap = 1.0 - mirror_score(target, target, rp)  # how unlike its mirror image the target is
     not_mirror = score - mirrored >= rp.mirror_margin * gap - rp.mirror_tolerance
     matched = judgeable and same_hue and not_mirror and score >= rp.threshold
-    outline, tolerance = 0.0, 0.0
+    outline, tolerance, tiers = 0.0, 0.0, False
     if matched:
         # the corners agree; the outline must also lie on the target's: a near shape (a
         # trapezoid, a notched corner, an arm shorter) has the target's corners too
-        accuracy = outline_accuracy_px(params.vectorize)
-        outline = outline_gap(target, centre, matches[candidate])
-        tolerance = outline_tolerance(target, centre, accuracy, accuracy)
-        matched = outline <= tolerance
+        # a target picture of one roof height is compared with any candidate: one that shows
+        # parts at several heights lies off its outline, and is not the target
+        tiers = target_stepped
+        if not tiers:
+            accuracy = outline_accuracy_px(params.vectorize)
+            outline = outline_gap(target, centre, matches[candidate])
+            tolerance = outline_tolerance(target, centre, accuracy, accuracy)
+            matched = outline <= tolerance
     return Judgement(
         scores,
         candidate,
@@ -143,6 +163,7 @@ def judge(
         not_mirror,
         outline,
         tolerance,
+        tiers,
     )
 
 

@@ -13,7 +13,7 @@ import math
 from typing import Any, ClassVar
 
 from uavtool.camera import Intrinsics
-from uavtool.mission.analysis import target_shapes
+from uavtool.mission.analysis import stepped, target_shapes
 from uavtool.mission.base import Envelope, FlightMission, MissionInputs, Wait
 from uavtool.mission.errors import MissionInputError
 from uavtool.mission.outputs import (
@@ -61,6 +61,9 @@ class SearchMission(FlightMission):
         self.matched_poi = -1
         self.match_score = 0.0
         self.model_built = False
+        self.target_stepped = stepped(inputs.target_rgb, self.target)
+        """Whether the target picture shows parts at several heights (then a match's outline
+        is not compared with it: `uavtool.mission.analysis.judge`)."""
         self.target_openings = enclosed_openings(
             inputs.target_rgb, self.target, least_px=params.vectorize.min_hole_area_px
         )

@@ -48,6 +48,9 @@ class Found:
     could be, else the point of interest's."""
     roof_measured: bool = False
     """Whether ``roof_m`` was measured (else it is the height assumed)."""
+    outline_compared: bool = True
+    """Whether the match's outline was compared with the target's (not when either shows
+    parts at several heights: `Judgement.stepped`)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -100,6 +103,7 @@ def search(
     p = m.params.mission
     best: Found | None = None
     best_score, best_poi = 0.0, -1
+    matches: list[Found] = []  # every building that matched, in turn
     ceiling_m = overview.pose.pos_enu_m[2]
     todo = list(order)
     while todo:
@@ -187,14 +191,19 @@ def search(
                 j.score,
                 poi.roof_m if roof is None else roof,
                 roof is not None or poi.roof_measured,
+                not j.stepped,
             )
+            matches.append(best)
             if not p.visit_all:
                 todo = _rivals(m, pois, todo, k)
+        elif j.matched:  # a match that does not beat the best: still a rival's evidence
+            matches.append(Found(poi, look.photo, look.shapes[j.candidate], j.score, poi.roof_m))
     if best is None:
         where = f" at point of interest {best_poi}" if best_poi >= 0 else ""
         raise m.end(
             Status.NO_MATCH, f"no building matched the target (best score {best_score:.3f}{where})"
         )
+    _unambiguous(m, best, matches)
     m.event(
         Level.INFO,
         f"target is point of interest {best.poi.index} (score {best.score:.3f}), "
@@ -203,13 +212,48 @@ def search(
     return best
 
 
+def _unambiguous(m: SearchMission, best: Found, matches: list[Found]) -> None:
+    """End the mission with NO_MATCH when another building matched as well and nothing tells
+    them apart: each lies on the target's outline as closely as its photos can tell (or,
+    showing parts at several heights, was not compared), and both show as many courtyards
+    as the target picture. Either may then be the target — a building that is *almost* the
+    target (a corner cut, an arm shorter) scores like it by its corners, sometimes higher —
+    and naming one would be a guess."""
+    holes = len(m.target.holes_px)
+    others = [
+        f
+        for f in matches
+        if f.poi.index != best.poi.index
+        and not _on_roof(best, f.photo, f.shape)
+        # a courtyard more or less than the target picture shows tells it apart
+        and not (len(f.shape.holes_px) != holes and len(best.shape.holes_px) == holes)
+    ]
+    if others:
+        rival = max(others, key=lambda f: f.score)
+        why = (
+            "their outlines lie on the target's as closely as these photos tell"
+            if best.outline_compared and rival.outline_compared
+            else "they show parts at several heights, so their outlines cannot be compared"
+        )
+        raise m.end(
+            Status.NO_MATCH,
+            f"points of interest {best.poi.index} and {rival.poi.index} both match the "
+            f"target (scores {best.score:.3f} and {rival.score:.3f}) and {why}: which is "
+            "the target is not known",
+        )
+
+
 def _shows_again(best: Found, look: _Look) -> bool:
     """Whether a look's matched candidate is the building already matched (``best``): its
     centre, on the matched roof's plane, lies on that roof. A look aimed at a rival of the
     target's hue (walls whose roof the overview did not show) may find the matched
     building nearer its centre; that is no new evidence."""
-    shape = look.shapes[look.judgement.candidate]
-    photo = look.photo
+    return _on_roof(best, look.photo, look.shapes[look.judgement.candidate])
+
+
+def _on_roof(best: Found, photo: Photo, shape: Shape) -> bool:
+    """Whether ``shape``'s centre (in ``photo``), on the matched roof's plane, lies on that
+    roof."""
     plane_m = min(best.roof_m, best.photo.pose.pos_enu_m[2] - 1.0, photo.pose.pos_enu_m[2] - 1.0)
     try:
         ring = ground_polygon(
@@ -310,7 +354,14 @@ def _look(
     photo, judged and reported."""
     photo = yield from m.photo(f"poi-{k}" if n == 1 else f"poi-{k}-{n}", -90.0)
     shapes = photo_shapes(m, photo)
-    j = judge(m.params, m.target, shapes, photo.intrinsics, aimed_rgb)
+    j = judge(
+        m.params,
+        m.target,
+        shapes,
+        photo.intrinsics,
+        aimed_rgb,
+        target_stepped=m.target_stepped,
+    )
     m.emit(
         Recognition(photo.frame_index, k, j.scores, j.candidate, j.score, j.matched, j.mirror_score)
     )
@@ -319,6 +370,8 @@ def _look(
         why = "; outline cut by the image border, not judged"
     elif not j.not_mirror and j.score >= m.params.recognize.threshold:
         why = f"; as much like the target's mirror image: {j.mirror_score:.3f}"
+    elif j.stepped:
+        why = "; parts at several heights: outline not compared"
     elif j.outline_tolerance > 0.0:
         fits = "within" if j.outline_fits else "beyond"
         why = (

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from uavtool.mission import Params, Photo, SearchMission
-from uavtool.mission.analysis import judge, nadir_shapes, side_shapes, target_shapes
+from uavtool.mission.analysis import judge, nadir_shapes, side_shapes, stepped, target_shapes
 from uavtool.replay.load import RecordedFlight
 
 _SIDE_TAGS = ("front", "right", "diagonal")
@@ -71,6 +71,7 @@ def reanalyse_frames(flight: RecordedFlight, params: Params) -> list[FrameChange
                 r, g, b = poi["colour_rgb"]
                 poi_colours[int(poi["index"])] = (int(r), int(g), int(b))
     _, target = target_shapes(params, flight.target_rgb)
+    target_stepped = stepped(flight.target_rgb, target)
     changes = []
     for obs in flight.observations:
         if not isinstance(obs, Photo):
@@ -82,7 +83,14 @@ def reanalyse_frames(flight: RecordedFlight, params: Params) -> list[FrameChange
         kind, *numbers = obs.tag.split("-")
         if kind == "poi" and numbers and all(n.isdigit() for n in numbers):
             aimed = poi_colours.get(int(numbers[0]))
-            j = judge(params, target, shapes, obs.intrinsics, aimed)
+            j = judge(
+                params,
+                target,
+                shapes,
+                obs.intrinsics,
+                aimed,
+                target_stepped=target_stepped,
+            )
             score_after, matched_after = j.score, j.matched
             best_after = max(j.scores, default=None)
             before = recorded_judgement.get(obs.frame_index)

@@ -16,7 +16,14 @@ from typing import Any
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.images import png_decode
 from uavtool.mission import Params
-from uavtool.mission.analysis import Judgement, judge, nadir_shapes, side_shapes, target_shapes
+from uavtool.mission.analysis import (
+    Judgement,
+    judge,
+    nadir_shapes,
+    side_shapes,
+    stepped,
+    target_shapes,
+)
 from uavtool.mission.codec import decode_camera, encode_output
 from uavtool.mission.outputs import Recognition, Shapes
 from uavtool.mission.params import to_dict
@@ -91,6 +98,7 @@ def analyse_photos(path: str | Path, target_png: bytes, params: Params) -> Photo
     path = Path(path)
     target_rgb = png_decode(target_png, where="--target")
     shapes_t, target = target_shapes(params, target_rgb)
+    target_stepped = stepped(target_rgb, target)
     frames = _frames(path)
     photos = [(rec, png, t) for rec, png, t in frames if int(rec.get("photo", -1)) >= 0]
     chosen = photos or frames
@@ -108,7 +116,7 @@ def analyse_photos(path: str | Path, target_png: bytes, params: Params) -> Photo
                 pose,
                 t_ns,
                 shapes,
-                judge(params, target, shapes, intrinsics),
+                judge(params, target, shapes, intrinsics, target_stepped=target_stepped),
             )
         )
     return PhotoAnalysis(tuple(results), shapes_t, all_frames=not photos)

@@ -11,11 +11,10 @@ measured (the symmetric Hausdorff distance).
 
 How far apart two outlines of the *same* footprint may lie follows from how exactly each was
 drawn: a vectorized outline lies within `outline_accuracy_px` of the true one in its own
-photo's pixels (the pixel grid's half pixel, the denoising that moves a boundary, the
-simplification's tolerance). At unit area, a photo whose shape covers ``A`` square pixels
-draws it to ``accuracy / sqrt(A)``: the tolerance is the two photos' sum. Two footprints that
-differ by less than that cannot be told apart in these photos — a closer look can; never a
-lower bar.
+photo's pixels (the pixel grid's half pixel and the simplification's tolerance). At unit
+area, a photo whose shape covers ``A`` square pixels draws it to ``accuracy / sqrt(A)``: the
+tolerance is the two photos' sum. Two footprints that differ by less than that cannot be
+told apart in these photos — a closer look can; never a lower bar.
 """
 
 from __future__ import annotations
@@ -36,10 +35,16 @@ _DENSIFY = 0.02  # Hausdorff's densification: segments split into 2 % pieces
 
 
 def outline_accuracy_px(params: VectorizeParams) -> float:
-    """How far (pixels) a vectorized outline may lie from the true one: half a pixel of
-    grid, half the denoising kernel (its opening and closing move a boundary by up to that
-    much), and the simplification's tolerance."""
-    return 0.5 + params.denoise_px / 2.0 + params.rdp_epsilon_px
+    """How far (pixels) a vectorized outline may lie from the true one, its size and turn
+    aside: half a pixel of grid and the simplification's tolerance. The denoising's median
+    rounds corners, but each corner is then put where its two edges' lines meet
+    (``refine_corners``), so it moves no vertex. Measured (`benchmarks/bench_near_shapes.py
+    --accuracy`: 3,000 rectangles, L, T and U shapes at any turn, σ 3 DN of noise, put on
+    the true outline at unit area), a vectorized outline lies a median 0.8 px from the true
+    one; this bound, 2 px with the default parameters, holds for 98.8 % of outlines and for
+    99 % of those 100-400 px across (99th percentile 1.6 px). Under 100 px across, edges
+    shorter than ``min_edge_px`` are lost and 1 outline in 50 lies further."""
+    return 0.5 + params.rdp_epsilon_px
 
 
 def outline_tolerance(
