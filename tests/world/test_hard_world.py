@@ -185,3 +185,10 @@ def test_sweeps_take_the_knobs_as_generator_options() -> None:
     options = tuple(sorted(dict.fromkeys(WORLD_KNOBS, True).items()))
     source = SceneSource(SceneKind.HARD, seeds=(4,), options=options)
     assert load_source_scene(source, 4) == generate_hard_scene(seed=4, options=WORLD)
+
+
+def test_the_grounds_hue_gap_is_the_vectorizers_hue_window() -> None:
+    from uavtool.vision.params import VectorizeParams
+    from uavtool.world.hard_world import GROUND_HUE_GAP_DEG
+
+    assert VectorizeParams().hue_tolerance_deg == GROUND_HUE_GAP_DEG

@@ -104,7 +104,7 @@ def draw_world(
             sun_elevation_deg=round(uniform(rng, 5.0, 90.0), 1),
             ambient=round(uniform(rng, 0.15, 0.8), 2),
         )
-    tolerance_deg = _hue_tolerance_deg() if (o.any_ground or o.ground_areas) else 0.0
+    tolerance_deg = GROUND_HUE_GAP_DEG if (o.any_ground or o.ground_areas) else 0.0
     if o.any_ground:
         ground = _fair(rng, _ground_colour, target_rgb, roofs, tolerance_deg)
     if o.ground_areas:
@@ -136,11 +136,11 @@ def draw_world(
     return World(lighting, ground, areas, texture, tuple(near), tuple(classes))
 
 
-def _hue_tolerance_deg() -> float:
-    """The vectorizer's hue window: read, not copied (imported only when a knob needs it)."""
-    from uavtool.vision.params import VectorizeParams  # noqa: PLC0415
-
-    return float(VectorizeParams().hue_tolerance_deg)
+GROUND_HUE_GAP_DEG = 12.0
+"""How far (degrees of hue) a drawn ground stays from the target's colour: the vectorizer's
+default hue window (`uavtool.vision.VectorizeParams.hue_tolerance_deg`; a test keeps the two
+equal), so the ground is never of the target's colour to the vision — a different, unfair
+problem. A constant here, not an import: the world does not depend on the vision."""
 
 
 # --------------------------------------------------------------------------- colours
