@@ -49,8 +49,8 @@ class Found:
     roof_measured: bool = False
     """Whether ``roof_m`` was measured (else it is the height assumed)."""
     outline_compared: bool = True
-    """Whether the match's outline was compared with the target's (not when either shows
-    parts at several heights: `Judgement.stepped`)."""
+    """Whether the match's outline was compared with the target's (not when the target
+    picture shows parts at several heights: `Judgement.stepped`)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -197,13 +197,29 @@ def search(
             if not p.visit_all:
                 todo = _rivals(m, pois, todo, k)
         elif j.matched:  # a match that does not beat the best: still a rival's evidence
-            matches.append(Found(poi, look.photo, look.shapes[j.candidate], j.score, poi.roof_m))
+            shape = look.shapes[j.candidate]
+            # its roof as the overview and the look tell it (no flight for it): a closer look
+            # may then descend toward it
+            roof = roof_between(overview_shapes[poi.shape_index], overview, shape, look.photo)
+            if roof is not None and roof > p.assumed_roof_m:
+                roof = None
+            matches.append(
+                Found(
+                    poi,
+                    look.photo,
+                    shape,
+                    j.score,
+                    poi.roof_m if roof is None else roof,
+                    roof is not None or poi.roof_measured,
+                    not j.stepped,
+                )
+            )
     if best is None:
         where = f" at point of interest {best_poi}" if best_poi >= 0 else ""
         raise m.end(
             Status.NO_MATCH, f"no building matched the target (best score {best_score:.3f}{where})"
         )
-    _unambiguous(m, best, matches)
+    best = yield from _settle(m, best, matches)
     m.event(
         Level.INFO,
         f"target is point of interest {best.poi.index} (score {best.score:.3f}), "
@@ -212,15 +228,60 @@ def search(
     return best
 
 
-def _unambiguous(m: SearchMission, best: Found, matches: list[Found]) -> None:
-    """End the mission with NO_MATCH when another building matched as well and nothing tells
-    them apart: each lies on the target's outline as closely as its photos can tell (or,
-    showing parts at several heights, was not compared), and both show as many courtyards
-    as the target picture. Either may then be the target — a building that is *almost* the
-    target (a corner cut, an arm shorter) scores like it by its corners, sometimes higher —
-    and naming one would be a guess."""
+def _settle(m: SearchMission, best: Found, matches: list[Found]) -> Wait[Found]:
+    """The target among the buildings that matched: ``best`` when no other did, or when a
+    closer look at each tells them apart. Two buildings both match when each lies on the
+    target's outline as closely as its photos can tell (or the target picture, showing parts
+    at several heights, was not compared), and both show as many courtyards as the target
+    picture: a building *almost* the target (a corner cut, an arm shorter) scores like it by
+    its corners, sometimes higher. A closer look shrinks its photo's part of the tolerance:
+    each is looked at again from where it fills ``mission.top_fill`` of the photo (its roof
+    measured, so the descent is safe), and one whose outline then lies off the target's is
+    out. When more than one is left, the mission ends NO_MATCH naming two of them: naming one
+    would be a guess."""
+    left = [best, *_rivals_of(m, best, matches)]
+    if len(left) == 1:
+        return best
+    if all(f.outline_compared for f in left):
+        closer = []
+        for f in left:
+            j = yield from _look_closer(m, f, left)
+            if j is None or j.matched:
+                closer.append(f)
+            else:
+                m.event(
+                    Level.INFO,
+                    f"point of interest {f.poi.index}: from closer, its outline lies off the "
+                    "target's: not the target",
+                )
+        left = closer
+    if len(left) == 1:
+        return left[0]
+    if not left:
+        raise m.end(
+            Status.NO_MATCH,
+            "every building that matched lies off the target's outline from closer",
+        )
+    first, rival = sorted(left, key=lambda f: -f.score)[:2]
+    why = (
+        "their outlines lie on the target's as closely as these photos tell"
+        if first.outline_compared and rival.outline_compared
+        else "they show parts at several heights, so their outlines cannot be compared"
+    )
+    raise m.end(
+        Status.NO_MATCH,
+        f"points of interest {first.poi.index} and {rival.poi.index} both match the "
+        f"target (scores {first.score:.3f} and {rival.score:.3f}) and {why}: which is "
+        "the target is not known",
+    )
+
+
+def _rivals_of(m: SearchMission, best: Found, matches: list[Found]) -> list[Found]:
+    """The other buildings that matched and nothing yet tells from ``best``: not ``best``'s
+    own roof seen again, and showing as many courtyards as the target picture if ``best``
+    does."""
     holes = len(m.target.holes_px)
-    others = [
+    return [
         f
         for f in matches
         if f.poi.index != best.poi.index
@@ -228,19 +289,35 @@ def _unambiguous(m: SearchMission, best: Found, matches: list[Found]) -> None:
         # a courtyard more or less than the target picture shows tells it apart
         and not (len(f.shape.holes_px) != holes and len(best.shape.holes_px) == holes)
     ]
-    if others:
-        rival = max(others, key=lambda f: f.score)
-        why = (
-            "their outlines lie on the target's as closely as these photos tell"
-            if best.outline_compared and rival.outline_compared
-            else "they show parts at several heights, so their outlines cannot be compared"
-        )
-        raise m.end(
-            Status.NO_MATCH,
-            f"points of interest {best.poi.index} and {rival.poi.index} both match the "
-            f"target (scores {best.score:.3f} and {rival.score:.3f}) and {why}: which is "
-            "the target is not known",
-        )
+
+
+def _look_closer(m: SearchMission, f: Found, left: list[Found]) -> Wait[Judgement | None]:
+    """A look at ``f``'s building from where it fills ``mission.top_fill`` of the photo, and
+    its judgement; None when its roof is not measured (no descent toward a roof of unknown
+    height) or that is not clearly closer than the look that matched."""
+    p = m.params.mission
+    poi, photo = f.poi, f.photo
+    if not f.roof_measured:
+        return None
+    k = photo.intrinsics
+    alt_was = photo.pose.pos_enu_m[2]
+    plane = min(f.roof_m, alt_was - 1.0)
+    try:
+        ring = ground_polygon(f.shape.polygon_px, photo.pose, k, plane_z_m=plane)
+        x, y = ground_point(*f.shape.centroid_px, photo.pose, k, plane_z_m=plane)
+    except NavError:
+        return None
+    extent = math.dist(*_farthest_pair(ring))
+    fit = fit_altitude_m(roof_m=f.roof_m, extent_m=extent, intrinsics=k, fill=p.top_fill)
+    alt = max(fit, f.roof_m + p.min_above_roof_m, m.floor_at(x, y))
+    if alt > alt_was - p.recheck_climb_m / 2.0:
+        return None
+    others = ", ".join(str(o.poi.index) for o in left if o is not f)
+    yield from _shift(
+        m, (x, y, alt), f"point of interest {poi.index}: closer, to tell it from {others}"
+    )
+    look = yield from _look(m, poi.index, p.max_looks + 1, alt, poi.colour_rgb)
+    return look.judgement
 
 
 def _shows_again(best: Found, look: _Look) -> bool:
