@@ -52,7 +52,7 @@ import time
 from io import BytesIO
 from pathlib import Path
 
-from uavtool.recording.process import core_to_spare
+from uavtool.recording.cores import core_to_spare
 from uavtool.runner.fly import FlyConfig, fly
 
 ROOT = Path(__file__).resolve().parents[1]

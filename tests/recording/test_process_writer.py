@@ -29,7 +29,9 @@ from uavtool.recording import (
     RecordingWriter,
     RgbImage,
     TriangleMesh,
+    cores,
     process,
+    process_child,
     summarize,
 )
 from uavtool.recording.process import BATCH_NS
@@ -246,10 +248,10 @@ def test_the_child_drains_the_pipe_while_its_writer_is_busy(
     """Batches are read ahead of the writer, up to `BACKLOG_BYTES`: a photo the child is
     compressing does not keep the flight waiting on a full pipe, and a flight that outruns
     the writer by more does wait."""
-    monkeypatch.setattr(process, "BACKLOG_BYTES", 4 << 20)
+    monkeypatch.setattr(process_child, "BACKLOG_BYTES", 4 << 20)
     read, write = os.pipe()
     try:
-        backlog = process._Backlog(read)
+        backlog = process_child._Backlog(read)
         photo = bytes(range(256)) * 4096  # 1 MiB, as big as the pipe
         sent: list[int] = []
 
@@ -304,16 +306,16 @@ def test_a_writer_process_is_chosen_when_other_processes_leave_a_core(
     monkeypatch.setattr(os, "cpu_count", lambda: 2)
     monkeypatch.setattr(os, "getloadavg", lambda: (load, load, load))
     mine_s = 0.9 * span_s  # this process: busy most of the window (its start-up)
-    monkeypatch.setattr(process, "_last_sample", (100.0, 50.0, 3.0))
+    monkeypatch.setattr(cores, "_last_sample", (100.0, 50.0, 3.0))
     now = (100.0 + span_s, 50.0 + mine_s + others_busy_cores * span_s, 3.0 + mine_s)
-    monkeypatch.setattr(process, "_cpu_sample", lambda: now)
-    assert process.core_to_spare() is spare
-    assert process._last_sample == now  # the next call measures from here
+    monkeypatch.setattr(cores, "_cpu_sample", lambda: now)
+    assert cores.core_to_spare() is spare
+    assert cores._last_sample == now  # the next call measures from here
 
 
 def test_one_core_never_gets_a_writer_process(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(os, "sched_getaffinity", lambda _pid: {0})
-    assert process.core_to_spare() is False
+    assert cores.core_to_spare() is False
 
 
 def test_the_flight_knows_every_value_the_writer_encodes() -> None:

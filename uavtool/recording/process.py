@@ -25,10 +25,10 @@ What is kept:
   last and when to close.
 - **Back pressure.** The child reads the pipe in a thread of its own, so a photo it is
   compressing never keeps the flight waiting on a full pipe (it did: ~60 ms a flight); what
-  it has read and not yet written is held to `BACKLOG_BYTES`, and a flight that outruns its
-  writer by more waits for it. That thread looks at the pipe every millisecond or so
-  (`POLL_S`) instead of waiting in ``read``: a waiting reader is woken by every batch, at
-  the flight's cost.
+  it has read and not yet written is held to `process_child.BACKLOG_BYTES`, and a flight
+  that outruns its writer by more waits for it. That thread looks at the pipe every
+  millisecond or so (`process_child.POLL_S`) instead of waiting in ``read``: a waiting
+  reader is woken by every batch, at the flight's cost.
 
 The child is a fresh interpreter (`subprocess`, never a fork: the flight may run threads,
 and in a Dask worker it is a daemon) with the parent's ``sys.path``; it imports the writer,
@@ -44,12 +44,10 @@ import fcntl
 import json
 import os
 import pickle
-import queue
 import struct
 import subprocess
 import sys
 import threading
-import time
 import weakref
 from array import array
 from collections.abc import Callable, Mapping
@@ -58,7 +56,7 @@ from types import TracebackType
 from typing import TYPE_CHECKING, Any, BinaryIO, NoReturn
 
 from uavtool.recording.errors import RecordingError, create_file
-from uavtool.recording.protocol import check_metadata, check_topic, foxglove_module
+from uavtool.recording.protocol import check_metadata, check_topic
 from uavtool.recording.schemas import DEFAULT_DIALECT, dialect_module, dumps
 from uavtool.recording.topics import FIX, POSE
 from uavtool.recording.values import (
@@ -67,7 +65,6 @@ from uavtool.recording.values import (
     Direction,
     LocationFix,
     PosesInFrame,
-    RgbImage,
 )
 
 if TYPE_CHECKING:
@@ -81,15 +78,6 @@ sends ~230 batches, not ~900 as it would every quarter second."""
 BATCH_CALLS = 2048
 """Calls a batch may hold before it is sent."""
 PIPE_BYTES = 1 << 20
-BACKLOG_BYTES = 64 << 20
-"""Batches the child may hold read but not yet written: a flight that outruns its writer by
-more waits at the pipe."""
-POLL_S = (0.001, 0.02)
-"""How long the child's reader sleeps when the pipe is empty: from the shortest, doubling
-while it stays empty, to the longest. A reader asleep in ``read`` would be woken by each
-batch, and the flight's process pays for the waking (~20 us a batch in a virtual machine);
-a reader that looks every millisecond costs it nothing, and a few hundred wake-ups a second
-of its own on the other core. The longest is what a flush or a close may wait more."""
 _HEADER = struct.Struct("<QI")  # each value on the pipe: its pickle's size, its buffers' count
 
 # the calls, as the first item of each tuple in a batch (most frequent first)
@@ -116,60 +104,8 @@ _Batch = tuple[list[tuple[Any, ...]], "array[int]", bytes, "array[int]", bytes, 
 before each, then the frames: their bytes joined, their sizes, directions and times."""
 _CHILD = (
     "import sys, json; sys.path[:] = json.loads(sys.argv[1]); "
-    "from uavtool.recording.process import serve; serve()"
+    "from uavtool.recording.process_child import serve; serve()"
 )
-
-
-def _cpu_sample() -> tuple[float, float, float] | None:
-    """(now, seconds of CPU the whole machine spent busy, seconds this process spent) from
-    ``/proc/stat``, or None where there is none."""
-    try:
-        with Path("/proc/stat").open("rb") as stat:
-            fields = stat.readline().split()
-        ticks = [int(v) for v in fields[1:9]]  # user nice system idle iowait irq softirq steal
-    except (OSError, ValueError):
-        return None
-    if fields[:1] != [b"cpu"] or len(ticks) < 5:
-        return None
-    busy_s = (sum(ticks) - ticks[3] - ticks[4]) / os.sysconf("SC_CLK_TCK")
-    mine = os.times()
-    return time.monotonic(), busy_s, mine.user + mine.system
-
-
-_last_sample = _cpu_sample()  # from this module's import: what the machine did meanwhile
-SAMPLE_S = (0.05, 10.0)
-"""The window `core_to_spare` measures the machine over: from its last call (or this
-module's import, early in a command's start-up) to now, when that is this many seconds;
-else the load average decides."""
-
-
-def core_to_spare() -> bool:
-    """Whether a writer process would find a core of its own: at least two cores for this
-    process, and other processes busy for less than the cores less one and a half (the
-    flight takes one; half a core is left for the writer) since the last call or this
-    module's import, 0.05-10 s ago; without that measure, a load average of the last minute
-    below the cores less one half. A load average lags a minute: after a burst of commands
-    it still counts those that ended. Without a spare core a writer process only adds its
-    work to a busy machine, and the flight waits for it at the end."""
-    global _last_sample  # noqa: PLW0603 - the window runs from call to call
-    try:
-        cores = len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):
-        return False
-    if cores < 2:
-        return False
-    before, now = _last_sample, _cpu_sample()
-    _last_sample = now
-    if before is not None and now is not None:
-        span_s = now[0] - before[0]
-        if SAMPLE_S[0] <= span_s <= SAMPLE_S[1]:
-            others = ((now[1] - before[1]) - (now[2] - before[2])) / span_s  # cores, busy
-            return others < (os.cpu_count() or cores) - 1.5
-    try:
-        load = os.getloadavg()[0]
-    except (AttributeError, OSError):
-        return False
-    return load < cores - 0.5
 
 
 def _check_time(t: Any, what: str = "log_time_ns") -> None:
@@ -573,38 +509,6 @@ def _framed(value: Any) -> list[bytes | memoryview]:
     return [_HEADER.pack(len(data), len(raws)) + sizes, data, *raws]
 
 
-def _read_framed(fd: int) -> tuple[Any, int]:
-    """One framed value from the pipe ``fd``, and its size; `EOFError` at the pipe's end
-    (or a frame cut short). Plain reads: no buffered stream's lock for a daemon thread to
-    hold when the interpreter ends."""
-    size, count = _HEADER.unpack(_read_exactly(fd, _HEADER.size))
-    sizes = struct.unpack(f"<{count}Q", _read_exactly(fd, 8 * count))
-    data = _read_exactly(fd, size)
-    buffers = [_read_exactly(fd, n) for n in sizes]
-    return pickle.loads(data, buffers=buffers), size + sum(sizes)
-
-
-def _read_exactly(fd: int, size: int) -> bytearray:
-    """``size`` bytes from ``fd``; on a non-blocking ``fd``, sleeping `POLL_S` between
-    looks while it is empty."""
-    data = bytearray(size)
-    view = memoryview(data)
-    done = 0
-    pause = POLL_S[0]
-    while done < size:
-        try:
-            n = os.readv(fd, [view[done:]])
-        except BlockingIOError:
-            time.sleep(pause)
-            pause = min(2 * pause, POLL_S[1])
-            continue
-        if n == 0:
-            raise EOFError
-        done += n
-        pause = POLL_S[0]
-    return data
-
-
 def _spawn(file: BinaryIO) -> subprocess.Popen[bytes]:
     try:
         proc = subprocess.Popen(
@@ -632,183 +536,3 @@ def _abandon(proc: subprocess.Popen[bytes]) -> None:
             with contextlib.suppress(OSError):
                 stream.close()
     proc.wait()
-
-
-# --- the child ----------------------------------------------------------------------------------
-
-
-def serve() -> None:
-    """The child's loop: an init tuple, then batches of calls on stdin; replies on stdout."""
-    replies = os.fdopen(os.dup(1), "wb", buffering=0)
-    sys.stdout = sys.stderr  # stdout carries replies only
-    source = sys.stdin.fileno()
-
-    def reply(*answer: Any) -> None:
-        replies.write(pickle.dumps(answer, protocol=pickle.HIGHEST_PROTOCOL))
-
-    (path, fd, metadata, dialect, interval_ns, budget, fsync), _ = _read_framed(source)
-    batches = _Backlog(source)  # the pipe drained from now on, while the writer is imported
-    try:
-        # the MCAP writer, imported here: the flight's process, which imports this module
-        # too, never needs it
-        from uavtool.recording.writer import RecordingWriter  # noqa: PLC0415
-
-        writer = RecordingWriter(
-            path,
-            metadata=metadata,
-            dialect=dialect,
-            chunk_interval_ns=interval_ns,
-            chunk_bytes=budget,
-            fsync=fsync,
-            file=os.fdopen(fd, "wb"),
-        )
-        _serve(writer, batches, reply)
-    except RecordingError as exc:
-        reply("error", exc.path, exc.problem)
-    except Exception as exc:  # whatever it is, the flight must hear of it
-        reply("error", path, f"the recording's writer failed: {type(exc).__name__}: {exc}")
-    else:
-        # the file is closed (or, the flight gone, its chunks flushed) and the reply sent: an
-        # interpreter's orderly exit would keep the flight waiting ~50 ms more at its close
-        os._exit(0)
-
-
-class _Backlog:
-    """Batches read from the pipe by a thread of the child's own, for its main thread to
-    write: the pipe is drained while a photo is compressed (zlib and zstd let go of the
-    GIL). At most `BACKLOG_BYTES` are held; `None` marks the pipe's end."""
-
-    def __init__(self, source: int) -> None:
-        self._source = source
-        self._batches: queue.SimpleQueue[tuple[_Batch, int] | None] = queue.SimpleQueue()
-        self._room = threading.Semaphore(BACKLOG_BYTES >> 16)  # in 64 KiB units
-        threading.Thread(target=self._read, name="uavtool-recording-reader", daemon=True).start()
-
-    def _read(self) -> None:
-        os.set_blocking(self._source, False)  # looked at, not waited on: `POLL_S`
-        while True:
-            try:
-                batch, size = _read_framed(self._source)
-            except (EOFError, pickle.UnpicklingError, OSError):
-                self._batches.put(None)
-                return
-            units = min(BACKLOG_BYTES, size) >> 16
-            for _ in range(units):
-                self._room.acquire()
-            self._batches.put((batch, units))
-
-    def next(self) -> _Batch | None:
-        """The next batch, or `None` at the pipe's end."""
-        item = self._batches.get()
-        if item is None:
-            return None
-        batch, units = item
-        if units:
-            self._room.release(units)
-        return batch
-
-
-class _Frames:
-    """A batch's MAVLink frames, in its columns, written in turn between its other calls."""
-
-    def __init__(
-        self, data: bytes, lengths: array[int], ops: bytes, times: array[int], write: Any
-    ) -> None:
-        self._data, self._lengths, self._ops, self._times = data, lengths, ops, times
-        self._write = write
-        self._next = self._offset = 0  # the next frame, and where it starts in data
-
-    def write_to(self, stop: int) -> None:
-        """Write the frames up to (not including) frame ``stop``."""
-        data, lengths, ops, times, write = (
-            self._data,
-            self._lengths,
-            self._ops,
-            self._times,
-            self._write,
-        )
-        inbound, outbound = Direction.IN, Direction.OUT
-        frame, offset = self._next, self._offset
-        while frame < stop:
-            end = offset + lengths[frame]
-            direction = inbound if ops[frame] == _MAV_IN else outbound
-            write(data[offset:end], direction=direction, log_time_ns=times[frame])
-            frame, offset = frame + 1, end
-        self._next, self._offset = frame, offset
-
-
-def _serve(writer: Any, source: _Backlog, reply: Any) -> None:
-    protobuf: dict[str, tuple[str, bytes]] = {}  # topic -> (schema name, schema)
-    write_mavlink, write_json, write_protobuf = (
-        writer.write_mavlink,
-        writer.write_json_bytes,
-        writer.write_protobuf,
-    )
-    inbound, outbound = Direction.IN, Direction.OUT
-    origin = None  # write_vehicle's, as the flight's last _ORIGIN set it
-    while True:
-        batch = source.next()
-        if batch is None:
-            # the flight's process ended without closing: keep what it sent, leave the file
-            # unfinished (uavtool info --recover reads it)
-            writer.flush()
-            return
-        calls, at, data, lengths, ops, times_bytes = batch
-        times = array("Q")
-        times.frombytes(times_bytes)
-        frames = _Frames(data, lengths, ops, times, write_mavlink)
-        for call, before in zip(calls, at, strict=True):
-            frames.write_to(before)
-            op = call[0]
-            if op <= _MAV_PUBLISHED_OUT:  # _MAV_PUBLISHED_IN or _MAV_PUBLISHED_OUT
-                direction = inbound if op == _MAV_PUBLISHED_IN else outbound
-                write_mavlink(
-                    call[1], direction=direction, log_time_ns=call[2], publish_time_ns=call[3]
-                )
-            elif op == _VEHICLE:
-                writer.write_vehicle(call[1], call[2], origin, log_time_ns=call[3])
-            elif op == _ORIGIN:
-                origin = call[1]
-            elif op == _ENCODE_RAW:
-                data, fmt, frame_id, height, width = call[2]
-                image = CompressedImage(
-                    data, fmt, frame_id, RgbImage(bytes(call[3]), height, width)
-                )
-                name, schema = protobuf[call[1]]
-                write_protobuf(
-                    call[1],
-                    foxglove_module().encode(image, call[4]),
-                    schema_name=name,
-                    schema=schema,
-                    log_time_ns=call[4],
-                    publish_time_ns=call[5],
-                )
-            elif op == _ENCODE:
-                name, schema = protobuf[call[1]]
-                write_protobuf(
-                    call[1],
-                    foxglove_module().encode(call[2], call[3]),
-                    schema_name=name,
-                    schema=schema,
-                    log_time_ns=call[3],
-                    publish_time_ns=call[4],
-                )
-            elif op == _JSON_FORMAT:
-                write_json(call[1], (call[2] % call[3]).encode(), log_time_ns=call[4])
-            elif op == _JSON:
-                write_json(call[1], call[2], log_time_ns=call[3], publish_time_ns=call[4])
-            elif op == _PROTO_TOPIC:
-                foxglove = foxglove_module()
-                protobuf[call[1]] = (foxglove.schema_name(call[2]), foxglove.schema_data(call[2]))
-            elif op == _JSON_TOPIC:
-                writer.add_json_topic(call[1], schema_name=call[2], schema=call[3])
-            elif op == _METADATA:
-                writer.add_metadata(call[1], call[2])
-            elif op == _FLUSH:
-                writer.flush()
-                reply("flushed")
-            elif op == _CLOSE:
-                writer.close()
-                reply("closed", writer.message_count)
-                return
-        frames.write_to(len(lengths))

@@ -31,9 +31,10 @@ from uavtool.mission import Level, MissionInputs, Outcome, SearchMission
 from uavtool.mission.outputs import Result
 from uavtool.mission.params import to_dict, with_overrides
 from uavtool.plugins import DEFAULT, MissionRef, create_mission, resolve
+from uavtool.recording.cores import core_to_spare
 from uavtool.recording.errors import RecordingError
 from uavtool.recording.files import atomic_output
-from uavtool.recording.process import ProcessWriter, core_to_spare
+from uavtool.recording.process import ProcessWriter
 from uavtool.runner.backends import open_backend
 from uavtool.runner.camera import open_camera
 from uavtool.runner.evaluate import Evaluation, evaluate
