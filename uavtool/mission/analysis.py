@@ -54,8 +54,9 @@ class Judgement:
     """A nadir photo at a point of interest compared with the target: ``scores`` per shape,
     ``candidate`` the shape the photo is centred on (−1 none), its ``score``, and whether it
     is a match: judgeable, shape score at the threshold, a hue close to the target's (if
-    asked), and more like the target than like the target's mirror image (the mirror rule,
-    :class:`uavtool.vision.RecognizeParams`)."""
+    asked), as many courtyards (holes) as the target, more like the target than like the
+    target's mirror image (the mirror rule, :class:`uavtool.vision.RecognizeParams`), and its
+    outline on the target's (`uavtool.vision.verify`)."""
 
     scores: tuple[float, ...]
     candidate: int
@@ -139,7 +140,10 @@ def judge(
     mirrored = mirror_score(target, centre, rp)
     gap = 1.0 - mirror_score(target, target, rp)  # how unlike its mirror image the target is
     not_mirror = score - mirrored >= rp.mirror_margin * gap - rp.mirror_tolerance
-    matched = judgeable and same_hue and not_mirror and score >= rp.threshold
+    # courtyards are part of the footprint: one more or fewer than the target picture shows
+    # is another building, however well the outer outlines agree
+    same_holes = len(centre.holes_px) == len(target.holes_px)
+    matched = judgeable and same_hue and not_mirror and same_holes and score >= rp.threshold
     outline, tolerance, tiers = 0.0, 0.0, False
     if matched:
         # the corners agree; the outline must also lie on the target's: a near shape (a
