@@ -184,15 +184,7 @@ def search(
             roof = roof_between(seen, overview, shape, look.photo)
             if roof is None or roof > p.assumed_roof_m:  # beyond the tallest expected: a
                 roof = yield from _measure_from_another_altitude(m, k, poi, look, shape)  # mismatch
-            best = Found(
-                poi,
-                look.photo,
-                shape,
-                j.score,
-                poi.roof_m if roof is None else roof,
-                roof is not None or poi.roof_measured,
-                not j.stepped,
-            )
+            best = _found(poi, look, roof)
             matches.append(best)
             if not p.visit_all:
                 todo = _rivals(m, pois, todo, k)
@@ -203,17 +195,7 @@ def search(
             roof = roof_between(overview_shapes[poi.shape_index], overview, shape, look.photo)
             if roof is not None and roof > p.assumed_roof_m:
                 roof = None
-            matches.append(
-                Found(
-                    poi,
-                    look.photo,
-                    shape,
-                    j.score,
-                    poi.roof_m if roof is None else roof,
-                    roof is not None or poi.roof_measured,
-                    not j.stepped,
-                )
-            )
+            matches.append(_found(poi, look, roof))
     if best is None:
         where = f" at point of interest {best_poi}" if best_poi >= 0 else ""
         raise m.end(
@@ -226,6 +208,21 @@ def search(
         f"roof {best.roof_m:.1f} m above home",
     )
     return best
+
+
+def _found(poi: PointOfInterest, look: _Look, roof_m: float | None) -> Found:
+    """The match of ``look`` at ``poi``, its roof at ``roof_m`` when measured (else the point
+    of interest's)."""
+    j = look.judgement
+    return Found(
+        poi,
+        look.photo,
+        look.shapes[j.candidate],
+        j.score,
+        poi.roof_m if roof_m is None else roof_m,
+        roof_m is not None or poi.roof_measured,
+        not j.stepped,
+    )
 
 
 def _settle(m: SearchMission, best: Found, matches: list[Found]) -> Wait[Found]:
