@@ -38,11 +38,12 @@ class VectorizeParams:
     denoise_px: int = 3
     """Median filter aperture applied to the colour-class image (0 or 1 = off; odd)."""
     roof_only: bool = False
-    """Keep only the brightest shade of each colour: in a photo from above that is the
-    roofs, without the walls perspective shows around them (use for nadir photos)."""
+    """Keep only the roofs, without the walls perspective shows around them (use for photos
+    from above): each region's shade on its edges facing away from the photo's nadir, where
+    a roof's edge is whatever the light (`uavtool.vision.roof`)."""
     roof_value_tolerance: int = 20
-    """With ``roof_only``, HSV values (0–255) this far below the brightest shade still count
-    as roof (sensor noise); walls are darker by much more under the renderer's lighting."""
+    """With ``roof_only``, HSV values (0–255) this far from the roof's shade still count as
+    roof (sensor noise); a wall lit within this of its roof is taken with it."""
     point_spacing_px: float = 2.0
     """Distance between the evenly spaced points put along each border: larger is faster
     and coarser."""

@@ -21,6 +21,7 @@ from uavtool.vision.colour import brightest_shade, hue_distance_deg, hue_lut, hu
 from uavtool.vision.errors import ImageError
 from uavtool.vision.outline import offset_ring, simplify_rings
 from uavtool.vision.params import VectorizeParams
+from uavtool.vision.roof import INSET_PX, far_edge_pixels, roof_value
 from uavtool.vision.shapes import FloatArray, Shape, orient
 
 U8Array = npt.NDArray[np.uint8]
@@ -39,11 +40,19 @@ __all__ = [
 ]
 
 
-def vectorize(frame_rgb: U8Array, params: VectorizeParams | None = None) -> tuple[Shape, ...]:
+def vectorize(
+    frame_rgb: U8Array,
+    params: VectorizeParams | None = None,
+    *,
+    nadir_px: tuple[float, float] | None = None,
+) -> tuple[Shape, ...]:
     """The coloured regions of an RGB frame ``(h, w, 3) uint8`` as shapes.
 
-    Shapes are ordered by palette colour, then by area (largest first). Raises
-    :class:`ImageError` for anything but an ``(h, w, 3)`` uint8 array.
+    Shapes are ordered by palette colour, then by area (largest first). With ``roof_only``,
+    each region keeps its roof's shade, told by geometry (:mod:`uavtool.vision.roof`):
+    ``nadir_px`` is the photo's point straight below the camera, ``(u, v)``; by default the
+    image centre (a camera looking straight down). Raises :class:`ImageError` for anything
+    but an ``(h, w, 3)`` uint8 array.
     """
     p = params if params is not None else VectorizeParams()
     frame = _check_frame(frame_rgb)
@@ -71,7 +80,6 @@ def vectorize(frame_rgb: U8Array, params: VectorizeParams | None = None) -> tupl
     if p.denoise_px > 1:
         # The median of class ids is always one of the ids present, so no class is invented.
         classes = cv2.medianBlur(classes, p.denoise_px)
-    val = val[box]
     regions: list[_Region] = []
     for k in range(1, n_classes + 1):
         mask = cv2.inRange(classes, k, k)
@@ -83,7 +91,8 @@ def vectorize(frame_rgb: U8Array, params: VectorizeParams | None = None) -> tupl
         mask = mask[sub]
         every = mask
         if p.roof_only:
-            mask = brightest_shade(val[sub], mask, p)
+            nadir = nadir_px if nadir_px is not None else _centre(frame)
+            mask = _roofs(val, mask, (x0 + bx, y0 + by), frame.shape[:2], nadir, p)
         regions.extend(_regions(mask, every, (x0 + bx, y0 + by), frame.shape[:2], k, p))
     shapes = [
         (r.colour_class, -shape.area_px, order, shape)
@@ -91,6 +100,56 @@ def vectorize(frame_rgb: U8Array, params: VectorizeParams | None = None) -> tupl
     ]
     shapes.sort(key=lambda t: t[:3])
     return tuple(s for *_, s in shapes)
+
+
+_PAD_PX = INSET_PX + 2
+"""How far around a colour's box its roofs are looked for edges: past the reading inset."""
+
+
+def _centre(frame: U8Array) -> tuple[float, float]:
+    return ((frame.shape[1] - 1) / 2.0, (frame.shape[0] - 1) / 2.0)
+
+
+def _roofs(
+    val: CvArray,
+    mask: CvArray,
+    at: tuple[int, int],
+    frame_hw: tuple[int, int],
+    nadir: tuple[float, float],
+    p: VectorizeParams,
+) -> CvArray:
+    """The part of ``mask`` (one colour, a box at frame pixel ``at``; ``val``: the frame's
+    HSV V channel) that is roof: each region's pixels within
+    ``roof_value_tolerance`` of the shade its far edges show (:mod:`uavtool.vision.roof`).
+    A region with less of a far edge in the picture than ``min_edge_px`` takes the shade its
+    colour's other regions show; a colour with too little anywhere keeps its brightest
+    shade, as light from high above draws a roof."""
+    bh, bw = mask.shape
+    (fx, fy), (fh, fw) = at, frame_hw
+    px0, py0 = max(fx - _PAD_PX, 0), max(fy - _PAD_PX, 0)
+    px1, py1 = min(fx + bw + _PAD_PX, fw), min(fy + bh + _PAD_PX, fh)
+    padded = np.zeros((py1 - py0, px1 - px0), np.uint8)
+    padded[fy - py0 : fy - py0 + bh, fx - px0 : fx - px0 + bw] = mask
+    value = val[py0:py1, px0:px1]
+    votes = far_edge_pixels(padded, (nadir[0] - px0, nadir[1] - py0))
+    tol = p.roof_value_tolerance
+    # a roof edge is an edge: at least min_edge_px long, or it is the stub of a corner
+    least = max(int(np.ceil(p.min_edge_px)), 1)
+    shade = roof_value(value, votes, tol) if len(votes[0]) >= least else None
+    if shade is None:
+        return brightest_shade(value[fy - py0 : fy - py0 + bh, fx - px0 : fx - px0 + bw], mask, p)
+    count, labels = cv2.connectedComponents(padded, connectivity=8)
+    shades = np.full(count, shade, np.int16)
+    vs, us = votes
+    owner = labels[vs, us]
+    # (np.unique would import numpy.ma: tests/test_imports.py)
+    for label in np.flatnonzero(np.bincount(owner, minlength=count) >= least).tolist():
+        mine = owner == label
+        own = roof_value(value, (vs[mine], us[mine]), tol)
+        shades[label] = shade if own is None else own
+    near = np.abs(value.astype(np.int16) - shades[labels]) <= tol
+    roof = np.where(near & (padded > 0), 255, 0).astype(np.uint8)
+    return roof[fy - py0 : fy - py0 + bh, fx - px0 : fx - px0 + bw]
 
 
 def _traced(
@@ -117,12 +176,15 @@ def non_ground(
     *,
     tolerance_dn: int = 15,
     within: CvArray | None = None,
+    nadir_px: tuple[float, float] | None = None,
 ) -> tuple[Shape, ...]:
     """The roofs of everything in an RGB frame that is not the ground, whatever its colour,
     largest first. Not ground: pixels differing from the ground's colour (the frame's most
     common colour, to 8 levels) by more than ``tolerance_dn`` in a channel; a roof: the part
-    of such a region in its brightest colour that covers a tenth of it (walls are shaded
-    darker from above in daylight).
+    of such a region in the colour its edges facing away from the nadir show
+    (:mod:`uavtool.vision.roof`; ``nadir_px`` by default the image centre), or, with too
+    little of such an edge in the picture, in its brightest colour that covers a tenth of it
+    (walls are shaded darker than roofs by light from high above).
     This is what the obstacle map is made of: grey, white or black roofs, and a darker shade
     of a colour, which :func:`vectorize` leaves out, are here. ``within`` (a mask of the
     frame's size, non-zero where to look) keeps only what lies in it."""
@@ -132,11 +194,14 @@ def non_ground(
     if within is not None:
         mask = cv2.bitwise_and(mask, cv2.threshold(within, 0, 255, cv2.THRESH_BINARY)[1])
     regions = _regions(mask, mask, (0, 0), frame.shape[:2], 1, p)
+    nadir = nadir_px if nadir_px is not None else _centre(frame)
+    least = max(int(np.ceil(p.min_edge_px)), 1)
     roofs: list[_Region] = []
     for r in regions:
         inside = np.zeros_like(mask)
         cv2.drawContours(inside, [r.contour], 0, 255, cv2.FILLED)
-        roof = cv2.bitwise_and(_near(frame, _roof_rgb(frame, inside), _ROOF_TOLERANCE_DN), inside)
+        rgb = _roof_rgb(frame, inside, _far_edge(inside, r.contour, nadir), least)
+        roof = cv2.bitwise_and(_near(frame, rgb, _ROOF_TOLERANCE_DN), inside)
         if p.denoise_px > 1:
             roof = cv2.medianBlur(roof, p.denoise_px)
         found = _regions(roof, roof, (0, 0), frame.shape[:2], 1, p)
@@ -333,9 +398,30 @@ _ROOF_TOLERANCE_DN = 6
 """How far (per channel) a roof's pixels may be from its colour: flat shading and noise."""
 
 
-def _roof_rgb(frame: U8Array, mask: CvArray) -> tuple[int, int, int]:
-    """The brightest colour (to 8 levels) holding at least `_ROOF_SHARE` of the pixels under
-    ``mask``: from above, in daylight, a roof is lit better than the walls around it."""
+def _far_edge(
+    inside: CvArray, contour: CvArray, nadir: tuple[float, float]
+) -> tuple[npt.NDArray[np.intp], npt.NDArray[np.intp]]:
+    """:func:`far_edge_pixels` of a frame-sized mask, worked out around ``contour`` only."""
+    x, y, w, h = cv2.boundingRect(contour)
+    fh, fw = inside.shape
+    x0, y0 = max(x - _PAD_PX, 0), max(y - _PAD_PX, 0)
+    x1, y1 = min(x + w + _PAD_PX, fw), min(y + h + _PAD_PX, fh)
+    vs, us = far_edge_pixels(inside[y0:y1, x0:x1], (nadir[0] - x0, nadir[1] - y0))
+    return vs + y0, us + x0
+
+
+def _roof_rgb(
+    frame: U8Array,
+    mask: CvArray,
+    far_edge: tuple[npt.NDArray[np.intp], npt.NDArray[np.intp]],
+    least: int,
+) -> tuple[int, int, int]:
+    """The colour (to 8 levels) most of the ``far_edge`` pixels show, when there are at least
+    ``least`` of them; else the brightest colour holding at least `_ROOF_SHARE` of the pixels
+    under ``mask``: light from high above lights a roof better than the walls around it."""
+    if len(far_edge[0]) >= least:
+        edge_codes = _colour_codes(frame)[far_edge]
+        return _code_rgb(int(np.argmax(np.bincount(edge_codes, minlength=1 << 15))))
     codes = _colour_codes(frame)[mask != 0]
     counts = np.bincount(codes, minlength=1 << 15)
     common = np.flatnonzero(counts >= _ROOF_SHARE * len(codes))
