@@ -276,16 +276,34 @@ def _settle(m: SearchMission, best: Found, matches: list[Found]) -> Wait[Found]:
 def _rivals_of(m: SearchMission, best: Found, matches: list[Found]) -> list[Found]:
     """The other buildings that matched and nothing yet tells from ``best``: not ``best``'s
     own roof seen again, and showing as many courtyards as the target picture if ``best``
-    does."""
+    does — and, unless the target picture shows parts at several heights (whose walls each
+    photo's perspective shows or hides), as many openings inside the roof (a courtyard whose
+    floor does not show: `enclosed_openings`)."""
     holes = len(m.target.holes_px)
-    return [
-        f
-        for f in matches
-        if f.poi.index != best.poi.index
-        and not _on_roof(best, f.photo, f.shape)
+    rivals = []
+    for f in matches:
+        if f.poi.index == best.poi.index or _on_roof(best, f.photo, f.shape):
+            continue
         # a courtyard more or less than the target picture shows tells it apart
-        and not (len(f.shape.holes_px) != holes and len(best.shape.holes_px) == holes)
-    ]
+        if len(f.shape.holes_px) != holes and len(best.shape.holes_px) == holes:
+            continue
+        want = m.target_openings
+        if not m.target_stepped and _openings(m, f) != want and _openings(m, best) == want:
+            m.event(
+                Level.INFO,
+                f"point of interest {f.poi.index}: its roof shows {_openings(m, f)} opening(s) "
+                f"inside its outline, the target picture's and {best.poi.index}'s "
+                f"{want}: not the target",
+            )
+            continue
+        rivals.append(f)
+    return rivals
+
+
+def _openings(m: SearchMission, f: Found) -> int:
+    """How many openings ``f``'s roof shows inside its outline (`enclosed_openings`)."""
+    least = m.params.vectorize.min_hole_area_px
+    return enclosed_openings(f.photo.image_rgb, f.shape, least_px=least)
 
 
 def _look_closer(m: SearchMission, f: Found, left: list[Found]) -> Wait[Judgement | None]:
