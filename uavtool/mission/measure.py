@@ -24,6 +24,7 @@ import cv2
 import numpy as np
 
 from uavtool.mission.analysis import not_flat, placed_roof, roof_between
+from uavtool.mission.ground import lies_on_ground, without_ground
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
 from uavtool.mission.search import photo_shapes
@@ -45,6 +46,7 @@ from uavtool.mission.unknown import (
 )
 from uavtool.nav import NavError, frame_on_plane, ground_point
 from uavtool.nav.heights import roof_from_cut_outline
+from uavtool.nav.parallax import STOREY_M
 from uavtool.vision import Shape
 from uavtool.vision.colour import has_hue, hue_distance_deg
 from uavtool.vision.vectorize import non_ground
@@ -134,6 +136,36 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         seen.photo, seen.shapes, roofs, measured, seen.regions, m.params.vectorize
     )
     others_m += [None] * (len(others) - len(others_m))
+    # What the overviews could not tell from the ground (beyond the lower one, near the
+    # point below both), the tour's photos, taken from beside it, may: a lawn, a road.
+    beside = photos  # the lower overview and the tour's photos
+    ground = frozenset(
+        i
+        for i, s in enumerate(seen.shapes)
+        if not (measured[i] and roofs[i] > STOREY_M)
+        and any(lies_on_ground(m, s, seen.photo, t, one_colour=False) for t in beside)
+    )
+    flat = 0
+    if beside:
+        still: list[tuple[Shape, float | None]] = []
+        for o, h in zip(others, others_m, strict=True):
+            kept, cut = without_ground(m, [o], seen.photo, beside)
+            flat += cut
+            if not cut:
+                still.append((o, h))
+            elif h is None:  # what stands on it, if anything, is still to be measured
+                still += [(k, None) for k in kept]
+            elif h > STOREY_M:  # measured standing: the parallax of its colour was not it
+                still.append((o, h))
+        others, others_m = [o for o, _ in still], [h for _, h in still]
+    if ground or flat:
+        m.event(
+            Level.INFO,
+            f"{len(ground) + flat} more region(s) lie on the ground (parallax between the "
+            "overview and the photos from above): not buildings",
+        )
+    for i in ground:
+        roofs[i], measured[i] = 0.0, True
     # Each photo is evidence of where nothing stands: the ground it sees, and the roofs of
     # known height (measured whole) it sees in their places.
     known = [
@@ -189,7 +221,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         for i, s in enumerate(shapes)
     ]
     footprints = tuple(place.footprint for place in places)
-    pois = points_of_interest(m, shapes, seen.photo, roofs, measured, footprints)
+    pois = points_of_interest(m, shapes, seen.photo, roofs, measured, footprints, ground)
     taller = [
         f"{poi.index} ({poi.roof_m:.1f} m)"
         for poi in pois
@@ -243,16 +275,22 @@ def may_be_target(m: SearchMission, region: Shape) -> bool:
 
 
 def _unclassified(m: SearchMission, seen: Survey) -> list[Shape]:
-    """The regions of the higher overview that are not ground and share no pixel with a
-    building the vectorizer found (a coloured roof and its walls are one region)."""
+    """The regions of the higher overview that are not ground (by its colour, nor by
+    parallax: `lies_on_ground`) and share no pixel with a building the vectorizer found (a
+    coloured roof and its walls are one region)."""
     k = seen.photo.intrinsics
     found = np.zeros((k.height_px, k.width_px), np.uint8)
     for s in seen.shapes:  # one by one: where two overlap, one call leaves the overlap empty
         cv2.fillPoly(found, [pixels(s.polygon_px)], 255)
+    for s in seen.shapes:  # a courtyard is not its building: what stands in it is other
+        for hole in s.holes_px:
+            cv2.fillPoly(found, [pixels(hole)], 0)
     out: list[Shape] = []
     for region in non_ground(seen.photo.image_rgb, m.params.vectorize):
         if region.area_px < m.params.vectorize.min_area_px:
             continue
+        if lies_on_ground(m, region, seen.photo, seen.lower, one_colour=True):
+            continue  # a road, a car park: ground of another colour
         own = np.zeros_like(found)
         cv2.fillPoly(own, [pixels(region.polygon_px)], 255)
         if cv2.countNonZero(cv2.bitwise_and(own, found)) == 0:

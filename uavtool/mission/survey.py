@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 from uavtool.camera import Intrinsics
 from uavtool.mission.analysis import roof_between
+from uavtool.mission.ground import lies_on_ground, measured_flat
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
 from uavtool.mission.params import MissionParams
@@ -91,11 +92,34 @@ def survey(m: SearchMission) -> Wait[Survey]:
     heading = overview_heading_deg(m.last.heading_deg if m.last else 0.0)
     yield from m.move((x, y, high_alt), heading, "second overview position")
     high = yield from m.photo("overview-2", -90.0)
-    shapes = photo_shapes(m, high)
-    found = [_measure(m, shape, high, low, low_shapes) for shape in shapes]
+    ground: list[Shape] = []
+    heights: dict[int, float | None] = {}
+
+    def building(s: Shape) -> bool:
+        h = heights[id(s)] = _measure(m, s, high, low, low_shapes)
+        flat = h is not None and measured_flat(
+            s, high, low, h, least_px=m.params.vectorize.min_edge_px
+        )
+        if flat or lies_on_ground(m, s, high, low, one_colour=False):
+            ground.append(s)
+            return False
+        return True
+
+    shapes = photo_shapes(m, high, keep=building)
+    regions = tuple(
+        r
+        for r in not_ground_regions(high.image_rgb, m.params.vectorize)
+        if not lies_on_ground(m, r, high, low, one_colour=True)
+    )
+    if ground:
+        m.event(
+            Level.INFO,
+            f"{len(ground)} region(s) of a colour lie on the ground (parallax between the "
+            "overviews): not buildings",
+        )
+    found = [heights[id(shape)] for shape in shapes]
     measured = [h is not None for h in found]
     roofs = [p.assumed_roof_m if h is None else h for h in found]
-    regions = not_ground_regions(high.image_rgb, m.params.vectorize)
     places = [
         Unknown(footprint_at(s, high, h), h)
         if h is not None
@@ -123,8 +147,10 @@ def points_of_interest(
     roofs_m: list[float],
     measured: list[bool],
     footprints: tuple[tuple[tuple[float, float], ...], ...],
+    ground: frozenset[int] = frozenset(),
 ) -> tuple[PointOfInterest, ...]:
-    """A point of interest per shape of the overview ``photo`` large enough for a building.
+    """A point of interest per shape of the overview ``photo`` large enough for a building
+    and not on the ground (``ground``: their indices).
     An unmeasured roof is assumed tall where that is the safe guess (``roofs_m``, for
     altitudes), and as high as the measured ones are (their median) where the best guess is
     (its position)."""
@@ -134,6 +160,8 @@ def points_of_interest(
     pois: list[PointOfInterest] = []
     limit = p.match_hue_tolerance_deg
     for i, shape in enumerate(shapes):
+        if i in ground:
+            continue
         like_target = limit <= 0 or hue_distance_deg(shape.colour_rgb, m.target.colour_rgb) <= limit
         if shape.area_px < p.min_poi_area_px and not (shape.cut_by_border or like_target):
             continue  # too small for a building; one cut by the border may be any size, and

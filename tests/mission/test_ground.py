@@ -1,0 +1,57 @@
+"""Ground that is not one grey: a ground of a colour, lawns, roads and car parks, a painted
+copy of the target on the ground. None is a building, a point of interest or an obstacle:
+parallax between photos from above tells them (`uavtool.nav.parallax`)."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+from uavtool.mission import Status
+from uavtool.runner.fly import FlyConfig
+from uavtool.runner.fly import fly as fly_scene
+from uavtool.world import load_scene
+from uavtool.world.ground import GroundArea, GroundTexture, TextureKind
+from uavtool.world.scene import dump_scene
+
+RED_L = ((5.0, -12.0), (15.0, -12.0), (15.0, -4.0), (11.5, -4.0), (11.5, -8.5), (5.0, -8.5))
+"""The paper target's footprint from above."""
+
+
+def _fly(tmp_path: Path, **changes: object) -> tuple[object, list[str]]:
+    scene = tmp_path / "scene.yaml"
+    scene.write_text(dump_scene(dataclasses.replace(load_scene("paper"), **changes)))
+    events: list[str] = []
+    summary = fly_scene(
+        FlyConfig(scene=str(scene), no_record=True), progress=lambda e, _t: events.append(e)
+    )
+    return summary, events
+
+
+def test_a_copy_of_the_target_painted_on_the_ground_is_not_taken_for_it(tmp_path: Path) -> None:
+    """The target's L in the target's red, painted on a brown ground with a grain, 25 m west
+    of the real one: it matches the target picture perfectly by shape and colour, and it is
+    flat. The real building is found; the painting is ground."""
+    painted = tuple((x - 35.0, y - 2.0) for x, y in RED_L)
+    summary, events = _fly(
+        tmp_path,
+        ground_rgb=(125, 85, 59),
+        ground_areas=(GroundArea("painted", (210, 40, 40), painted),),
+        ground_texture=GroundTexture(TextureKind.GRAIN, 6.0, 0.3, 7),
+    )
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason  # type: ignore[attr-defined]
+    assert summary.evaluation.matched_building == "red"  # type: ignore[attr-defined]
+    assert any("lie on the ground" in e for e in events), events
+
+
+def test_a_green_roof_on_grass_is_found(tmp_path: Path) -> None:
+    """The issue's green ground (86, 125, 62) and a green target (40, 150, 50): the grass is
+    no building and no point of interest, and the target's roof is told from it."""
+    paper = load_scene("paper")
+    buildings = tuple(
+        dataclasses.replace(b, color_rgb=(40, 150, 50)) if b.name == "red" else b
+        for b in paper.buildings
+    )
+    summary, _ = _fly(tmp_path, buildings=buildings, ground_rgb=(86, 125, 62))
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason  # type: ignore[attr-defined]
+    assert summary.evaluation.matched_building == "red"  # type: ignore[attr-defined]

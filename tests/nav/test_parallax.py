@@ -1,0 +1,85 @@
+"""Ground or not, by parallax between two photos from above (`uavtool.nav.parallax`): a
+flat area of any colour is ground, a roof of the same colour and outline is not, and near
+the point below both cameras the photos cannot tell."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import cv2
+import numpy as np
+import pytest
+
+from uavtool.camera import CameraPose, Intrinsics, project
+from uavtool.nav.parallax import on_ground, plane_homography
+from uavtool.world import Block, Building, load_scene, render
+from uavtool.world.ground import GroundArea
+
+K = Intrinsics.from_hfov(width_px=640, height_px=480)
+LOW = CameraPose((0.0, 0.0, 45.0), 0.0, -90.0)
+HIGH = CameraPose((0.0, 0.0, 117.0), 0.0, -90.0)
+BESIDE = CameraPose((-30.0, 20.0, 117.0), 0.0, -90.0)
+"""As the mission's roof measurement tour takes its photos: at the overview's height, over
+another building."""
+GREEN = (60, 160, 60)
+SQUARE = ((0.0, 0.0), (8.0, 0.0), (8.0, 6.0), (0.0, 6.0))
+
+
+def _at(x: float, y: float) -> tuple[tuple[float, float], ...]:
+    return tuple((px + x, py + y) for px, py in SQUARE)
+
+
+def _photos(
+    lawn_at: tuple[float, float], roof_at: tuple[float, float], roof_m: float, other: CameraPose
+) -> tuple[np.ndarray, np.ndarray]:
+    """A green lawn and a green box of the lawn's outline, ``roof_m`` tall, on grey ground;
+    photographed from ``other`` and HIGH."""
+    box = Building("box", GREEN, (Block(_at(*roof_at), 0.0, roof_m),))
+    scene = dataclasses.replace(
+        load_scene("paper"),
+        buildings=(box,),
+        target="box",
+        ground_areas=(GroundArea("lawn", GREEN, _at(*lawn_at)),),
+    )
+    return render(scene, other, K), render(scene, HIGH, K)
+
+
+def _region(ring: tuple[tuple[float, float], ...], z: float) -> np.ndarray:
+    px = project(np.array([(x, y, z) for x, y in ring]), HIGH, K)[:, :2]
+    mask = np.zeros((K.height_px, K.width_px), np.uint8)
+    cv2.fillPoly(mask, [np.round(px).astype(np.int32)], 255)
+    return mask
+
+
+def _ground(mask: np.ndarray, other: np.ndarray, high: np.ndarray, pose: CameraPose) -> bool | None:
+    return on_ground(mask, GREEN, high, HIGH, other, pose, K, top_m=44.0, least_px=60.0)
+
+
+@pytest.mark.parametrize("roof_m", [3.0, 6.0, 15.0])
+def test_a_lawn_is_ground_and_a_roof_of_its_colour_and_outline_is_not(roof_m: float) -> None:
+    lawn, roof = (-22.0, 4.0), (14.0, -12.0)
+    beside, high = _photos(lawn, roof, roof_m, BESIDE)
+    assert _ground(_region(_at(*lawn), 0.0), beside, high, BESIDE) is True
+    assert _ground(_region(_at(*roof), roof_m), beside, high, BESIDE) is False
+
+
+def test_under_the_cameras_the_photos_cannot_tell() -> None:
+    """Straight below both cameras no height moves anything."""
+    low, high = _photos((-4.0, -3.0), (30.0, 20.0), 6.0, LOW)
+    assert _ground(_region(_at(-4.0, -3.0), 0.0), low, high, LOW) is None
+
+
+def test_a_height_the_other_photo_cannot_show_is_not_ruled_out() -> None:
+    """The lower overview sees a plane high up only near the point below it: away from it,
+    a roof there is not ruled out, so nothing away from it is called ground by that photo
+    alone (a 15 m tower whose roof it does not show once was)."""
+    low, high = _photos((-22.0, 4.0), (30.0, 20.0), 6.0, LOW)
+    assert _ground(_region(_at(-22.0, 4.0), 0.0), low, high, LOW) is None
+
+
+def test_the_ground_plane_maps_a_ground_point_to_itself() -> None:
+    hom = plane_homography(LOW, HIGH, K, 0.0)
+    point = np.array([(12.0, -7.0, 0.0)])
+    here = project(point, LOW, K)[0, :2]
+    there = cv2.perspectiveTransform(here.reshape(1, 1, 2), hom)[0, 0]
+    assert np.allclose(there, project(point, HIGH, K)[0, :2], atol=1e-6)

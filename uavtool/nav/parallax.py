@@ -1,0 +1,160 @@
+"""Whether what a photo from above shows lies on the ground, by parallax between two photos.
+
+Two photos from above taken from different places (the mission's two overviews: one above
+the other) draw the ground, and any flat surface, in two places related by the plane's
+homography; a surface at another height moves by another. So a region of one colour is on
+the ground when the other photo, carried over as the ground would be, puts that colour
+where this photo shows it better than carried as any height the photos can tell from the
+ground. Its colour, its size and how common it is in the frame say nothing of that: a lawn,
+a road or a whole field of grass is ground, a green roof is not.
+
+Near the point below the cameras no height moves anything (the photos are taken along one
+vertical): there, and wherever the other photo does not reach, the answer is "not known".
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from uavtool.camera import CameraPose, Intrinsics, project
+from uavtool.nav.errors import NavError
+from uavtool.nav.projection import frame_corners_px, frame_on_plane
+
+CvArray = npt.NDArray[Any]
+
+PARALLAX_PX = 2.0
+"""The least shift between two planes' drawings of a region, in pixels, that tells them
+apart: each photo draws an edge to within a pixel (the vectorizer's outline accuracy)."""
+HEIGHTS_M = (1.0, 2.0, 3.0, 5.0, 8.0, 12.0, 17.0, 23.0, 30.0, 38.0)
+"""The heights above the ground the sweep tries: a roof at any height between two of them
+is carried nearer to one of them than to the ground."""
+STOREY_M = 3.0
+"""The lowest a building stands: one storey. A region the photos can tell from a plane this
+high (or lower) only is on the ground if it fits the ground best; where they cannot tell
+even that, it may be a building."""
+_NEAR_DN = 30
+"""How far (per channel) the other photo's pixel may be from the region's colour: flat
+shading is one colour per face, and a ground texture or sensor noise a few levels."""
+
+
+def plane_homography(
+    pose_from: CameraPose, pose_to: CameraPose, intrinsics: Intrinsics, plane_z_m: float
+) -> npt.NDArray[np.float64]:
+    """The 3x3 map from pixels of a photo taken at ``pose_from`` to pixels of one taken at
+    ``pose_to`` (same camera) for points on the plane z = ``plane_z_m``. NavError when a
+    frame's corner does not meet the plane (the camera looks above it)."""
+    corners = np.array(frame_corners_px(intrinsics), np.float32)
+    world = frame_on_plane(pose_from, intrinsics, plane_z_m=plane_z_m)
+    there = project(np.array([(x, y, plane_z_m) for x, y in world]), pose_to, intrinsics)
+    return cv2.getPerspectiveTransform(corners, there[:, :2].astype(np.float32)).astype(np.float64)
+
+
+def on_ground(
+    region: CvArray,
+    colour_rgb: tuple[int, int, int],
+    image: npt.NDArray[np.uint8],
+    pose: CameraPose,
+    other: npt.NDArray[np.uint8],
+    other_pose: CameraPose,
+    intrinsics: Intrinsics,
+    *,
+    top_m: float,
+    least_px: float,
+) -> bool | None:
+    """Whether ``region`` (uint8 mask over ``image``, a photo from above at ``pose``) of
+    colour ``colour_rgb`` lies on the ground: True when ``other`` (a photo from above at
+    ``other_pose``), carried into ``image`` as the ground, shows that colour where ``image``
+    does better than carried as any height up to ``top_m`` it can tell from the ground;
+    False when some height does better; None when the photos cannot tell: the region is
+    near the point below the cameras, ``other`` shows less than ``least_px`` pixels of it
+    carried as the ground or as any of those heights, or the photos tell it only from what
+    stands higher than a storey (`STOREY_M`)."""
+    least = least_telling_m(region, pose, other_pose, intrinsics, top_m)
+    if least is None or least > STOREY_M:
+        return None
+    # the region's box: where its pixels are
+    x0, y0, bw, bh = cv2.boundingRect(region)
+    x1, y1 = x0 + bw, y0 + bh
+    box = (slice(y0, y1), slice(x0, x1))
+    here = image[box]
+    mine = cv2.bitwise_and(_near(here, colour_rgb), region[box])
+    ones = np.full(other.shape[:2], 255, np.uint8)
+    shift = np.array([[1.0, 0.0, -x0], [0.0, 1.0, -y0], [0.0, 0.0, 1.0]])
+
+    def misfit(z: float) -> float | None:
+        """How far, on average, the other photo carried as the plane z is from this one
+        over the region's pixels (of those it shows at all): a flat surface's edges, and
+        the grain of a textured ground, line up only at their own height."""
+        try:
+            hom = shift @ plane_homography(other_pose, pose, intrinsics, z)
+        except NavError:
+            return None
+        size = (x1 - x0, y1 - y0)
+        carried = cv2.warpPerspective(other, hom, size, flags=cv2.INTER_LINEAR)
+        seen = cv2.bitwise_and(mine, cv2.warpPerspective(ones, hom, size, flags=cv2.INTER_NEAREST))
+        shown = cv2.countNonZero(seen)
+        if shown < least_px:
+            return None  # the other photo shows too little of it
+        differ = cv2.absdiff(here, carried).astype(np.float64).sum(axis=2)
+        return float(differ[seen > 0].sum()) / shown
+
+    ground = misfit(0.0)
+    if ground is None:
+        return None
+    # every height it may stand at must be tried: one the other photo cannot show it at
+    # (carried out of its frame) might be the one that fits
+    fits = [misfit(z) for z in HEIGHTS_M if least <= z <= top_m]
+    if not fits or any(f is None for f in fits):
+        return None
+    return ground < min(f for f in fits if f is not None)
+
+
+def _near(image: npt.NDArray[np.uint8], rgb: tuple[int, int, int]) -> CvArray:
+    lo = np.array([max(c - _NEAR_DN, 0) for c in rgb], np.uint8)
+    hi = np.array([min(c + _NEAR_DN, 255) for c in rgb], np.uint8)
+    return cv2.inRange(image, lo, hi)
+
+
+def _shift_px(
+    region: CvArray,
+    pose: CameraPose,
+    other_pose: CameraPose,
+    intrinsics: Intrinsics,
+    z_m: float,
+) -> float:
+    """How far apart the ground's and the plane z = ``z_m``'s carrying put the region's
+    pixels, at most (its outline's pixels suffice: the shift grows away from the nadir)."""
+    contours, _ = cv2.findContours(region, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
+    if not contours:
+        return 0.0
+    pts = np.concatenate([c[:, 0, :] for c in contours]).astype(np.float64)
+    try:
+        to_ground = np.linalg.inv(plane_homography(other_pose, pose, intrinsics, 0.0))
+        at_z = plane_homography(other_pose, pose, intrinsics, z_m)
+    except (NavError, np.linalg.LinAlgError):
+        return 0.0
+    # a pixel of this photo, carried back into the other as the ground, then here as z
+    back = cv2.perspectiveTransform(pts.reshape(-1, 1, 2), to_ground)
+    again = cv2.perspectiveTransform(back, at_z).reshape(-1, 2)
+    return float(np.max(np.hypot(*(again - pts).T)))
+
+
+def least_telling_m(
+    region: CvArray,
+    pose: CameraPose,
+    other_pose: CameraPose,
+    intrinsics: Intrinsics,
+    top_m: float,
+) -> float | None:
+    """The lowest of `HEIGHTS_M` (up to ``top_m``) whose drawing of the region the photos
+    tell from the ground's: shifted by at least `PARALLAX_PX`."""
+    for z in HEIGHTS_M:
+        if z > top_m:
+            return None
+        if _shift_px(region, pose, other_pose, intrinsics, z) >= PARALLAX_PX:
+            return z
+    return None
