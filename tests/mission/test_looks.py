@@ -252,3 +252,28 @@ def test_a_look_again_names_why(score: float, mirror: float, reason: str) -> Non
     pos, why = again
     assert why == reason
     assert pos[2] == pytest.approx(40.0 + params.mission.recheck_climb_m)
+
+
+@pytest.mark.parametrize(("height_m", "judged"), [(30.0, True), (120.0, True), (420.0, False)])
+def test_a_candidate_drawn_too_small_to_tell_the_targets_corners_is_not_judged(
+    paper: Scene, height_m: float, judged: bool
+) -> None:
+    """The paper target photographed straight down from ever higher: once a quarter of its
+    edges would be drawn shorter than the vectorizer keeps an edge (`vectorize.min_edge_px`), the
+    look says nothing of it either way — neither a match nor a miss — and a closer look is
+    what may tell."""
+    params = Params()
+    k = Intrinsics.from_hfov()
+    _, target = target_shapes(params, png_decode(target_picture(paper, k)))
+    red = paper.building("red")
+    xs = [x for b in red.blocks for x, _ in b.footprint_enu_m]
+    ys = [y for b in red.blocks for _, y in b.footprint_enu_m]
+    centre = ((min(xs) + max(xs)) / 2.0, (min(ys) + max(ys)) / 2.0)
+    photo = render(replace(paper, buildings=(red,)), CameraPose((*centre, height_m), 0.0, -90.0), k)
+    j = judge(params, target, nadir_shapes(params, photo), k, red.color_rgb)
+    assert j.too_small is not judged
+    assert j.judgeable is judged
+    if judged:
+        assert j.matched
+    else:
+        assert not j.matched

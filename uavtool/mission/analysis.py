@@ -3,6 +3,7 @@ does with each frame, and what replay re-runs on every recorded frame."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import cv2
@@ -42,11 +43,14 @@ def side_shapes(params: Params, image_rgb: U8Array) -> tuple[Shape, ...]:
 
 
 def target_shapes(params: Params, target_rgb: U8Array) -> tuple[tuple[Shape, ...], Shape]:
-    """The target picture's shapes and the target (the largest)."""
+    """The target picture's shapes and the target: the largest the picture shows whole (a
+    building pictured from above; what runs out of the picture on every side is the ground
+    it stands on, of a colour), else the largest."""
     shapes = nadir_shapes(params, target_rgb)
     if not shapes:
         raise MissionInputError("target image: no coloured shape found in it")
-    return shapes, max(shapes, key=lambda s: s.area_px)
+    whole = [s for s in shapes if not s.cut_by_border] or list(shapes)
+    return shapes, max(whole, key=lambda s: s.area_px)
 
 
 @dataclass(frozen=True, slots=True)
@@ -79,6 +83,10 @@ class Judgement:
     """The corners matched, but the target picture shows parts of the building at several
     heights (walls inside its roof's outline): each photo's perspective draws them apart by
     its own distance, so the outlines are not compared."""
+    too_small: bool = False
+    """The candidate is drawn too small to tell the target's corners (not judgeable): at
+    its size a quarter of the target's edges would be shorter than the vectorizer keeps an
+    edge (``vectorize.min_edge_px``). A closer look may judge it; a higher one cannot."""
 
     @property
     def outline_fits(self) -> bool:
@@ -134,6 +142,12 @@ def judge(
     scores = tuple(match.score for match in matches)
     score = scores[candidate]
     judgeable = matches[candidate].judgeable
+    # at the candidate's size, would three quarters of the target's edges be edges at all?
+    too_small = judgeable and (
+        quartile_edge_share(target) * math.sqrt(max(centre.area_px, 0.0))
+        < params.vectorize.min_edge_px
+    )
+    judgeable = judgeable and not too_small
     hue_limit = params.mission.match_hue_tolerance_deg
     same_hue = hue_limit <= 0 or hue_distance_deg(centre.colour_rgb, target.colour_rgb) <= hue_limit
     rp = params.recognize
@@ -168,7 +182,25 @@ def judge(
         outline,
         tolerance,
         tiers,
+        too_small,
     )
+
+
+def quartile_edge_share(shape: Shape) -> float:
+    """The lower quartile of the edges of ``shape``'s outline (holes included) over the
+    square root of its area: how long, in pixels, three quarters of its edges at least are
+    drawn per pixel of a photo's scale. (Not the shortest: a target picture's outline may
+    hold a short edge or two that are no corner of the footprint, a higher tier's walls seen
+    in perspective.)"""
+    edges = sorted(
+        float(e)
+        for ring in (shape.polygon_px, *shape.holes_px)
+        if len(ring) >= 2
+        for e in np.hypot(*np.diff(np.vstack([ring, ring[:1]]), axis=0).T)
+    )
+    if not edges:
+        return 0.0
+    return edges[(len(edges) - 1) // 4] / math.sqrt(max(shape.area_px, 1.0))
 
 
 def placed_roof(a: Shape, photo_a: Photo, b: Shape, photo_b: Photo) -> float | None:

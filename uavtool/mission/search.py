@@ -9,6 +9,7 @@ shrink (on ``paper``, over headings and ±0.5 m: 65 % of photos from 20 m match,
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -61,12 +62,21 @@ class _Look:
     alt_m: float  # the altitude commanded for the photo
 
 
-def photo_shapes(m: SearchMission, photo: Photo, *, nadir: bool = True) -> tuple[Shape, ...]:
-    """Vectorize a photo (from above, or from the side) and emit its shapes."""
+def photo_shapes(
+    m: SearchMission,
+    photo: Photo,
+    *,
+    nadir: bool = True,
+    keep: Callable[[Shape], bool] | None = None,
+) -> tuple[Shape, ...]:
+    """Vectorize a photo (from above, or from the side) and emit its shapes (those ``keep``
+    keeps, if given)."""
     if nadir:
         shapes = nadir_shapes(m.params, photo.image_rgb)
     else:
         shapes = side_shapes(m.params, photo.image_rgb)
+    if keep is not None:
+        shapes = tuple(s for s in shapes if keep(s))
     m.emit(Shapes(photo.frame_index, photo.tag, shapes))
     return shapes
 
@@ -104,6 +114,7 @@ def search(
     best: Found | None = None
     best_score, best_poi = 0.0, -1
     matches: list[Found] = []  # every building that matched, in turn
+    unjudged: list[tuple[int, _Look]] = []  # of the target's hue, never judged
     ceiling_m = overview.pose.pos_enu_m[2]
     todo = list(order)
     while todo:
@@ -155,6 +166,8 @@ def search(
             best_score, best_poi = top, k
         look = looks[-1]  # a match ends the looking: the last look is the match if any
         j = look.judgement
+        if not j.judgeable and j.candidate >= 0 and j.same_hue:
+            unjudged.append((k, look))
         if (
             j.matched
             and poi.shape_index in roofless
@@ -201,6 +214,7 @@ def search(
         raise m.end(
             Status.NO_MATCH, f"no building matched the target (best score {best_score:.3f}{where})"
         )
+    _judged_all(m, best, unjudged)
     best = yield from _settle(m, best, matches)
     m.event(
         Level.INFO,
@@ -208,6 +222,24 @@ def search(
         f"roof {best.roof_m:.1f} m above home",
     )
     return best
+
+
+def _judged_all(m: SearchMission, best: Found, unjudged: list[tuple[int, _Look]]) -> None:
+    """End the mission NO_MATCH when a building of the target's hue other than ``best``'s
+    was never judged (drawn too small to tell its corners, or cut by the border, however
+    it was looked at): it may be the target, and ``best`` a building almost like it."""
+    for k, look in unjudged:
+        shape = look.shapes[look.judgement.candidate]
+        if k == best.poi.index or _on_roof(best, look.photo, shape):
+            continue
+        too_small = look.judgement.too_small
+        why = "drawn too small to tell its corners" if too_small else "cut by the image border"
+        raise m.end(
+            Status.NO_MATCH,
+            f"point of interest {best.poi.index} matches the target (score {best.score:.3f}), "
+            f"but {k}, of the target's colour, could not be judged ({why}): which is the "
+            "target is not known",
+        )
 
 
 def _found(poi: PointOfInterest, look: _Look, roof_m: float | None) -> Found:
@@ -458,7 +490,9 @@ def _look(
         Recognition(photo.frame_index, k, j.scores, j.candidate, j.score, j.matched, j.mirror_score)
     )
     why = ""
-    if not j.judgeable:
+    if j.too_small:
+        why = "; drawn too small here to tell the target's corners, not judged"
+    elif not j.judgeable:
         why = "; outline cut by the image border, not judged"
     elif not j.not_mirror and j.score >= m.params.recognize.threshold:
         why = f"; as much like the target's mirror image: {j.mirror_score:.3f}"
@@ -483,7 +517,8 @@ def _closer_look(
 ) -> tuple[Vec3, float] | None:
     """Where to look again from, lower, and the roof height measured, when the look was
     taken high over a roof of unknown height (assumed the tallest expected) and its
-    candidate has the target's hue and scores just below the threshold: the candidate,
+    candidate has the target's hue and scores just below the threshold, or is drawn too small
+    to judge: the candidate,
     whole in the look and in an earlier photo of it (``before``: the overview's shape, the
     earlier looks' candidates; the one furthest in altitude that tells), gives its roof's
     height, and from it the altitude at which it fills the photo as a look should. None
@@ -491,10 +526,10 @@ def _closer_look(
     told."""
     p = m.params.mission
     j, photo = look.judgement, look.photo
-    if j.matched or j.candidate < 0 or not (j.same_hue and j.judgeable) or _other_outline(j):
+    if j.matched or j.candidate < 0 or not j.same_hue or _other_outline(j):
         return None
-    if j.score < p.recheck_min_score:
-        return None
+    if not j.too_small and (not j.judgeable or j.score < p.recheck_min_score):
+        return None  # a score from too far says nothing: only from closer
     shape = look.shapes[j.candidate]
     alt = photo.pose.pos_enu_m[2]
     heights = (
@@ -555,8 +590,8 @@ def _look_again(
     candidate, a candidate of another hue, or a clear miss centred in the photo."""
     p = m.params.mission
     j, photo = look.judgement, look.photo
-    if j.matched or j.candidate < 0 or not j.same_hue or _other_outline(j):
-        return None
+    if j.matched or j.candidate < 0 or not j.same_hue or _other_outline(j) or j.too_small:
+        return None  # drawn too small: from higher it is smaller still
     shape = look.shapes[j.candidate]
     u, v = shape.centroid_px
     k = photo.intrinsics
