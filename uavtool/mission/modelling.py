@@ -8,7 +8,7 @@ import dataclasses
 import math
 from typing import TYPE_CHECKING
 
-from uavtool.mission.analysis import roof_between
+from uavtool.mission.analysis import aimed_shape, roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import DiagonalView, Level, ModelBuilt, Viewpoints
 from uavtool.mission.search import Found, photo_shapes
@@ -38,7 +38,6 @@ from uavtool.vision.model3d import (
     Model,
     View,
     build_model,
-    central_shape,
     open_beneath,
 )
 
@@ -88,7 +87,9 @@ def photograph_and_model(
         yield from m.travel(top.pos_enu_m, top.heading_deg, transit_m, "top viewpoint")
         top_photo = yield from m.photo("top" if attempt == 1 else f"top-{attempt}", -90.0)
         top_shapes = photo_shapes(m, top_photo)
-        obj = central_shape(top_shapes, top_photo.intrinsics)
+        # the building of the match's colour the photo is centred on (a lawn or a field of
+        # another hue around it, in the middle of the photo too, is not it)
+        obj = aimed_shape(m.params, top_shapes, top_photo.intrinsics, found.shape.colour_rgb)
         if obj is None:
             m.no_model = "the top photo shows no building"
             return

@@ -138,13 +138,15 @@ def default_recording_path(now: datetime | None = None) -> Path:
 
 
 def target_picture(scene: Scene, intrinsics: Intrinsics) -> bytes:
-    """The scene's target building alone, photographed from above (PNG)."""
+    """The scene's target building alone, photographed from above (PNG): on the scene's
+    ground, in its light, without the other buildings and the ground's areas (a lawn
+    beside it would be a second shape in the picture)."""
     building = scene.target_building
     xs = [x for blk in building.blocks for x, _ in blk.footprint_enu_m]
     ys = [y for blk in building.blocks for _, y in blk.footprint_enu_m]
     top = max(blk.top_m for blk in building.blocks)
     centre = ((min(xs) + max(xs)) / 2.0, (min(ys) + max(ys)) / 2.0, top + _TARGET_VIEW_M)
-    alone = dataclasses.replace(scene, buildings=(building,))
+    alone = dataclasses.replace(scene, buildings=(building,), ground_areas=())
     return png_encode(render(alone, CameraPose(centre, 0.0, -90.0), intrinsics))
 
 
