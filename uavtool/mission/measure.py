@@ -138,18 +138,17 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     others_m += [None] * (len(others) - len(others_m))
     # What the overviews could not tell from the ground (beyond the lower one, near the
     # point below both), the tour's photos, taken from beside it, may: a lawn, a road.
-    beside = photos  # the lower overview and the tour's photos
     ground = frozenset(
         i
         for i, s in enumerate(seen.shapes)
         if not (measured[i] and roofs[i] > STOREY_M)
-        and any(lies_on_ground(m, s, seen.photo, t, one_colour=False) for t in beside)
+        and lies_on_ground(m, s, seen.photo, photos, one_colour=False)
     )
     flat = 0
-    if beside:
+    if photos:
         still: list[tuple[Shape, float | None]] = []
         for o, h in zip(others, others_m, strict=True):
-            kept, cut = without_ground(m, [o], seen.photo, beside)
+            kept, cut = without_ground(m, [o], seen.photo, photos)
             flat += cut
             if not cut:
                 still.append((o, h))
@@ -289,7 +288,9 @@ def _unclassified(m: SearchMission, seen: Survey) -> list[Shape]:
     for region in non_ground(seen.photo.image_rgb, m.params.vectorize):
         if region.area_px < m.params.vectorize.min_area_px:
             continue
-        if lies_on_ground(m, region, seen.photo, seen.lower, one_colour=True):
+        if lies_on_ground(
+            m, region, seen.photo, () if seen.lower is None else (seen.lower,), one_colour=True
+        ):
             continue  # a road, a car park: ground of another colour
         own = np.zeros_like(found)
         cv2.fillPoly(own, [pixels(region.polygon_px)], 255)

@@ -100,7 +100,7 @@ def survey(m: SearchMission) -> Wait[Survey]:
         flat = h is not None and measured_flat(
             s, high, low, h, least_px=m.params.vectorize.min_edge_px
         )
-        if flat or lies_on_ground(m, s, high, low, one_colour=False):
+        if flat or lies_on_ground(m, s, high, (low,), one_colour=False):
             ground.append(s)
             return False
         return True
@@ -109,7 +109,7 @@ def survey(m: SearchMission) -> Wait[Survey]:
     regions = tuple(
         r
         for r in not_ground_regions(high.image_rgb, m.params.vectorize)
-        if not lies_on_ground(m, r, high, low, one_colour=True)
+        if not lies_on_ground(m, r, high, (low,), one_colour=True)
     )
     if ground:
         m.event(

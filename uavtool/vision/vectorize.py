@@ -243,13 +243,13 @@ def roof_inside(
     ``inset_px`` from its outline and from any pixel of the ground's colour (a courtyard or
     an opening shows the ground; a wall between two tiers of one building does not)."""
     frame = _check_frame(frame_rgb)
-    inside = _outline_mask(frame, shape)
+    inside = outline_mask(frame, shape)
     inside = cv2.bitwise_and(inside, cv2.bitwise_not(ground_mask(frame, tolerance_dn=tolerance_dn)))
     side = 2 * inset_px + 1
     return cv2.erode(inside, np.ones((side, side), np.uint8))
 
 
-def _outline_mask(frame: U8Array, shape: Shape) -> CvArray:
+def outline_mask(frame: U8Array, shape: Shape) -> CvArray:
     """255 inside ``shape``'s outline and not in its holes, over ``frame``'s pixels."""
     inside: CvArray = np.zeros(frame.shape[:2], np.uint8)
     cv2.fillPoly(inside, [_ring(shape.polygon_px)], 255)
@@ -293,15 +293,7 @@ def inner_walls(
         if tolerance_dn >= 0
         else np.ones(frame.shape[:2], np.uint8)
     )
-    hsv = cv2.cvtColor(frame, cv2.COLOR_RGB2HSV)
-    roof_hsv = cv2.cvtColor(np.array([[shape.colour_rgb]], np.uint8), cv2.COLOR_RGB2HSV)[0, 0]
-    grey = int(roof_hsv[1]) < _GREY_SATURATION
-    if grey:
-        alike = hsv[:, :, 1] < _GREY_SATURATION
-    else:
-        d = np.abs(hsv[:, :, 0].astype(np.int16) - int(roof_hsv[0]))
-        alike = (np.minimum(d, 180 - d) <= _WALL_HUE_HALF_DEG) & (hsv[:, :, 1] >= _GREY_SATURATION)
-    strips = (inside > 0) & (other > 0) & alike
+    strips = (inside > 0) & (other > 0) & same_paint(frame, shape.colour_rgb)
     ground = ground_mask(frame, tolerance_dn=tolerance_dn)
     near_ground = cv2.dilate(ground, np.ones((5, 5), np.uint8)) > 0
     count, labels = cv2.connectedComponents(strips.astype(np.uint8), connectivity=8)
@@ -362,7 +354,7 @@ def enclosed_openings(
     frame = _check_frame(frame_rgb)
     kernel = np.ones((3, 3), np.uint8)
     # the outline's blended edge pixels are no opening
-    inside = cv2.erode(_outline_mask(frame, shape), kernel)
+    inside = cv2.erode(outline_mask(frame, shape), kernel)
     rim = cv2.subtract(inside, cv2.erode(inside, kernel))
     roof = _near(frame, shape.colour_rgb, 2 * tolerance_dn)
     other = cv2.bitwise_and(inside, cv2.bitwise_not(roof))
@@ -373,6 +365,27 @@ def enclosed_openings(
         for label in range(1, count)
         if label not in touching and stats[label, cv2.CC_STAT_AREA] >= least_px
     )
+
+
+def same_paint(frame_rgb: U8Array, colour_rgb: tuple[int, int, int]) -> npt.NDArray[np.bool_]:
+    """Where ``frame_rgb`` shows ``colour_rgb``'s paint in any shade: its hue (within
+    `_WALL_HUE_HALF_DEG`), or grey for a grey. A wall is its roof's colour, shaded."""
+    frame = _check_frame(frame_rgb)
+    hsv = cv2.cvtColor(frame, cv2.COLOR_RGB2HSV)
+    own = cv2.cvtColor(np.array([[colour_rgb]], np.uint8), cv2.COLOR_RGB2HSV)[0, 0]
+    if int(own[1]) < _GREY_SATURATION:
+        grey: npt.NDArray[np.bool_] = hsv[:, :, 1] < _GREY_SATURATION
+        return grey
+    d = np.abs(hsv[:, :, 0].astype(np.int16) - int(own[0]))
+    alike: npt.NDArray[np.bool_] = (np.minimum(d, 180 - d) <= _WALL_HUE_HALF_DEG) & (
+        hsv[:, :, 1] >= _GREY_SATURATION
+    )
+    return alike
+
+
+def near_colour(frame_rgb: U8Array, rgb: tuple[int, int, int], tolerance_dn: int) -> CvArray:
+    """255 where every channel of ``frame_rgb`` is within ``tolerance_dn`` of ``rgb``."""
+    return _near(_check_frame(frame_rgb), rgb, tolerance_dn)
 
 
 _GREY_SATURATION = 40
