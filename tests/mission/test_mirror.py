@@ -5,13 +5,13 @@ from __future__ import annotations
 
 import math
 
-import cv2
 import numpy as np
 import pytest
 
 from uavtool.camera import Intrinsics
 from uavtool.mission import Params
 from uavtool.mission.analysis import judge, nadir_shapes, target_shapes
+from uavtool.world.raster import paint_polygon
 
 K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
 RGB = (200, 40, 40)
@@ -31,7 +31,7 @@ def _draw(ring: list[tuple[int, int]], *, turn_deg: float, px_per_unit: float, m
     rot = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
     pts = pts @ rot.T * px_per_unit + np.array([320.0, 240.0])
     image = np.full((480, 640, 3), 128, dtype=np.uint8)
-    cv2.fillPoly(image, [np.round(pts).astype(np.int32)], RGB)
+    paint_polygon(image, pts, RGB)
     return image
 
 

@@ -7,13 +7,13 @@ from __future__ import annotations
 
 import math
 
-import cv2
 import numpy as np
 import pytest
 
 from uavtool.camera import Intrinsics
 from uavtool.mission import Params
 from uavtool.mission.analysis import Judgement, judge, nadir_shapes, target_shapes
+from uavtool.world.raster import paint_polygon
 
 K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
 RGB = (210, 40, 40)
@@ -32,7 +32,7 @@ def _draw(ring: list[tuple[float, float]], *, turn_deg: float, px_per_m: float) 
     rot = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
     pts = pts @ rot.T * px_per_m + np.array([320.0, 240.0])
     image = np.full((480, 640, 3), 128, dtype=np.uint8)
-    cv2.fillPoly(image, [np.round(pts * 16).astype(np.int32)], RGB, shift=4)
+    paint_polygon(image, pts, RGB)
     return image
 
 

@@ -226,14 +226,14 @@ def search(
 
 def _judged_all(m: SearchMission, best: Found, unjudged: list[tuple[int, _Look]]) -> None:
     """End the mission NO_MATCH when a building of the target's hue other than ``best``'s
-    was never judged (drawn too small to tell its corners, or cut by the border, however
+    was never judged (drawn too small to tell its outline, or cut by the border, however
     it was looked at): it may be the target, and ``best`` a building almost like it."""
     for k, look in unjudged:
         shape = look.shapes[look.judgement.candidate]
         if k == best.poi.index or _on_roof(best, look.photo, shape):
             continue
         too_small = look.judgement.too_small
-        why = "drawn too small to tell its corners" if too_small else "cut by the image border"
+        why = "drawn too small to tell its outline" if too_small else "cut by the image border"
         raise m.end(
             Status.NO_MATCH,
             f"point of interest {best.poi.index} matches the target (score {best.score:.3f}), "
@@ -491,7 +491,7 @@ def _look(
     )
     why = ""
     if j.too_small:
-        why = "; drawn too small here to tell the target's corners, not judged"
+        why = "; drawn too small here to tell the target's outline, not judged"
     elif not j.judgeable:
         why = "; outline cut by the image border, not judged"
     elif not j.not_mirror and j.score >= m.params.recognize.threshold:

@@ -54,6 +54,7 @@ def shapes_to_json(shapes: tuple[Shape, ...], *, width_px: int, height_px: int) 
                 "area_px": s.area_px,
                 "centroid_px": list(s.centroid_px),
                 "cut_by_border": s.cut_by_border,
+                "detail_px": s.detail_px,
             }
             for s in shapes
         ],
@@ -91,6 +92,7 @@ def shapes_from_json(text: str, *, source: str = "<shapes>") -> tuple[Shape, ...
                     float(item["area_px"]),
                     centroid,
                     bool(item["cut_by_border"]),
+                    _detail(item.get("detail_px", 0.0), f"{where}.detail_px"),
                 )
             )
         except ShapeFileError:
@@ -177,6 +179,15 @@ def _ring(value: Any, where: str) -> FloatArray:
     if not np.all(np.isfinite(arr)):
         raise ShapeFileError(f"{where}: non-finite coordinate")
     return arr
+
+
+def _detail(value: Any, where: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ShapeFileError(f"{where}: expected a number of pixels")
+    f = float(value)
+    if not (math.isfinite(f) and f >= 0.0):
+        raise ShapeFileError(f"{where}: expected a finite number of pixels >= 0, got {value!r}")
+    return f
 
 
 def _finite(value: Any) -> float:

@@ -63,6 +63,8 @@ def merge_touching(
                 polygon_px=np.asarray(closed.exterior.coords[:-1], dtype=np.float64),
                 holes_px=tuple(np.asarray(r.coords[:-1], dtype=np.float64) for r in holes),
                 cut_by_border=any(shapes[i].cut_by_border for i in idx),
+                # the closing may have drawn the outline anywhere across the slits it closed
+                detail_px=max(half, *(shapes[i].detail_px for i in idx)),
             )
         )
     return tuple(out)
@@ -90,6 +92,7 @@ def _without_strips(shape: Shape, gap_px: float) -> Shape:
         polygon_px=shape.polygon_px,
         holes_px=holes,
         cut_by_border=shape.cut_by_border,
+        detail_px=shape.detail_px,
     )
 
 

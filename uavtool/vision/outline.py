@@ -25,17 +25,62 @@ _MAX_MITRE = 3.0
 def simplify_rings(contours_px: list[npt.NDArray[Any]], p: VectorizeParams) -> list[FloatArray]:
     """Each closed pixel border ``(n, 2)`` as a simplified ring ``(m, 2)`` (``m`` may be < 3
     for a border too small to make a polygon)."""
+    return simplify_rings_detail(contours_px, p)[0]
+
+
+def simplify_rings_detail(
+    contours_px: list[npt.NDArray[Any]], p: VectorizeParams
+) -> tuple[list[FloatArray], list[float]]:
+    """:func:`simplify_rings`, and how much detail each ring holds at the limit of what it
+    can be trusted with, in pixels: how far its border strays from it (:func:`ring_detail`:
+    what the simplification left out), or its longest edge shorter than ``min_edge_px``
+    when longer (a step kept at the limit), whichever is more."""
     dense = [resample_ring(c.astype(np.float64), p.point_spacing_px) for c in contours_px]
     kept = rdp_rings_indices(dense, p.rdp_epsilon_px)
     if not p.refine_corners:
-        return [d[k] for d, k in zip(dense, kept, strict=True)]
-    return refine_rings(
-        dense,
-        [k.tolist() for k in kept],
-        min_edge_px=p.min_edge_px,
-        max_shift_px=p.min_edge_px + p.point_spacing_px + p.rdp_epsilon_px,
-        straight_tolerance_px=p.straight_tolerance_px,
-    )
+        rings = [d[k] for d, k in zip(dense, kept, strict=True)]
+    else:
+        rings = refine_rings(
+            dense,
+            [k.tolist() for k in kept],
+            min_edge_px=p.min_edge_px,
+            max_shift_px=p.min_edge_px + p.point_spacing_px + p.rdp_epsilon_px,
+            straight_tolerance_px=p.straight_tolerance_px,
+        )
+    return rings, [
+        max(ring_detail(d, r), _longest_stub(r, p.min_edge_px))
+        for d, r in zip(dense, rings, strict=True)
+    ]
+
+
+def _longest_stub(ring_px: FloatArray, min_edge_px: float) -> float:
+    """The longest edge of ``ring_px`` shorter than ``min_edge_px`` (0 if none): a step the
+    outline kept at the limit of what it keeps, which another photo may draw as a slant or
+    not at all."""
+    if len(ring_px) < 3:
+        return 0.0
+    d = np.roll(ring_px, -1, axis=0) - ring_px
+    lengths = np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1])
+    short = lengths[lengths < min_edge_px]
+    return float(short.max()) if len(short) else 0.0
+
+
+def ring_detail(points_px: FloatArray, ring_px: FloatArray) -> float:
+    """The largest distance (pixels) from any of ``points_px`` ``(n, 2)`` to the closed ring
+    ``ring_px`` ``(m, 2)``: how much of a traced border its simplified outline leaves out
+    (a step or a notch shorter than an edge the outline keeps). 0 for fewer than 2 ring
+    points."""
+    if len(ring_px) < 2 or len(points_px) == 0:
+        return 0.0
+    a = ring_px[:, None, :]  # (1... segments) start
+    ab = np.roll(ring_px, -1, axis=0)[:, None, :] - a
+    ap = points_px[None, :, :] - a
+    length2 = ab[..., 0] * ab[..., 0] + ab[..., 1] * ab[..., 1]
+    t = (ap[..., 0] * ab[..., 0] + ap[..., 1] * ab[..., 1]) / np.where(length2 > 0, length2, 1.0)
+    t = np.clip(t, 0.0, 1.0)
+    dx = ap[..., 0] - t * ab[..., 0]
+    dy = ap[..., 1] - t * ab[..., 1]
+    return float(np.sqrt((dx * dx + dy * dy).min(axis=0).max()))
 
 
 def resample_ring(ring_px: FloatArray, spacing_px: float) -> FloatArray:

@@ -28,6 +28,9 @@ class Shape:
     ``area_px`` : outer area minus hole areas, in square pixels.
     ``centroid_px`` : area centroid ``(u, v)`` of the region with holes removed.
     ``cut_by_border`` : the region touches the image border, so its outline is incomplete.
+    ``detail_px`` : how far the traced border strays from ``polygon_px`` at most, in pixels:
+    what the simplification left out (a step or notch shorter than an edge it keeps); 0
+    when the shape was not traced from pixels.
     """
 
     colour_rgb: tuple[int, int, int]
@@ -36,6 +39,7 @@ class Shape:
     area_px: float
     centroid_px: tuple[float, float]
     cut_by_border: bool
+    detail_px: float = 0.0
 
     @classmethod
     def from_rings(
@@ -45,6 +49,7 @@ class Shape:
         polygon_px: FloatArray,
         holes_px: tuple[FloatArray, ...] = (),
         cut_by_border: bool = False,
+        detail_px: float = 0.0,
     ) -> Shape:
         """A shape whose orientation, area and centroid are computed from its rings."""
         outer = orient(np.asarray(polygon_px, dtype=np.float64), positive=True)
@@ -52,7 +57,7 @@ class Shape:
         rings = (outer, *holes)
         area, cu, cv = _area_moments(rings)
         centroid = (cu / area, cv / area) if area != 0.0 else _vertex_mean(outer)
-        return cls(colour_rgb, outer, holes, area, centroid, cut_by_border)
+        return cls(colour_rgb, outer, holes, area, centroid, cut_by_border, detail_px)
 
 
 def signed_area(ring: FloatArray) -> float:

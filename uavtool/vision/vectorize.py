@@ -19,7 +19,7 @@ import numpy.typing as npt
 
 from uavtool.vision.colour import brightest_shade, hue_distance_deg, hue_lut, hue_of
 from uavtool.vision.errors import ImageError
-from uavtool.vision.outline import offset_ring, simplify_rings
+from uavtool.vision.outline import offset_ring, simplify_rings_detail
 from uavtool.vision.params import VectorizeParams
 from uavtool.vision.roof import INSET_PX, far_edge_pixels, roof_value
 from uavtool.vision.shapes import FloatArray, Shape, orient
@@ -157,15 +157,16 @@ def _traced(
 ) -> list[tuple[int, _Region, Shape]]:
     """(order, region, shape with its inside colour) for each region whose outline keeps
     three corners once the outlines are simplified together."""
-    rings = simplify_rings([c for r in regions for c in (r.outer, *r.holes)], p)
+    rings, details = simplify_rings_detail([c for r in regions for c in (r.outer, *r.holes)], p)
     out: list[tuple[int, _Region, Shape]] = []
     at = 0
     for order, r in enumerate(regions):
         outer, holes = rings[at], rings[at + 1 : at + 1 + len(r.holes)]
+        detail = details[at]
         at += 1 + len(r.holes)
         if len(outer) < 3:
             continue
-        shape = _offset_shape(outer, tuple(h for h in holes if len(h) >= 3), r.cut, p)
+        shape = _offset_shape(outer, tuple(h for h in holes if len(h) >= 3), r.cut, detail, p)
         out.append((order, r, _with_colour(shape, _inside_colour(frame, r, shape))))
     return out
 
@@ -535,7 +536,7 @@ def _shows_other(hole: CvArray, colour: CvArray, origin: tuple[int, int], least:
 
 
 def _offset_shape(
-    outer: FloatArray, holes: tuple[FloatArray, ...], cut: bool, p: VectorizeParams
+    outer: FloatArray, holes: tuple[FloatArray, ...], cut: bool, detail: float, p: VectorizeParams
 ) -> Shape:
     outer = orient(outer, positive=True)
     holes = tuple(orient(h, positive=False) for h in holes)
@@ -544,6 +545,7 @@ def _offset_shape(
         polygon_px=offset_ring(outer, p.edge_offset_px),
         holes_px=tuple(offset_ring(h, p.edge_offset_px) for h in holes),
         cut_by_border=cut,
+        detail_px=detail,
     )
 
 
@@ -555,6 +557,7 @@ def _with_colour(shape: Shape, colour_rgb: tuple[int, int, int]) -> Shape:
         shape.area_px,
         shape.centroid_px,
         shape.cut_by_border,
+        shape.detail_px,
     )
 
 

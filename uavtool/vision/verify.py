@@ -36,24 +36,41 @@ _DENSIFY = 0.02  # Hausdorff's densification: segments split into 2 % pieces
 
 def outline_accuracy_px(params: VectorizeParams) -> float:
     """How far (pixels) a vectorized outline may lie from the true one, its size and turn
-    aside: half a pixel of grid and the simplification's tolerance. The denoising's median
-    rounds corners, but each corner is then put where its two edges' lines meet
-    (``refine_corners``), so it moves no vertex. Measured (`benchmarks/bench_near_shapes.py
-    --accuracy`: 3,000 rectangles, L, T and U shapes at any turn, σ 3 DN of noise, put on
-    the true outline at unit area), a vectorized outline lies a median 0.8 px from the true
-    one; this bound, 2 px with the default parameters, holds for 98.8 % of outlines and for
-    99 % of those 100-400 px across (99th percentile 1.6 px). Under 100 px across, edges
-    shorter than ``min_edge_px`` are lost and 1 outline in 50 lies further."""
+    aside. With ``refine_corners`` (the default) every corner is where lines fitted to its
+    two edges meet: along an edge the pixel grid's error averages out, except along an edge
+    that runs with the grid, whose every pixel is off by the same fraction. A corner between
+    two such edges is known only to the pixel it falls in: half its diagonal, √2 / 2 px.
+    Without ``refine_corners`` the corners are the simplification's points: half a pixel of
+    grid and the simplification's tolerance.
+
+    Measured (`benchmarks/bench_near_shapes.py --accuracy`: 3,000 rectangles, L, T and U
+    shapes at any turn drawn by the renderer's pixel-centre rule, σ 3 DN of noise, put on
+    the true outline at unit area), a vectorized outline lies a median 0.1 px from the true
+    one; of outlines 100 px across or more, 99.6 % lie within √2 / 2 px. Under 100 px across,
+    edges shorter than ``min_edge_px`` are lost and 1 outline in 20 lies further (a photo
+    that draws the target so small is not judged, `uavtool.mission.analysis.judge`)."""
+    if params.refine_corners:
+        return math.sqrt(0.5)
     return 0.5 + params.rdp_epsilon_px
 
 
 def outline_tolerance(
-    reference: Shape, candidate: Shape, accuracy_px: float, reference_accuracy_px: float
+    reference: Shape,
+    candidate: Shape,
+    accuracy_px: float,
+    reference_accuracy_px: float,
 ) -> float:
     """The largest gap (at unit area) two vectorized outlines of one footprint may show: each
-    outline's accuracy in its own pixels, at its own scale."""
-    return reference_accuracy_px / math.sqrt(max(reference.area_px, 1.0)) + accuracy_px / (
-        math.sqrt(max(candidate.area_px, 1.0))
+    outline's accuracy in its own pixels, at its own scale. The reference outline, when it
+    leaves out more of its traced border than that (``Shape.detail_px``: a step or notch
+    shorter than an edge it keeps, the tiers of a building at several heights drawn a few
+    pixels apart), is known only to what it left out; so is the candidate's. (A candidate
+    that left out the very feature that makes it another building, a notch its photo drew
+    too small to keep, is then taken for the target: a closer photo draws that feature.)"""
+    ref_px = max(reference_accuracy_px, reference.detail_px)
+    cand_px = max(accuracy_px, candidate.detail_px)
+    return ref_px / math.sqrt(max(reference.area_px, 1.0)) + cand_px / math.sqrt(
+        max(candidate.area_px, 1.0)
     )
 
 

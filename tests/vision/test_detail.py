@@ -1,0 +1,55 @@
+"""What an outline leaves out (``Shape.detail_px``) and the outline tolerance it widens."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from uavtool.vision import Shape, VectorizeParams, vectorize
+from uavtool.vision.io import shapes_from_json, shapes_to_json
+from uavtool.vision.verify import outline_accuracy_px, outline_tolerance
+from uavtool.world.raster import paint_polygon
+
+RED = (210, 40, 40)
+SLOTTED = [(60.0, 50.0), (150.0, 50.0), (150.0, 55.0), (155.0, 55.0), (155.0, 50.0),
+           (250.0, 50.0), (250.0, 170.0), (60.0, 170.0)]  # fmt: skip
+
+
+def _one(ring: list[tuple[float, float]]) -> Shape:
+    image = np.full((240, 320, 3), 128, np.uint8)
+    paint_polygon(image, np.array(ring, dtype=np.float64), RED)
+    (shape,) = vectorize(image, VectorizeParams())
+    return shape
+
+
+def test_paint_polygon_covers_the_pixels_whose_centres_are_inside() -> None:
+    image = np.zeros((10, 10), np.uint8)
+    paint_polygon(image, np.array([[1.0, 1.0], [6.0, 1.0], [6.0, 4.0], [1.0, 4.0]]), 1)
+    assert int(image.sum()) == 5 * 3  # columns 1-5, rows 1-3
+    assert image[1, 1] == 1 and image[4, 1] == 0 and image[1, 6] == 0
+
+
+def test_a_clean_outline_leaves_out_no_more_than_its_pixels() -> None:
+    shape = _one([(60.3, 50.2), (250.7, 70.9), (240.1, 180.4), (50.6, 160.8)])
+    assert shape.detail_px < 1.5
+    assert outline_accuracy_px(VectorizeParams()) == np.sqrt(0.5)
+
+
+def test_a_notch_shorter_than_an_edge_kept_is_what_the_outline_left_out() -> None:
+    """A 5 px slot in the long edge of a 190 px rectangle: its edges under ``min_edge_px``
+    (8), so the outline keeps the plain rectangle and says it left out about the slot's
+    depth."""
+    ring = SLOTTED
+    shape = _one(ring)
+    assert len(shape.polygon_px) == 4
+    assert 3.0 <= shape.detail_px <= 7.0
+    clean = _one([(60.0, 50.0), (250.0, 50.0), (250.0, 170.0), (60.0, 170.0)])
+    accuracy = outline_accuracy_px(VectorizeParams())
+    assert outline_tolerance(clean, shape, accuracy, accuracy) > outline_tolerance(
+        clean, clean, accuracy, accuracy
+    )
+
+
+def test_detail_survives_the_shapes_file() -> None:
+    shape = _one(SLOTTED)
+    (back,) = shapes_from_json(shapes_to_json((shape,), width_px=320, height_px=240))
+    assert back.detail_px == shape.detail_px
