@@ -6,7 +6,7 @@ import numpy as np
 
 from uavtool.vision import Shape, VectorizeParams, vectorize
 from uavtool.vision.io import shapes_from_json, shapes_to_json
-from uavtool.vision.verify import outline_accuracy_px, outline_tolerance
+from uavtool.vision.verify import hides_detail, outline_accuracy_px, outline_tolerance
 from uavtool.world.raster import paint_polygon
 
 RED = (210, 40, 40)
@@ -53,3 +53,40 @@ def test_detail_survives_the_shapes_file() -> None:
     shape = _one(SLOTTED)
     (back,) = shapes_from_json(shapes_to_json((shape,), width_px=320, height_px=240))
     assert back.detail_px == shape.detail_px
+
+
+def test_a_line_of_wall_into_the_roof_is_no_detail_left_out() -> None:
+    """The wall between two roofs of one building, seen as a dark line of its paint running
+    into the roof from its edge: the roof's border follows it as a slit 40 px deep, but the
+    building's own wall is the building. (What is left is the slit's mouth, a step of its
+    width the outline kept.)"""
+    image = np.full((240, 320, 3), 128, np.uint8)
+    paint_polygon(
+        image, np.array([(60.0, 50.0), (250.0, 50.0), (250.0, 170.0), (60.0, 170.0)]), RED
+    )
+    wall = (120, 20, 20)  # the roof's paint, in shade
+    paint_polygon(
+        image, np.array([(150.0, 49.0), (152.0, 49.0), (152.0, 90.0), (150.0, 90.0)]), wall
+    )
+    # a photo from above, roofs only: the wall is no roof, and the roof's border runs into it
+    (shape,) = [
+        s for s in vectorize(image, VectorizeParams(roof_only=True)) if s.colour_rgb[0] > 180
+    ]
+    assert shape.detail_px < 4.0
+
+
+def test_a_notch_the_target_picture_would_draw_is_not_judged_from_a_coarser_photo() -> None:
+    """The slotted rectangle's 5 px slot is lost in its outline. A reference photo drawing a
+    plain rectangle at the same scale could not show such a slot either (under
+    `min_edge_px`); one drawing it three times larger would (15 px): the candidate leaves
+    out what that reference shows, and is not judged from this photo."""
+    slotted = _one(SLOTTED)
+    min_edge = VectorizeParams().min_edge_px
+    same_scale = _one([(60.0, 50.0), (250.0, 50.0), (250.0, 170.0), (60.0, 170.0)])
+    assert not hides_detail(same_scale, slotted, min_edge)
+    image = np.full((480, 680, 3), 128, np.uint8)
+    paint_polygon(
+        image, np.array([(30.0, 40.0), (600.0, 40.0), (600.0, 400.0), (30.0, 400.0)]), RED
+    )
+    (finer,) = vectorize(image, VectorizeParams())
+    assert hides_detail(finer, slotted, min_edge)

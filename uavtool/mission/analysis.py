@@ -25,7 +25,12 @@ from uavtool.vision import Shape, best_match, mirror_score, vectorize
 from uavtool.vision.merge import merge_touching
 from uavtool.vision.model3d import central_shape
 from uavtool.vision.vectorize import ground_mask, hue_distance_deg, inner_walls
-from uavtool.vision.verify import outline_accuracy_px, outline_gap, outline_tolerance
+from uavtool.vision.verify import (
+    hides_detail,
+    outline_accuracy_px,
+    outline_gap,
+    outline_tolerance,
+)
 
 
 def nadir_shapes(params: Params, image_rgb: U8Array) -> tuple[Shape, ...]:
@@ -86,7 +91,9 @@ class Judgement:
     too_small: bool = False
     """The candidate is drawn too small to tell the target's corners (not judgeable): at
     its size a quarter of the target's edges would be shorter than the vectorizer keeps an
-    edge (``vectorize.min_edge_px``). A closer look may judge it; a higher one cannot."""
+    edge (``vectorize.min_edge_px``), or its outline leaves out (``Shape.detail_px``) a
+    feature the target picture would draw as an edge. A closer look may judge it; a higher
+    one cannot."""
 
     @property
     def outline_fits(self) -> bool:
@@ -143,10 +150,8 @@ def judge(
     score = scores[candidate]
     judgeable = matches[candidate].judgeable
     # at the candidate's size, would three quarters of the target's edges be edges at all?
-    too_small = judgeable and (
-        quartile_edge_share(target) * math.sqrt(max(centre.area_px, 0.0))
-        < params.vectorize.min_edge_px
-    )
+    size = math.sqrt(max(centre.area_px, 0.0))
+    too_small = judgeable and quartile_edge_share(target) * size < params.vectorize.min_edge_px
     judgeable = judgeable and not too_small
     hue_limit = params.mission.match_hue_tolerance_deg
     same_hue = hue_limit <= 0 or hue_distance_deg(centre.colour_rgb, target.colour_rgb) <= hue_limit
@@ -158,6 +163,11 @@ def judge(
     # is another building, however well the outer outlines agree
     same_holes = len(centre.holes_px) == len(target.holes_px)
     matched = judgeable and same_hue and not_mirror and same_holes and score >= rp.threshold
+    # its corners are the target's, but does its outline leave out (`Shape.detail_px`) what
+    # the target picture would draw as an edge? A notch or a cut corner drawn too small to
+    # keep may be what makes it another building: not judged from here, a closer look may
+    if matched and hides_detail(target, centre, params.vectorize.min_edge_px):
+        matched, judgeable, too_small = False, False, True
     outline, tolerance, tiers = 0.0, 0.0, False
     if matched:
         # the corners agree; the outline must also lie on the target's: a near shape (a

@@ -48,12 +48,12 @@ def simplify_rings_detail(
             straight_tolerance_px=p.straight_tolerance_px,
         )
     return rings, [
-        max(ring_detail(d, r), _longest_stub(r, p.min_edge_px))
+        max(ring_detail(d, r), longest_stub(r, p.min_edge_px))
         for d, r in zip(dense, rings, strict=True)
     ]
 
 
-def _longest_stub(ring_px: FloatArray, min_edge_px: float) -> float:
+def longest_stub(ring_px: FloatArray, min_edge_px: float) -> float:
     """The longest edge of ``ring_px`` shorter than ``min_edge_px`` (0 if none): a step the
     outline kept at the limit of what it keeps, which another photo may draw as a slant or
     not at all."""

@@ -19,7 +19,13 @@ import numpy.typing as npt
 
 from uavtool.vision.colour import brightest_shade, hue_distance_deg, hue_lut, hue_of
 from uavtool.vision.errors import ImageError
-from uavtool.vision.outline import offset_ring, simplify_rings_detail
+from uavtool.vision.outline import (
+    longest_stub,
+    offset_ring,
+    resample_ring,
+    ring_detail,
+    simplify_rings_detail,
+)
 from uavtool.vision.params import VectorizeParams
 from uavtool.vision.roof import INSET_PX, far_edge_pixels, roof_value
 from uavtool.vision.shapes import FloatArray, Shape, orient
@@ -167,8 +173,51 @@ def _traced(
         if len(outer) < 3:
             continue
         shape = _offset_shape(outer, tuple(h for h in holes if len(h) >= 3), r.cut, detail, p)
-        out.append((order, r, _with_colour(shape, _inside_colour(frame, r, shape))))
+        shape = _with_colour(shape, _inside_colour(frame, r, shape))
+        if detail > _STAIRCASE_PX:
+            shape = _with_detail(shape, _detail_with_walls(frame, r, outer, shape, p))
+        out.append((order, r, shape))
     return out
+
+
+_STAIRCASE_PX = 1.0
+"""A traced border within this of its outline is the pixel grid's staircase: nothing left
+out worth looking at again."""
+
+
+def _detail_with_walls(
+    frame: U8Array, r: _Region, outer: FloatArray, shape: Shape, p: VectorizeParams
+) -> float:
+    """What ``shape``'s outline (``outer`` before its edge offset) leaves out of its region
+    once the building's own walls inside the outline count as the building: the line of
+    wall between two roofs of one building, which the roof's border runs into as a slit, is
+    none of the footprint's detail; a step between its tiers, or a notch, is."""
+    x, y, w, h = cv2.boundingRect(r.contour)
+    box = (slice(y, y + h), slice(x, x + w))
+    region: CvArray = np.zeros((h, w), np.uint8)
+    cv2.drawContours(region, [r.contour], 0, 255, cv2.FILLED, offset=(-x, -y))
+    inside: CvArray = np.zeros((h, w), np.uint8)
+    cv2.fillPoly(inside, [_ring(shape.polygon_px - (x, y))], 255)
+    walls = same_paint(frame[box], shape.colour_rgb) & (inside > 0)
+    region[walls] = 255
+    contours, _ = cv2.findContours(region, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE, offset=(x, y))
+    if not contours:
+        return 0.0
+    border = max(contours, key=cv2.contourArea)[:, 0, :].astype(np.float64)
+    left_out = ring_detail(resample_ring(border, p.point_spacing_px), outer)
+    return max(left_out, longest_stub(outer, p.min_edge_px))
+
+
+def _with_detail(shape: Shape, detail_px: float) -> Shape:
+    return Shape(
+        shape.colour_rgb,
+        shape.polygon_px,
+        shape.holes_px,
+        shape.area_px,
+        shape.centroid_px,
+        shape.cut_by_border,
+        detail_px,
+    )
 
 
 def non_ground(

@@ -28,7 +28,13 @@ from uavtool.vision.align import Match
 from uavtool.vision.params import VectorizeParams
 from uavtool.vision.shapes import FloatArray, Shape
 
-__all__ = ["outline_accuracy_px", "outline_fits", "outline_gap", "outline_tolerance"]
+__all__ = [
+    "hides_detail",
+    "outline_accuracy_px",
+    "outline_fits",
+    "outline_gap",
+    "outline_tolerance",
+]
 
 _REFINE_DEG = (4.0, 1.0, 0.25, 0.0625)  # the rotation searched around the match's, finer each pass
 _DENSIFY = 0.02  # Hausdorff's densification: segments split into 2 % pieces
@@ -74,6 +80,19 @@ def outline_tolerance(
     )
 
 
+def hides_detail(reference: Shape, candidate: Shape, reference_min_edge_px: float) -> bool:
+    """Whether ``candidate``'s outline leaves out (``Shape.detail_px``) a feature the
+    reference's photo would have drawn as an edge of its outline: at least
+    ``reference_min_edge_px`` long at the reference's scale (a notch or a cut corner this
+    photo drew too small to keep, or a blurred outline a few pixels across). Whether such a
+    candidate is the reference cannot be told from this photo: the feature may be what makes
+    it another building. A closer photo draws it."""
+    scale = math.sqrt(max(reference.area_px, 0.0))
+    return candidate.detail_px * scale >= reference_min_edge_px * math.sqrt(
+        max(candidate.area_px, 0.0)
+    )
+
+
 def outline_fits(
     reference: Shape,
     candidate: Shape,
@@ -83,9 +102,12 @@ def outline_fits(
 ) -> bool:
     """Whether ``candidate`` (vectorized with ``params``) lies on ``reference`` (vectorized
     with ``reference_params``, by default the same) as closely as one footprint photographed
-    twice can: `outline_gap` within `outline_tolerance`."""
+    twice can: `outline_gap` within `outline_tolerance`, and nothing left out of it that
+    the reference would show (`hides_detail`)."""
     p = params if params is not None else VectorizeParams()
     q = reference_params if reference_params is not None else p
+    if hides_detail(reference, candidate, q.min_edge_px):
+        return False
     tolerance = outline_tolerance(
         reference, candidate, outline_accuracy_px(p), outline_accuracy_px(q)
     )
