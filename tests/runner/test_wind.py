@@ -47,8 +47,8 @@ def test_photos_record_the_pose_they_were_taken_from_in_gusty_wind(
 
 
 def test_wind_makes_the_flight_longer_and_costs_battery() -> None:
-    calm = fly(FlyConfig(record=None))
-    windy = fly(FlyConfig(wind=(10.0, 270.0), vehicle_params=TURBULENT, record=None))
+    calm = fly(FlyConfig(no_record=True))
+    windy = fly(FlyConfig(wind=(10.0, 270.0), vehicle_params=TURBULENT, no_record=True))
     for s in (calm, windy):
         assert s.outcome.status is Status.COMPLETED, s.outcome.reason
     assert windy.flight_time_s > calm.flight_time_s
@@ -58,7 +58,7 @@ def test_wind_makes_the_flight_longer_and_costs_battery() -> None:
 def test_a_wind_the_vehicle_cannot_hold_ends_the_flight_honestly() -> None:
     """16 m/s: past what a 30° lean holds (~10 m/s of airspeed for this airframe), the vehicle
     drifts downwind; the mission sees it never reaches its overview point and gives up."""
-    summary = fly(FlyConfig(wind=(16.0, 270.0), vehicle_params=TURBULENT, record=None))
+    summary = fly(FlyConfig(wind=(16.0, 270.0), vehicle_params=TURBULENT, no_record=True))
     assert summary.outcome.status is Status.ABORTED
     assert "never reached" in summary.outcome.reason
     assert summary.evaluation.matched_building == ""
