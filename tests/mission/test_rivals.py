@@ -157,3 +157,18 @@ def test_a_closer_look_tells_the_target_from_a_near_shape_that_matched_too() -> 
     summary = fly_scene(FlyConfig(scene=str(DATA / "near-46009.yaml"), no_record=True))
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == "b00"
+
+
+def test_a_near_shape_matched_from_afar_is_not_modelled_when_the_top_photo_tells() -> None:
+    """World scene 49346 (every world knob on): a decoy with one corner chamfered matched the
+    small convex target from a look that drew it 29 px across (the target picture: 64 px),
+    within what that scale tells. The top photo, closer, shows it as much like the target's
+    mirror image: the mission ends no-match instead of modelling it as the target."""
+    summary = fly_scene(FlyConfig(scene=str(DATA / "world-49346.yaml"), no_record=True))
+    outcome = summary.outcome
+    assert outcome.status is Status.NO_MATCH, outcome.reason
+    assert "the top photo, closer, shows it as much like the target's mirror image" in (
+        outcome.reason
+    )
+    assert outcome.matched_poi == -1 and not outcome.model_built
+    assert summary.evaluation.matched_building != "b09"

@@ -8,9 +8,9 @@ import dataclasses
 import math
 from typing import TYPE_CHECKING
 
-from uavtool.mission.analysis import aimed_shape, roof_between
+from uavtool.mission.analysis import aimed_shape, judge, roof_between
 from uavtool.mission.observations import Photo
-from uavtool.mission.outputs import DiagonalView, Level, ModelBuilt, Viewpoints
+from uavtool.mission.outputs import DiagonalView, Level, ModelBuilt, Status, Viewpoints
 from uavtool.mission.search import Found, photo_shapes
 from uavtool.mission.sides import SidePlan, side_view
 from uavtool.mission.survey import (
@@ -33,6 +33,7 @@ from uavtool.nav import (
 )
 from uavtool.nav.heights import fit_altitude_m
 from uavtool.nav.viewpoints import farther, for_building
+from uavtool.vision import Shape
 from uavtool.vision.errors import VisionError
 from uavtool.vision.model3d import (
     Model,
@@ -44,6 +45,54 @@ from uavtool.vision.model3d import (
 if TYPE_CHECKING:
     from uavtool.mission.base import Wait
     from uavtool.mission.mission import SearchMission
+
+
+def _still_the_target(
+    m: SearchMission, found: Found, photo: Photo, shapes: tuple[Shape, ...]
+) -> None:
+    """The top photo is the closest look at the match and draws it larger than the look
+    did. Where its corners score at the threshold again (and its hue is the target's), the
+    building must still be more like the target than like the target's mirror image, and
+    show as many courtyards as the target picture: a near shape the look drew too small to
+    tell apart may fail either here. The mission then ends NO_MATCH rather than model
+    another building. Its outline is not judged again from here: a building at several
+    heights seen this close lies off its own outline from afar by its tiers' perspective
+    (paper's red, under a low sun, 4.5 % off), so the event only reports it. (Corners under
+    the threshold prove nothing either: a tall building's walls seen close change them.)"""
+    j = judge(
+        m.params,
+        m.target,
+        shapes,
+        photo.intrinsics,
+        found.shape.colour_rgb,
+        target_stepped=m.target_stepped,
+    )
+    if j.candidate < 0 or not j.judgeable or not j.same_hue:
+        return
+    if j.score < m.params.recognize.threshold:
+        return
+    shape = shapes[j.candidate]
+    if not j.not_mirror:
+        why = f"as much like the target's mirror image ({j.mirror_score:.3f})"
+    elif len(shape.holes_px) != len(m.target.holes_px):
+        why = (
+            f"{len(shape.holes_px)} courtyard(s) where the target picture shows "
+            f"{len(m.target.holes_px)}"
+        )
+    else:
+        if j.outline_tolerance > 0.0:
+            m.event(
+                Level.INFO,
+                f"top photo: outline {j.outline_gap * 100:.1f} % of its size off the target's "
+                f"(the photos' accuracy {j.outline_tolerance * 100:.1f} %; not judged this close)",
+            )
+        return
+    m.matched_poi, m.match_score = -1, 0.0
+    raise m.end(
+        Status.NO_MATCH,
+        f"point of interest {found.poi.index} matched, but the top photo, closer, shows it "
+        f"{why}: not the target",
+    )
 
 
 def photograph_and_model(
@@ -104,6 +153,7 @@ def photograph_and_model(
     else:
         m.no_model = f"the top photo never showed the whole building ({p.max_looks} tries)"
         return
+    _still_the_target(m, found, top_photo, top_shapes)
     if not found.roof_measured:
         # The look and the top photo see the building whole from two places: its height,
         # which neither the overview nor a photo from another altitude could tell (a tower
