@@ -72,7 +72,7 @@ def ring_detail(points_px: FloatArray, ring_px: FloatArray) -> float:
     points."""
     if len(ring_px) < 2 or len(points_px) == 0:
         return 0.0
-    a = ring_px[:, None, :]  # (1... segments) start
+    a = ring_px[:, None, :]  # (m, 1, 2): each segment's start
     ab = np.roll(ring_px, -1, axis=0)[:, None, :] - a
     ap = points_px[None, :, :] - a
     length2 = ab[..., 0] * ab[..., 0] + ab[..., 1] * ab[..., 1]

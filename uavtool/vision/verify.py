@@ -70,9 +70,9 @@ def outline_tolerance(
     outline's accuracy in its own pixels, at its own scale. The reference outline, when it
     leaves out more of its traced border than that (``Shape.detail_px``: a step or notch
     shorter than an edge it keeps, the tiers of a building at several heights drawn a few
-    pixels apart), is known only to what it left out; so is the candidate's. (A candidate
-    that left out the very feature that makes it another building, a notch its photo drew
-    too small to keep, is then taken for the target: a closer photo draws that feature.)"""
+    pixels apart), is known only to what it left out; so is the candidate's, as far as the
+    reference could not have drawn it either (one that left out more is not judged at all:
+    `hides_detail`)."""
     ref_px = max(reference_accuracy_px, reference.detail_px)
     cand_px = max(accuracy_px, candidate.detail_px)
     return ref_px / math.sqrt(max(reference.area_px, 1.0)) + cand_px / math.sqrt(
@@ -87,6 +87,8 @@ def hides_detail(reference: Shape, candidate: Shape, reference_min_edge_px: floa
     photo drew too small to keep, or a blurred outline a few pixels across). Whether such a
     candidate is the reference cannot be told from this photo: the feature may be what makes
     it another building. A closer photo draws it."""
+    if candidate.detail_px <= 0.0:
+        return False
     scale = math.sqrt(max(reference.area_px, 0.0))
     return candidate.detail_px * scale >= reference_min_edge_px * math.sqrt(
         max(candidate.area_px, 0.0)
