@@ -22,19 +22,14 @@ from uavtool.vision.shapes import FloatArray
 _MAX_MITRE = 3.0
 
 
-def simplify_rings(contours_px: list[npt.NDArray[Any]], p: VectorizeParams) -> list[FloatArray]:
-    """Each closed pixel border ``(n, 2)`` as a simplified ring ``(m, 2)`` (``m`` may be < 3
-    for a border too small to make a polygon)."""
-    return simplify_rings_detail(contours_px, p)[0]
-
-
 def simplify_rings_detail(
     contours_px: list[npt.NDArray[Any]], p: VectorizeParams
 ) -> tuple[list[FloatArray], list[float]]:
-    """:func:`simplify_rings`, and how much detail each ring holds at the limit of what it
-    can be trusted with, in pixels: how far its border strays from it (:func:`ring_detail`:
-    what the simplification left out), or its longest edge shorter than ``min_edge_px``
-    when longer (a step kept at the limit), whichever is more."""
+    """Each closed pixel border ``(n, 2)`` as a simplified ring ``(m, 2)`` (``m`` may be < 3
+    for a border too small to make a polygon), and how much detail each ring holds at the
+    limit of what it can be trusted with, in pixels: how far its border strays from it
+    (:func:`ring_detail`: what the simplification left out), or its longest edge shorter
+    than ``min_edge_px`` when longer (a step kept at the limit), whichever is more."""
     dense = [resample_ring(c.astype(np.float64), p.point_spacing_px) for c in contours_px]
     kept = rdp_rings_indices(dense, p.rdp_epsilon_px)
     if not p.refine_corners:

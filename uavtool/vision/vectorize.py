@@ -11,6 +11,7 @@ together (:mod:`uavtool.vision.outline`).
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any, NamedTuple
 
 import cv2
@@ -173,9 +174,10 @@ def _traced(
         if len(outer) < 3:
             continue
         shape = _offset_shape(outer, tuple(h for h in holes if len(h) >= 3), r.cut, detail, p)
-        shape = _with_colour(shape, _inside_colour(frame, r, shape))
+        shape = dataclasses.replace(shape, colour_rgb=_inside_colour(frame, r, shape))
         if detail > _STAIRCASE_PX:
-            shape = _with_detail(shape, _detail_with_walls(frame, r, outer, shape, p))
+            detail = _detail_with_walls(frame, r, outer, shape, p)
+            shape = dataclasses.replace(shape, detail_px=detail)
         out.append((order, r, shape))
     return out
 
@@ -206,18 +208,6 @@ def _detail_with_walls(
     border = max(contours, key=cv2.contourArea)[:, 0, :].astype(np.float64)
     left_out = ring_detail(resample_ring(border, p.point_spacing_px), outer)
     return max(left_out, longest_stub(outer, p.min_edge_px))
-
-
-def _with_detail(shape: Shape, detail_px: float) -> Shape:
-    return Shape(
-        shape.colour_rgb,
-        shape.polygon_px,
-        shape.holes_px,
-        shape.area_px,
-        shape.centroid_px,
-        shape.cut_by_border,
-        detail_px,
-    )
 
 
 def non_ground(
@@ -595,18 +585,6 @@ def _offset_shape(
         holes_px=tuple(offset_ring(h, p.edge_offset_px) for h in holes),
         cut_by_border=cut,
         detail_px=detail,
-    )
-
-
-def _with_colour(shape: Shape, colour_rgb: tuple[int, int, int]) -> Shape:
-    return Shape(
-        colour_rgb,
-        shape.polygon_px,
-        shape.holes_px,
-        shape.area_px,
-        shape.centroid_px,
-        shape.cut_by_border,
-        shape.detail_px,
     )
 
 
