@@ -51,6 +51,8 @@ class FakeVehicle:
     ``deny``: command keys refused for good (``MAV_RESULT_DENIED``, a final answer).
     ``stuck``: GoTo targets are taken but the vehicle never moves toward them.
     ``airborne``: start there, armed and in LOITER, instead of on the ground at home.
+    ``disarm_on_ground_s``: armed and still at ground level that long, it disarms itself (PX4's
+    ``COM_DISARM_PRFLT``, ArduCopter's ``DISARM_DELAY``).
     Rates: horizontal ``speed_m_s``, vertical ``climb_m_s``, yaw and gimbal in degrees/s.
     """
 
@@ -69,6 +71,7 @@ class FakeVehicle:
         deny: frozenset[str] = frozenset(),
         stuck: bool = False,
         airborne: Vec3 | None = None,
+        disarm_on_ground_s: float | None = None,
     ) -> None:
         self.scene = scene
         self.intrinsics = intrinsics
@@ -96,6 +99,8 @@ class FakeVehicle:
         self.rtl_cruise_m = rtl_alt_m
         if airborne is not None:  # already flying, as a pilot left it
             self.pos, self.mode, self.armed, self.landed = airborne, "LOITER", True, False
+        self.disarm_on_ground_s = disarm_on_ground_s
+        self._on_ground_armed_ms = 0
         self.frames = 0
         self.received: list[Command] = []  # every command that reached the vehicle
 
@@ -198,6 +203,14 @@ class FakeVehicle:
         self.gimbal_pitch_deg += max(-limit, min(limit, turn))
         if self.armed and self.pos[2] <= 0.0 and self.mode in ("RTL", "LAND"):
             self.landed, self.armed = True, False  # on the ground: ArduCopter lands and disarms
+        self._on_ground_armed_ms = (
+            self._on_ground_armed_ms + TICK_MS if self.armed and self.pos[2] <= 0.0 else 0
+        )
+        if (
+            self.disarm_on_ground_s is not None
+            and self._on_ground_armed_ms >= self.disarm_on_ground_s * 1000.0
+        ):
+            self.landed, self.armed = True, False
 
     def _target(self) -> Vec3 | None:
         x, y, z = self.pos

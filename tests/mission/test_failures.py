@@ -187,6 +187,19 @@ def test_take_off_accepted_but_never_climbing_aborts(paper: Scene) -> None:
     assert_home_safely(flown)
 
 
+def test_a_take_off_that_never_leaves_the_ground_is_no_crash(paper: Scene) -> None:
+    """The vehicle accepts the take-off but never climbs, and its autopilot disarms it on the
+    ground after 2 s (as PX4 did once under load): the flight never left home, so it is
+    aborted, not crashed. (A disarm after the climb is a crash: tests/runner/test_fly.py.)"""
+    flown = fly(paper, climb_m_s=0.0, disarm_on_ground_s=2.0)
+    assert flown.outcome.status is Status.ABORTED
+    assert flown.outcome.reason == (
+        "the vehicle disarmed on the ground at 0.0 m: the take-off never left it"
+    )
+    assert flown.flight.texts()[-1] == "landed and disarmed"
+    assert not [c for c in _commands(flown.flight.outputs) if isinstance(c, GoTo)]
+
+
 def test_gimbal_never_reporting_its_pitch_warns_and_photographs_anyway(paper: Scene) -> None:
     """A gimbal that reports another pitch than commanded: the mission waits, warns and takes
     the photo at the reported pose (here: looking at the horizon, so it sees no roof)."""

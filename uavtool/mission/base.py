@@ -133,6 +133,7 @@ class FlightMission:
         self._expected_modes: frozenset[str] = frozenset()
         self._link_was_lost = False
         self._airborne = False  # from take-off until landed: disarming in the air is a crash
+        self._left_ground = False  # seen above home's height tolerance since the take-off
         self._landing = False  # RTL or LAND sent: a disarm on the ground at home is the landing
         self._deferred: list[Observation] = []
         self._gen = self._run()
@@ -298,7 +299,16 @@ class FlightMission:
                 continue
             if isinstance(obs, Telemetry):
                 self.last = obs
+                if self._airborne and obs.pos_enu_m[2] > _HOME_HEIGHT_TOLERANCE_M:
+                    self._left_ground = True
                 if self._airborne and not obs.armed and not self._landed_at_home(obs):
+                    if not self._left_ground and abs(obs.pos_enu_m[2]) <= _HOME_HEIGHT_TOLERANCE_M:
+                        # e.g. PX4 disarming on the ground after a take-off it never flew
+                        raise MissionEnd(
+                            Status.ABORTED,
+                            f"the vehicle disarmed on the ground at {obs.pos_enu_m[2]:.1f} m: "
+                            "the take-off never left it",
+                        )
                     raise MissionEnd(
                         Status.CRASHED,
                         f"the vehicle disarmed in the air at {obs.pos_enu_m[2]:.1f} m "
@@ -492,9 +502,12 @@ class FlightMission:
         if not climbed:
             raise MissionEnd(Status.ABORTED, f"take-off: {alt_m:g} m never reached")
 
-    def airborne(self) -> None:
-        """From now until the return home, a vehicle that disarms has crashed."""
+    def airborne(self, *, flying: bool = False) -> None:
+        """From now until the return home, a vehicle that disarms has crashed; one that
+        disarms on the ground before it was ever seen above home's height tolerance never took
+        off (aborted). ``flying``: it is already in the air (taken over from a pilot)."""
         self._airborne = True
+        self._left_ground = self._left_ground or flying
 
 
 def _move_time_s(t: Telemetry | None, pos_enu_m: Vec3, p: FlightParams) -> float:

@@ -29,7 +29,7 @@ def fly(m: SearchMission) -> Wait[None]:
     if last.armed and not last.landed:
         m.event(Level.INFO, "already flying: taking control in GUIDED")
         yield from m.set_mode("GUIDED")
-        m.airborne()
+        m.airborne(flying=True)
     else:
         yield from m.arm_and_take_off(p.overview_alt_m)
     here = m.last.pos_enu_m if m.last else (0.0, 0.0, 0.0)
