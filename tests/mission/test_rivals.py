@@ -6,12 +6,23 @@ from __future__ import annotations
 import dataclasses
 import math
 from pathlib import Path
+from types import SimpleNamespace
+from typing import cast
+
+import numpy as np
+import pytest
 
 from tests.mission.driver import fly
-from uavtool.mission import Status
+from tests.mission.fakes import INTRINSICS
+from uavtool.mission import MissionInputs, Params, Photo, SearchMission, Status
+from uavtool.mission.base import MissionEnd
+from uavtool.mission.modelling import still_the_target
+from uavtool.mission.search import Found
 from uavtool.runner.fly import FlyConfig
 from uavtool.runner.fly import fly as fly_scene
+from uavtool.vision import VectorizeParams, vectorize
 from uavtool.world import Scene, scene_from_dict
+from uavtool.world.raster import paint_polygon
 
 RED = [210, 40, 40]
 DATA = Path(__file__).parent / "data"
@@ -159,16 +170,70 @@ def test_a_closer_look_tells_the_target_from_a_near_shape_that_matched_too() -> 
     assert summary.evaluation.matched_building == "b00"
 
 
-def test_a_near_shape_matched_from_afar_is_not_modelled_when_the_top_photo_tells() -> None:
-    """World scene 49346 (every world knob on): a decoy with one corner chamfered matched the
-    small convex target from a look that drew it 29 px across (the target picture: 64 px),
-    within what that scale tells. The top photo, closer, shows it as much like the target's
-    mirror image: the mission ends no-match instead of modelling it as the target."""
+def test_a_near_shape_matched_from_afar_is_not_modelled() -> None:
+    """World scene 49346 (every world knob on): a decoy with one corner chamfered used to
+    match the small convex target from a look that drew it 29 px across (the target picture:
+    64 px); the top photo then told it apart. Its outline now keeps the chamfer from the look
+    itself: no match, and nothing modelled."""
     summary = fly_scene(FlyConfig(scene=str(DATA / "world-49346.yaml"), no_record=True))
     outcome = summary.outcome
     assert outcome.status is Status.NO_MATCH, outcome.reason
-    assert "the top photo, closer, shows it as much like the target's mirror image" in (
-        outcome.reason
-    )
     assert outcome.matched_poi == -1 and not outcome.model_built
     assert summary.evaluation.matched_building != "b09"
+
+
+_RED = (200, 40, 40)
+# An L whose arms differ by 5 %: its mirror image scores 0.95 against it
+_NEARLY_SYMMETRIC_L = [(0.0, 0.0), (10.0, 0.0), (10.0, 3.0), (3.0, 3.0), (3.0, 9.5), (0.0, 9.5)]
+
+
+def _nadir_picture(
+    ring: list[tuple[float, float]],
+    px_per_m: float,
+    *,
+    mirrored: bool = False,
+    courtyard: bool = False,
+) -> np.ndarray:
+    image = np.full((480, 640, 3), 128, np.uint8)
+    pts = np.array([(-x if mirrored else x, y) for x, y in ring]) * px_per_m
+    shift = np.array([320.0, 240.0]) - pts.mean(axis=0)
+    paint_polygon(image, pts + shift, _RED)
+    if courtyard:  # a 1.5 m square hole in the long arm
+        hole = np.array([(5.5, 0.75), (7.0, 0.75), (7.0, 2.25), (5.5, 2.25)])
+        hole[:, 0] *= -1.0 if mirrored else 1.0
+        paint_polygon(image, hole * px_per_m + shift, (128, 128, 128))
+    return image
+
+
+@pytest.mark.parametrize(
+    ("mirrored", "courtyard", "why"),
+    [
+        (False, False, None),
+        (True, False, "as much like the target's mirror image (0.9"),
+        (False, True, "1 courtyard(s) where the target picture shows 0"),
+    ],
+)
+def test_the_top_photo_ends_a_match_that_it_shows_to_be_another_building(
+    mirrored: bool, courtyard: bool, why: str | None
+) -> None:
+    """The top photo draws the match twice as large as the target picture: the target itself
+    is modelled (its outline only reported); the target's mirror image, scoring over the
+    threshold but more like the mirror, or the same footprint with a courtyard the target
+    lacks, ends no-match with the reason, and the match is taken back."""
+    target = _nadir_picture(_NEARLY_SYMMETRIC_L, 12.0)
+    mission = SearchMission(Params(), MissionInputs(target))
+    top = _nadir_picture(_NEARLY_SYMMETRIC_L, 25.0, mirrored=mirrored, courtyard=courtyard)
+    shapes = tuple(vectorize(top, VectorizeParams(roof_only=True)))
+    (shape,) = shapes
+    found = cast(Found, SimpleNamespace(shape=shape, poi=SimpleNamespace(index=4)))
+    photo = cast(Photo, SimpleNamespace(intrinsics=INTRINSICS))
+    mission.matched_poi, mission.match_score = 4, 0.9
+    if why is None:
+        still_the_target(mission, found, photo, shapes)
+        assert mission.matched_poi == 4
+        return
+    with pytest.raises(MissionEnd) as ended:
+        still_the_target(mission, found, photo, shapes)
+    assert ended.value.status is Status.NO_MATCH
+    assert why in ended.value.reason and "top photo, closer" in ended.value.reason
+    assert mission.matched_poi == -1

@@ -49,6 +49,23 @@ def test_a_notch_shorter_than_an_edge_kept_is_what_the_outline_left_out() -> Non
     )
 
 
+def test_a_notch_with_edges_longer_than_an_edge_kept_is_kept_at_any_angle() -> None:
+    """A 12 px square notch in a corner of a 180 x 120 px rectangle (its edges half as long
+    again as ``min_edge_px``), turned in 2.5° steps and shifted by fractions of a pixel: the
+    outline keeps it (six corners) every time. RDP may split one of its edges in two
+    where its staircase strays a little more than RDP's epsilon; those two pieces, each under
+    ``min_edge_px``, are one straight edge, not two stubs to drop."""
+    notched = [(70, 60), (238, 60), (238, 72), (250, 72), (250, 180), (70, 180)]
+    for angle in np.arange(0.0, 90.0, 2.5):
+        c, s = np.cos(np.radians(angle)), np.sin(np.radians(angle))
+        for shift in (0.0, 0.3, 0.6):
+            ring = [
+                (160 + (x - 160) * c - (y - 120) * s + shift, 120 + (x - 160) * s + (y - 120) * c)
+                for x, y in notched
+            ]
+            assert len(_one(ring).polygon_px) == 6, (angle, shift)
+
+
 def test_detail_survives_the_shapes_file() -> None:
     shape = _one(SLOTTED)
     (back,) = shapes_from_json(shapes_to_json((shape,), width_px=320, height_px=240))

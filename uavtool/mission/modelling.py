@@ -47,7 +47,7 @@ if TYPE_CHECKING:
     from uavtool.mission.mission import SearchMission
 
 
-def _still_the_target(
+def still_the_target(
     m: SearchMission, found: Found, photo: Photo, shapes: tuple[Shape, ...]
 ) -> None:
     """The top photo is the closest look at the match and draws it larger than the look
@@ -153,7 +153,7 @@ def photograph_and_model(
     else:
         m.no_model = f"the top photo never showed the whole building ({p.max_looks} tries)"
         return
-    _still_the_target(m, found, top_photo, top_shapes)
+    still_the_target(m, found, top_photo, top_shapes)
     if not found.roof_measured:
         # The look and the top photo see the building whole from two places: its height,
         # which neither the overview nor a photo from another altitude could tell (a tower

@@ -33,11 +33,15 @@ def refine_corners(
     min_edge_px: float,
     max_shift_px: float,
     straight_tolerance_px: float = 0.0,
+    join_tolerance_px: float = 0.0,
 ) -> FloatArray:
     """Corners ``(m, 2)`` of a ring whose RDP vertices are ``dense_px[kept]``.
 
     ``dense_px`` : (n, 2) — the evenly spaced border points; ``kept`` — RDP's vertex indices
-    in cyclic order. Edges shorter than ``min_edge_px`` are corner stubs and dropped. A
+    in cyclic order. Edges shorter than ``min_edge_px`` are corner stubs and dropped, unless
+    consecutive short edges are together one straight edge of at least ``min_edge_px``: all
+    their border points within ``join_tolerance_px`` of the line from the first to the last
+    (RDP splits a short edge whose staircase strays a little more than its epsilon). A
     refined corner further than ``max_shift_px`` from the RDP vertex it replaces (nearly
     parallel edges) falls back to that vertex.
     """
@@ -47,6 +51,7 @@ def refine_corners(
         min_edge_px=min_edge_px,
         max_shift_px=max_shift_px,
         straight_tolerance_px=straight_tolerance_px,
+        join_tolerance_px=join_tolerance_px,
     )[0]
 
 
@@ -57,6 +62,7 @@ def refine_rings(
     min_edge_px: float,
     max_shift_px: float,
     straight_tolerance_px: float = 0.0,
+    join_tolerance_px: float = 0.0,
 ) -> list[FloatArray]:
     """:func:`refine_corners` of several rings at once (the line fits share array calls)."""
     # The RDP vertices as Python floats, by dense index: every span starts and ends at one.
@@ -64,7 +70,7 @@ def refine_rings(
         dict(zip(k, d[k].tolist(), strict=True)) for d, k in zip(dense_px, kept, strict=True)
     ]
     spans = [
-        _long_edges(len(d), k, v, min_edge_px)
+        _long_edges(d, k, v, min_edge_px, join_tolerance_px)
         for d, k, v in zip(dense_px, kept, vertices, strict=True)
     ]
     lines = _fit_spans(dense_px, spans, vertices)
@@ -80,19 +86,93 @@ def refine_rings(
 
 
 def _long_edges(
-    n: int, kept: list[int], vertices: dict[int, list[float]], min_edge_px: float
+    dense: FloatArray,
+    kept: list[int],
+    vertices: dict[int, list[float]],
+    min_edge_px: float,
+    join_px: float,
 ) -> list[Span]:
-    """The edges of the RDP ring long enough to fit a line to."""
-    m = len(kept)
+    """The edges of the RDP ring long enough to fit a line to; with ``join_px``, also each
+    run of short edges that is one straight edge long enough (see :func:`refine_corners`)."""
+    n, m = len(dense), len(kept)
     if m < 3:
         return []
-    spans: list[Span] = []
-    for e in range(m):
-        first, last = kept[e], kept[(e + 1) % m]
+
+    def long_enough(first: int, last: int) -> bool:
         (x0, y0), (x1, y1) = vertices[first], vertices[last]
-        if (last - first) % n >= 2 and math.hypot(x1 - x0, y1 - y0) >= min_edge_px:
-            spans.append((first, last))
+        return (last - first) % n >= 2 and math.hypot(x1 - x0, y1 - y0) >= min_edge_px
+
+    edges = [(kept[e], kept[(e + 1) % m]) for e in range(m)]
+    long = [long_enough(first, last) for first, last in edges]
+    if join_px <= 0.0 or all(long) or not any(long):
+        return [edge for edge, ok in zip(edges, long, strict=True) if ok]
+    # From a long edge's start, so that no run of short edges wraps past the scan's end.
+    start = long.index(True)
+    order = [kept[(start + i) % m] for i in range(m + 1)]
+    flags = long[start:] + long[:start]
+    spans: list[Span] = []
+    e = 0
+    while e < m:
+        if flags[e]:
+            spans.append((order[e], order[e + 1]))
+            e += 1
+            continue
+        best, end = 0, e
+        while end < m and not flags[end]:
+            end += 1
+            if not _straight(dense, vertices, order[e], order[end], join_px):
+                break
+            if long_enough(order[e], order[end]):
+                best = end
+        joined = (order[e], order[best]) if best else None
+        if joined is not None and not (
+            (e > 0 and flags[e - 1] and _along(vertices, (order[e - 1], order[e]), joined, join_px))
+            or (
+                best < m
+                and flags[best]
+                and _along(vertices, (order[best], order[best + 1]), joined, join_px)
+            )
+        ):
+            spans.append(joined)
+            e = best
+        else:
+            e += 1
     return spans
+
+
+def _along(vertices: dict[int, list[float]], edge: Span, joined: Span, join_px: float) -> bool:
+    """Whether a joined run of short edges runs the way of its long neighbour ``edge``, as
+    far as its direction is known (each end to ``join_px`` across, over its length): then it
+    is the ragged end of that edge round a corner, not an edge of its own."""
+    (ax, ay), (bx, by) = vertices[edge[0]], vertices[edge[1]]
+    (cx, cy), (dx, dy) = vertices[joined[0]], vertices[joined[1]]
+    ux, uy, vx, vy = bx - ax, by - ay, dx - cx, dy - cy
+    long, short = math.hypot(ux, uy), math.hypot(vx, vy)
+    if long == 0.0 or short == 0.0:
+        return True
+    sine = abs(ux * vy - uy * vx) / (long * short)
+    return ux * vx + uy * vy > 0.0 and sine < min(1.0, 2.0 * join_px / short)
+
+
+def _straight(
+    dense: FloatArray, vertices: dict[int, list[float]], first: int, last: int, tol_px: float
+) -> bool:
+    """Whether every border point from ``first`` to ``last`` lies within ``tol_px`` of the
+    line through those two vertices."""
+    n = len(dense)
+    count = (last - first) % n + 1
+    pts = (
+        dense[first : first + count]
+        if first + count <= n
+        else np.concatenate([dense[first:], dense[: first + count - n]])
+    )
+    (x0, y0), (x1, y1) = vertices[first], vertices[last]
+    dx, dy = x1 - x0, y1 - y0
+    length = math.hypot(dx, dy)
+    if length == 0.0:
+        return False
+    off = np.abs((pts[:, 0] - x0) * dy - (pts[:, 1] - y0) * dx) / length
+    return float(off.max()) <= tol_px
 
 
 def _corners(

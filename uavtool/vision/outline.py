@@ -41,6 +41,9 @@ def simplify_rings_detail(
             min_edge_px=p.min_edge_px,
             max_shift_px=p.min_edge_px + p.point_spacing_px + p.rdp_epsilon_px,
             straight_tolerance_px=p.straight_tolerance_px,
+            # a vertex RDP kept on a short straight edge lies within its epsilon and a
+            # pixel's half-diagonal of it
+            join_tolerance_px=p.rdp_epsilon_px + math.sqrt(0.5),
         )
     return rings, [
         max(ring_detail(d, r), longest_stub(r, p.min_edge_px))
