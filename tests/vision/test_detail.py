@@ -93,13 +93,17 @@ def test_a_line_of_wall_into_the_roof_is_no_detail_left_out() -> None:
 
 
 def test_a_notch_the_target_picture_would_draw_is_not_judged_from_a_coarser_photo() -> None:
-    """The slotted rectangle's 5 px slot is lost in its outline. A reference photo drawing a
-    plain rectangle at the same scale could not show such a slot either (under
-    `min_edge_px`); one drawing it three times larger would (15 px): the candidate leaves
-    out what that reference shows, and is not judged from this photo."""
-    slotted = _one(SLOTTED)
+    """A 3 px slot is lost in the outline of a 190 px rectangle, which says it left out
+    about 2 px: at most a corner cut with 4-5 px legs, under `min_edge_px` for a reference
+    photo drawing it at the same scale, but up to ~14 px for one drawing it three times
+    larger, which would keep it: from this photo the candidate is not judged against that
+    reference. A candidate drawn larger than the reference hides nothing from it, whatever it
+    left out: the reference, drawn smaller, leaves out as much."""
+    slotted = _one([(60.0, 50.0), (150.0, 50.0), (150.0, 53.0), (153.0, 53.0), (153.0, 50.0),
+                    (250.0, 50.0), (250.0, 170.0), (60.0, 170.0)])  # fmt: skip
     min_edge = VectorizeParams().min_edge_px
     same_scale = _one([(60.0, 50.0), (250.0, 50.0), (250.0, 170.0), (60.0, 170.0)])
+    assert 1.5 <= slotted.detail_px <= 3.0
     assert not hides_detail(same_scale, slotted, min_edge)
     image = np.full((480, 680, 3), 128, np.uint8)
     paint_polygon(
@@ -107,3 +111,5 @@ def test_a_notch_the_target_picture_would_draw_is_not_judged_from_a_coarser_phot
     )
     (finer,) = vectorize(image, VectorizeParams())
     assert hides_detail(finer, slotted, min_edge)
+    smaller = _one([(100.0, 80.0), (160.0, 80.0), (160.0, 120.0), (100.0, 120.0)])
+    assert not hides_detail(smaller, _one(SLOTTED), min_edge)

@@ -86,13 +86,26 @@ def hides_detail(reference: Shape, candidate: Shape, reference_min_edge_px: floa
     ``reference_min_edge_px`` long at the reference's scale (a notch or a cut corner this
     photo drew too small to keep, or a blurred outline a few pixels across). Whether such a
     candidate is the reference cannot be told from this photo: the feature may be what makes
-    it another building. A closer photo draws it."""
+    it another building. A closer photo draws it.
+
+    The feature left out may be up to `LEGS_PER_DETAIL` times the detail long: a corner
+    cut at 45° whose legs are ``c`` lies at most ``c / 2`` from the corner the outline
+    kept, the most length for the least detail of any corner cut (a square notch of side
+    ``k`` leaves out ``k``). A candidate drawn at least as large as the reference hides
+    nothing from it: what its outline left out, the reference's, drawn smaller by the same
+    vectorizer, leaves out too."""
     if candidate.detail_px <= 0.0:
         return False
+    drawn = math.sqrt(max(candidate.area_px, 0.0))
     scale = math.sqrt(max(reference.area_px, 0.0))
-    return candidate.detail_px * scale >= reference_min_edge_px * math.sqrt(
-        max(candidate.area_px, 0.0)
-    )
+    if drawn >= scale:
+        return False
+    return LEGS_PER_DETAIL * candidate.detail_px * scale >= reference_min_edge_px * drawn
+
+
+LEGS_PER_DETAIL = 2.0
+"""How long a feature an outline left out may be, per pixel of `Shape.detail_px` (see
+`hides_detail`)."""
 
 
 def outline_fits(
