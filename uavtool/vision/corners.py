@@ -125,12 +125,13 @@ def _long_edges(
             if long_enough(order[e], order[end]):
                 best = end
         joined = (order[e], order[best]) if best else None
+        # the long edges either side (the scan starts at a long edge: e > 0 here, and a run
+        # that reaches the scan's end is followed by the first edge)
+        after = best % m
         if joined is not None and not (
-            (e > 0 and flags[e - 1] and _along(vertices, (order[e - 1], order[e]), joined, join_px))
+            (flags[e - 1] and _along(vertices, (order[e - 1], order[e]), joined, join_px))
             or (
-                best < m
-                and flags[best]
-                and _along(vertices, (order[best], order[best + 1]), joined, join_px)
+                flags[after] and _along(vertices, (order[after], order[after + 1]), joined, join_px)
             )
         ):
             spans.append(joined)
