@@ -160,13 +160,7 @@ def _straight(
 ) -> bool:
     """Whether every border point from ``first`` to ``last`` lies within ``tol_px`` of the
     line through those two vertices."""
-    n = len(dense)
-    count = (last - first) % n + 1
-    pts = (
-        dense[first : first + count]
-        if first + count <= n
-        else np.concatenate([dense[first:], dense[: first + count - n]])
-    )
+    pts = _ring_slice(dense, first, (last - first) % len(dense) + 1)
     (x0, y0), (x1, y1) = vertices[first], vertices[last]
     dx, dy = x1 - x0, y1 - y0
     length = math.hypot(dx, dy)
@@ -312,10 +306,17 @@ def _span_points(dense: FloatArray, span: Span) -> FloatArray:
     first, last = span
     count = (last - first) % n + 1
     trim = 1 if count >= 6 else 0
-    i0, k = first + trim, count - 2 * trim
-    if i0 + k <= n:
-        return dense[i0 : i0 + k]
-    return np.concatenate([dense[i0:], dense[: i0 + k - n]])
+    return _ring_slice(dense, first + trim, count - 2 * trim)
+
+
+def _ring_slice(dense: FloatArray, start: int, count: int) -> FloatArray:
+    """``count`` points of the closed ring ``dense`` from index ``start`` on, past its end
+    onto its start."""
+    n = len(dense)
+    start %= n
+    if start + count <= n:
+        return dense[start : start + count]
+    return np.concatenate([dense[start:], dense[: start + count - n]])
 
 
 def _fit_span(dense: FloatArray, span: Span, vertices: dict[int, list[float]]) -> Line:

@@ -176,8 +176,8 @@ def _traced(
         shape = _offset_shape(outer, tuple(h for h in holes if len(h) >= 3), r.cut, detail, p)
         shape = dataclasses.replace(shape, colour_rgb=_inside_colour(frame, r, shape))
         if detail > _STAIRCASE_PX:
-            detail = _detail_with_walls(frame, r, outer, shape, p)
-            shape = dataclasses.replace(shape, detail_px=detail)
+            detail_px = _detail_with_walls(frame, r, outer, shape, p)
+            shape = dataclasses.replace(shape, detail_px=detail_px)
         out.append((order, r, shape))
     return out
 

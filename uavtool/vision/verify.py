@@ -80,6 +80,11 @@ def outline_tolerance(
     )
 
 
+LEGS_PER_DETAIL = 2.0
+"""How long a feature an outline left out may be, per pixel of `Shape.detail_px` (see
+`hides_detail`)."""
+
+
 def hides_detail(reference: Shape, candidate: Shape, reference_min_edge_px: float) -> bool:
     """Whether ``candidate``'s outline leaves out (``Shape.detail_px``) a feature the
     reference's photo would have drawn as an edge of its outline: at least
@@ -101,11 +106,6 @@ def hides_detail(reference: Shape, candidate: Shape, reference_min_edge_px: floa
     if drawn >= scale:
         return False
     return LEGS_PER_DETAIL * candidate.detail_px * scale >= reference_min_edge_px * drawn
-
-
-LEGS_PER_DETAIL = 2.0
-"""How long a feature an outline left out may be, per pixel of `Shape.detail_px` (see
-`hides_detail`)."""
 
 
 def outline_fits(
