@@ -20,10 +20,15 @@ _NS = 1_000_000_000
 
 
 class Pilot:
-    """Talks to ``sitl`` as sysid 255 / compid 190, stepping the vehicle itself."""
+    """Talks to ``sitl`` as sysid 255 / compid 190, stepping the vehicle itself (or, with
+    ``step``, stepping whatever else moves its clock: a fleet's world)."""
 
-    def __init__(self, sitl: Sitl | None = None, **config: Any) -> None:
+    def __init__(
+        self, sitl: Sitl | None = None, *, step: Callable[[], None] | None = None, **config: Any
+    ) -> None:
         self.sitl = sitl if sitl is not None else Sitl(SitlConfig(endpoints=(), **config))
+        self._step = step or self.sitl.step
+        self.target = self.sitl.sysid
         self._out = bytearray()
         self.link = self.sitl.attach("pilot", self._out.extend)
         self.parser = FrameParser()
@@ -43,15 +48,16 @@ class Pilot:
     def run(self, seconds: float) -> None:
         end = self.sitl.now_ns + round(seconds * _NS)
         while self.sitl.now_ns < end:
-            self.sitl.step()
+            self._step()
             self._collect()
+        self._collect()  # what it was sent while another stepped the clock
 
     def run_until(self, cond: Callable[[Pilot], bool], seconds: float, what: str) -> None:
         end = self.sitl.now_ns + round(seconds * _NS)
         while not cond(self):
             if self.sitl.now_ns >= end:
                 raise AssertionError(f"no {what} within {seconds} s of vehicle time")
-            self.sitl.step()
+            self._step()
             self._collect()
 
     def _collect(self) -> None:
@@ -72,7 +78,7 @@ class Pilot:
     def command(self, command: int, *params: float) -> Any:
         p = [*params, *([0.0] * (7 - len(params)))]
         before = len(self.received)
-        self.send(M.MAVLink_command_long_message(1, 1, command, 0, *p))
+        self.send(M.MAVLink_command_long_message(self.target, 1, command, 0, *p))
         acks = [
             m
             for m in self.received[before:]
@@ -86,7 +92,7 @@ class Pilot:
 
     def set_param(self, name: str, value: float) -> Any:
         before = len(self.received)
-        self.send(M.MAVLink_param_set_message(1, 1, name.encode(), value, 9))
+        self.send(M.MAVLink_param_set_message(self.target, 1, name.encode(), value, 9))
         echoes = [
             m
             for m in self.received[before:]

@@ -50,6 +50,9 @@ def test_help_has_an_example() -> None:
         (["--param", "NOPE=1"], "unknown parameter 'NOPE'"),
         (["--param", "RTL_ALT"], "expected NAME=VALUE"),
         (["--link-outage", "5:inf"], "link outage 5:inf"),
+        (["--vehicles", "2", "--offset-line", "90"], "offset line '90'"),
+        (["--vehicles", "3", "--home", "1,2,3,4", "--home", "1,2,3,5"], "--home given 2 times"),
+        (["--vehicles", "2", "--scene", "paper", "--offset-line", "0,10"], "in building 'purple'"),
     ],
 )
 def test_bad_options_exit_2_with_one_line(args: list[str], message: str) -> None:
@@ -139,3 +142,53 @@ def test_the_readmes_mount_file_loads_on_the_builtin_vehicle(tmp_path: Path) -> 
     result = CliRunner().invoke(cli, ["sitl", "--params", str(parm), "--duration", "0.5"])
     assert result.exit_code == 0, result.output
     assert "stopped at sim time" in result.output
+
+
+def test_a_fleet_answers_on_each_vehicles_port_with_its_own_sysid() -> None:
+    """``--vehicles 2``: vehicle 2 on the first endpoint's port + 10 as sysid 2 (ArduPilot's
+    ``-I1``), flown by one client while vehicle 1 stays on the ground; the summary on exit
+    gives the closest approach."""
+    port = _free_port()
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "uavtool", "sitl", "--vehicles", "2", "--speedup", "5",
+         "--endpoint", f"tcpin:127.0.0.1:{port}"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )  # fmt: skip
+    try:
+        assert proc.stdout is not None
+        banner = "".join(proc.stdout.readline() for _ in range(4))
+        assert "2 vehicles on offset line 90,10" in banner
+        assert "vehicle sysid 2 at" in banner and f"tcpin:127.0.0.1:{port + 10}" in banner
+        script = f"""
+import os
+os.environ["MAVLINK20"] = "1"
+from pymavlink import mavutil
+one = mavutil.mavlink_connection("tcp:127.0.0.1:{port}", source_system=255)
+two = mavutil.mavlink_connection("tcp:127.0.0.1:{port + 10}", source_system=255)
+print("sysids", one.wait_heartbeat(timeout=10).get_srcSystem(),
+      two.wait_heartbeat(timeout=10).get_srcSystem())
+two.target_system = 2
+two.set_mode("GUIDED")
+while not two.motors_armed():
+    two.arducopter_arm()
+    two.recv_match(type="HEARTBEAT", blocking=True, timeout=1)
+two.mav.command_long_send(2, 1, mavutil.mavlink.MAV_CMD_NAV_TAKEOFF, 0, 0, 0, 0, 0, 0, 0, 5)
+while two.recv_match(type="GLOBAL_POSITION_INT", blocking=True, timeout=10).relative_alt < 4800:
+    pass
+print("one at", one.recv_match(type="GLOBAL_POSITION_INT", blocking=True).relative_alt)
+"""
+        out = subprocess.run(
+            [sys.executable, "-c", script], capture_output=True, text=True, timeout=60, check=False
+        )
+        assert out.returncode == 0, out.stderr
+        lines = out.stdout.splitlines()
+        assert lines[0] == "sysids 1 2"
+        assert abs(int(lines[1].split()[2])) < 100  # vehicle 1 never left the ground
+    finally:
+        proc.send_signal(signal.SIGINT)
+        rest, _ = proc.communicate(timeout=10)
+    assert "closest approach: vehicles 1 and 2, bodies" in rest
+    assert "crashed" not in rest

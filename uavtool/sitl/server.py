@@ -229,11 +229,22 @@ class Sitl:
 
     def step(self) -> None:
         """Advance the simulation by one physics step and send what is due."""
+        self.advance()
+        self.publish()
+
+    def advance(self) -> None:
+        """The first half of :meth:`step`: one physics step, nothing sent yet (a fleet steps
+        every vehicle, then judges contacts between them, then lets each speak)."""
         ap = self.autopilot
         now = ap.now_ns + self.dt_ns
         ap.tick(now, self.dt_ns / _NS)
         self.steps += 1
         self.link_down = bool(self._outages_ns) and any(a <= now < b for a, b in self._outages_ns)
+
+    def publish(self) -> None:
+        """The second half of :meth:`step`: send what is due at the vehicle's time."""
+        ap = self.autopilot
+        now = ap.now_ns
         if self.link_down:
             ap.events.clear()  # what the vehicle says during an outage is lost
             return
@@ -269,6 +280,13 @@ class Sitl:
                 while owner.accepted:
                     self._register(owner.accepted.pop())
         self._reap()
+
+    def fileno(self) -> int | None:
+        """A descriptor that turns readable when any of the vehicle's sockets has something
+        to read (its epoll or kqueue), for a loop that serves several vehicles; None where
+        the platform's selector has none."""
+        fileno = getattr(self._selector, "fileno", None)
+        return None if fileno is None else int(fileno())
 
     def _tcp_connections(self) -> list[TcpConnection]:
         return [s for s in self._sockets if isinstance(s, TcpConnection)]
