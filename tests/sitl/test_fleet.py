@@ -7,10 +7,11 @@ Stepped by the test (no sockets, no wall clock), so every time is vehicle time.
 from __future__ import annotations
 
 import math
+import socket
 
 import pytest
 
-from uavtool.errors import InputError
+from uavtool.errors import InputError, LinkError
 from uavtool.geo import GeoPoint, enu_from_geo
 from uavtool.mavlink import mavlink as M
 from uavtool.sitl import Prism, SitlConfig
@@ -189,3 +190,13 @@ def test_a_fleet_of_one_flies_as_one_vehicle() -> None:
     b = alone.sitl.autopilot.vehicle.state.pos_ned_m
     assert list(a) == list(b)
     assert in_fleet.sitl.now_ns == alone.sitl.now_ns
+
+
+def test_a_port_in_use_fails_the_fleet_cleanly() -> None:
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        base = SitlConfig(endpoints=(f"tcpin:127.0.0.1:{port - 10}",), start_unix_us=0)
+        with pytest.raises(LinkError, match=f"port {port} is in use"):
+            Fleet(fleet_configs(base, line_homes(HOME, 2, OffsetLine())))

@@ -139,6 +139,8 @@ class Fleet:
         self.offsets_enu_m = tuple(enu_from_geo(origin, c.home) for c in configs)
         """Each vehicle's home in the fleet's frame (ENU metres around the first's home)."""
         _check_homes(configs, self.offsets_enu_m, sysids)
+        self._waiter: selectors.BaseSelector | None = None
+        self._naps = False  # no selector to wait on every vehicle's sockets at once
         self.vehicles: list[Sitl] = []
         try:
             for config in configs:
@@ -160,8 +162,6 @@ class Fleet:
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self.error: BaseException | None = None
-        self._waiter: selectors.BaseSelector | None = None
-        self._naps = False  # no selector to wait on every vehicle's sockets at once
 
     # ------------------------------------------------------------------ the world
     @property
