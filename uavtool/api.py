@@ -37,6 +37,7 @@ from __future__ import annotations
 
 from uavtool.camera import CameraPose, Intrinsics, pixel_ray, project
 from uavtool.images import png_decode, png_encode
+from uavtool.mission.airspace import Airspace, Claim
 from uavtool.mission.base import (
     HORIZONTAL_DEG,
     NADIR_DEG,
@@ -46,6 +47,7 @@ from uavtool.mission.base import (
     MissionInputs,
     Wait,
 )
+from uavtool.mission.fleet import Crew, FleetMember, FleetParams
 from uavtool.mission.observations import (
     CommandResult,
     LinkLost,
@@ -76,13 +78,18 @@ from uavtool.vision.detection import Detection, Frame
 __all__ = [
     "HORIZONTAL_DEG",
     "NADIR_DEG",
+    "Airspace",
     "Arm",
     "CameraPose",
+    "Claim",
     "Command",
     "CommandResult",
+    "Crew",
     "Detection",
     "Envelope",
     "Event",
+    "FleetMember",
+    "FleetParams",
     "FlightMission",
     "FlightParams",
     "Frame",

@@ -72,6 +72,11 @@ class FlightDescription:
     """Where the target picture came from: ``scene`` (rendered), ``file``, or ``none`` (the
     mission needs none)."""
     no_gimbal: bool = False
+    vehicles: int = 1
+    """How many built-in vehicles flew (a fleet: more than one)."""
+    offset_line: tuple[float, float] = (90.0, 10.0)
+    """A fleet's homes: vehicle i's is i × spacing (m) from the first's along the bearing
+    (degrees): (bearing, spacing)."""
     tool_version: str = field(default="", compare=False)
     """The uavtool that flew it (not part of what the flight was)."""
 
@@ -114,6 +119,11 @@ class FlightDescription:
             # among them) stay as they were.
             **({"no_gimbal": "true"} if self.no_gimbal else {}),
         }
+        if self.vehicles > 1 or self.offset_line != (90.0, 10.0):  # one vehicle's as it was
+            records["fleet"] = {
+                "vehicles": str(self.vehicles),
+                "offset_line": json.dumps(list(self.offset_line)),
+            }
         return records
 
     @classmethod
@@ -128,6 +138,7 @@ class FlightDescription:
                 )
         mission, params = mission_of(meta, source=source)
         vehicle, flight = meta["vehicle"], meta["flight"]
+        fleet = meta.get("fleet", {})
         r = _Fields(source)
         scene = scene_data(meta, source=source)
         return cls(
@@ -148,6 +159,8 @@ class FlightDescription:
             size_px=r.value(flight, "flight", "size_px", _size),
             target=r.choice(flight, "flight", "target", TARGETS),
             no_gimbal=r.value(flight, "flight", "no_gimbal", _bool, default="false"),
+            vehicles=r.value(fleet, "fleet", "vehicles", _vehicles, default="1"),
+            offset_line=r.value(fleet, "fleet", "offset_line", _offset_line, default="[90, 10]"),
             tool_version=r.text(meta["mission"], "mission", "tool_version", default=""),
         )
 
@@ -249,6 +262,27 @@ def _int(text: str) -> int:
     if not text.lstrip("-").isdigit() or len(text) > 20:
         raise ValueError(f"{text!r:.40} is not an integer")
     return int(text)
+
+
+MAX_FLEET = 64
+"""The most vehicles a recording may say flew (as many as ``uavtool sitl`` serves)."""
+
+
+def _vehicles(text: str) -> int:
+    n = _int(text)
+    if not 1 <= n <= MAX_FLEET:
+        raise ValueError(f"{n} vehicles: expected 1 to {MAX_FLEET}")
+    return n
+
+
+def _offset_line(text: str) -> tuple[float, float]:
+    value = _json(text)
+    if not (isinstance(value, list) and len(value) == 2):
+        raise ValueError("expected [bearing, spacing]")
+    bearing, spacing = _number(value[0]), _number(value[1])
+    if not 0.0 < spacing <= 1000.0:
+        raise ValueError(f"spacing {spacing:g} m: expected (0, 1000]")
+    return bearing, spacing
 
 
 def _bool(text: str) -> bool:

@@ -41,6 +41,8 @@ OTHER: dict[str, Any] = {
     "size_px": (800, 600),
     "target": "file",
     "no_gimbal": True,
+    "vehicles": 3,
+    "offset_line": (45.0, 12.5),
     "tool_version": "9.9.9",
 }
 """A value other than the default for every field."""

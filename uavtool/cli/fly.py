@@ -3,8 +3,11 @@ it."""
 
 from __future__ import annotations
 
+import dataclasses
 import sys
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, NoReturn
 
 import click
 
@@ -12,6 +15,11 @@ from uavtool.checks import NON_NEGATIVE, POSITIVE, Range, coerce
 from uavtool.cli.options import PORT, SEED, Number, Numbers, check_web_ports
 from uavtool.cli.spelling import Command, OldSpelling
 from uavtool.errors import InputError
+
+if TYPE_CHECKING:
+    from uavtool.runner.fly import FlyConfig
+
+Echo = Callable[[str], None]
 
 EXIT_CODES: dict[str, int] = {
     "completed": 0,
@@ -170,6 +178,22 @@ _WRITERS: dict[str, bool | None] = {"auto": None, "process": False, "thread": Tr
     help="With --camera sim and --connect: put the scene at the vehicle's home, or keep the "
     "scene's own position (refused, with the SITL --home to use, when the vehicle is far).",
 )
+@click.option(
+    "--vehicles",
+    default=1,
+    show_default=True,
+    type=click.IntRange(1, 16),
+    help="Fly N built-in vehicles in one lockstep world with a fleet mission (e.g. --mission "
+    "fleet-survey); see docs/fleets.md.",
+)
+@click.option(
+    "--offset-line",
+    default="90,10",
+    show_default=True,
+    metavar="BEARING,SPACING",
+    help="With --vehicles: vehicle i's home is i·SPACING m from the scene's home along BEARING "
+    "degrees (as ArduPilot's sim_vehicle.py --auto-offset-line).",
+)
 @click.option("-q", "--quiet", is_flag=True, help="Print only the summary.")
 def fly(
     connect: str | None,
@@ -194,6 +218,8 @@ def fly(
     grpc_port: int | None,
     no_gimbal: bool,
     scene_origin: str,
+    vehicles: int,
+    offset_line: str,
     quiet: bool,
 ) -> None:
     """Fly a mission and record everything to one MCAP file: by default the search mission,
@@ -213,6 +239,7 @@ def fly(
       uavtool fly --connect tcp:127.0.0.1:5760 --no-gimbal   # a camera fixed down
       uavtool fly --connect udpin:0.0.0.0:14540    # PX4 SITL (its API link)
       uavtool fly --mission orbit --set orbit.step_deg=30   # another mission
+      uavtool fly --vehicles 3 --mission fleet-survey --no-record   # a fleet
     """
     from uavtool.mission.params import parse_settings, valid_keys, with_overrides
     from uavtool.plugins import resolve
@@ -263,6 +290,8 @@ def fly(
         if not quiet:
             click.echo(text)
 
+    if vehicles > 1:
+        _fly_fleet(config, vehicles, offset_line, echo)
     summary = fly_mission(
         config,
         progress=lambda text, t: echo(format_progress(text, t)),
@@ -274,6 +303,24 @@ def fly(
 
 
 _LIVE_VIEWERS = ("spawn", "web")
+
+
+def _fly_fleet(config: FlyConfig, vehicles: int, offset_line: str, echo: Echo) -> NoReturn:
+    from uavtool.runner.fleet import fly_fleet
+    from uavtool.runner.summary import format_fleet_summary, format_progress
+    from uavtool.sitl.fleet import parse_offset_line
+
+    line = parse_offset_line(offset_line)
+    config = dataclasses.replace(
+        config, vehicles=vehicles, offset_line=(line.bearing_deg, line.spacing_m)
+    )
+    summary = fly_fleet(
+        config,
+        progress=lambda sysid, text, t: echo(f"v{sysid} {format_progress(text, t)}"),
+        status=lambda text: echo(f"uavtool fly: {text}"),
+    )
+    click.echo(format_fleet_summary(summary))
+    sys.exit(EXIT_CODES[summary.status.value])
 
 
 def _rerun_target(text: str | None) -> str | None:

@@ -187,6 +187,17 @@ def replay(
         return
     if out is not None:
         refuse_same_file(out, [recording])  # now, not after the whole replay
+    from uavtool.replay.load import is_fleet
+
+    if is_fleet(recording):
+        if out is not None or vision_only:
+            raise InputError(
+                f"{recording}: a fleet's recording: replay --check and --set work on it, "
+                "-o/--output and --vision-only not yet"
+            )
+        extra = _params_file(params_file) if params_file is not None else {}
+        _replay_fleet(recording, check, {**extra, **parse_settings(settings)}, mission)
+        return
     flight = load_flight(recording, mission=mission)
     overrides: dict[str, object] = {}
     if params_file is not None:
@@ -256,6 +267,48 @@ def replay(
     if check and not vision_only and result.first_difference is not None:
         sys.exit(1)
     if flight.truncated:
+        from uavtool.recording.info import truncation
+
+        click.echo(f"incomplete: {truncation(recording)}")
+        sys.exit(INCOMPLETE_EXIT)
+
+
+def _replay_fleet(
+    recording: Path, check: bool, overrides: dict[str, object], mission: str | None
+) -> None:
+    """Replay every member of a fleet; exit 1 under --check at any difference."""
+    from uavtool.mission.params import with_overrides
+    from uavtool.replay.fleet import replay_fleet
+    from uavtool.replay.load import load_fleet
+
+    fleet = load_fleet(recording, mission=mission)
+    if fleet.truncated and check:
+        raise InputError(
+            f"{recording}: the recording is truncated (cut while writing); --check needs a whole "
+            "file"
+        )
+    params = with_overrides(fleet.params, overrides)
+    results = replay_fleet(fleet, params)
+    differs = False
+    for vehicle, result in zip(fleet.vehicles, results, strict=True):
+        head = (
+            f"{recording}: vehicle {vehicle.sysid}: {result.steps} observations replayed, "
+            f"{len(result.outputs)} outputs ({len(vehicle.outputs)} recorded)"
+        )
+        if result.identical:
+            click.echo(f"{head}; identical")
+            continue
+        differs = differs or result.first_difference is not None
+        if result.first_difference is not None:
+            click.echo(f"{head}; first difference: {result.first_difference.describe()}")
+        if result.divergence is not None:
+            d = result.divergence
+            click.echo(f"{head}; diverged at step {d.step}: {d.reason}")
+    if not differs and all(r.identical for r in results):
+        click.echo("identical: every output of every vehicle equals the recorded one")
+    if check and differs:
+        sys.exit(1)
+    if fleet.truncated:
         from uavtool.recording.info import truncation
 
         click.echo(f"incomplete: {truncation(recording)}")

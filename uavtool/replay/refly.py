@@ -25,6 +25,7 @@ from uavtool.recording import CompressedImage, RecordingReader
 from uavtool.recording.files import refuse_same_file
 from uavtool.recording.reader import Message
 from uavtool.recording.topics import TARGET
+from uavtool.runner.fleet import FleetSummary, fly_fleet
 from uavtool.runner.fly import FlightSummary, FlyConfig, fly
 from uavtool.runner.runner import Progress
 from uavtool.sitl.lockstep import SIM_EPOCH_NS
@@ -49,7 +50,7 @@ class ReflyResult:
     reflown: Path
     messages: int
     first_difference: str | None
-    summary: FlightSummary
+    summary: FlightSummary | FleetSummary
 
     @property
     def identical(self) -> bool:
@@ -104,6 +105,8 @@ def refly_config(path: Path, *, out: Path, workdir: Path, mission: str | None = 
             size_px=d.size_px,
             target=_target_file(reader, path, workdir) if d.target == "file" else None,
             no_gimbal=d.no_gimbal,
+            vehicles=d.vehicles,
+            offset_line=d.offset_line,
         )
 
 
@@ -124,7 +127,9 @@ def refly(
         work = Path(tmp)
         target = out if out is not None else work / "reflown.mcap"
         config = refly_config(path, out=target, workdir=work, mission=mission)
-        summary = fly(config, progress=progress)
+        summary: FlightSummary | FleetSummary = (
+            fly_fleet(config) if config.vehicles > 1 else fly(config, progress=progress)
+        )
         count, diff = compare_recordings(path, target) if compare else (0, None)
     return ReflyResult(path, target, count, diff, summary)
 

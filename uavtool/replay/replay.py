@@ -95,7 +95,7 @@ def replay(
     recorded ones) and compare its outputs with the recording's, step by step."""
     p = params if params is not None else flight.params
     mission = create_mission(flight.mission, p, MissionInputs(target_rgb=flight.target_rgb))
-    cmp = _Comparison(flight.outputs, flight_params(flight.mission, p))
+    cmp = Comparison(flight.outputs, flight_params(flight.mission, p))
     total = len(flight.observations)
     cmp.emit(0, guarded(mission.start))
     for step, obs in enumerate(flight.observations, start=1):
@@ -111,14 +111,11 @@ def replay(
     result = cmp.result
     result.finished = mission.done
     if result.identical and len(result.outputs) < len(flight.outputs) and not flight.truncated:
-        missing = flight.outputs[len(result.outputs)]
-        result.first_difference = Difference(
-            missing.step, missing.n, str(missing.data.get("type")), "", missing.data, "nothing"
-        )
+        cmp.missing(flight.outputs[len(result.outputs)])
     return result
 
 
-class _Comparison:
+class Comparison:
     """Positional comparison of all outputs (for ``--check``), and of the commands alone (to
     find where the mission's decisions leave the recording)."""
 
@@ -128,6 +125,12 @@ class _Comparison:
         self._heading_deg = flight.heading_tolerance_deg
         self._recorded = iter(recorded)
         self._commands = iter([r for r in recorded if r.data.get("type") in _COMMANDS])
+
+    def missing(self, recorded: RecordedOutput) -> None:
+        """The recording has this output, and the replay ended before making it."""
+        self.result.first_difference = Difference(
+            recorded.step, recorded.n, str(recorded.data.get("type")), "", recorded.data, "nothing"
+        )
 
     def diverge(self, step: int, reason: str) -> None:
         if self.result.divergence is None:

@@ -93,6 +93,12 @@ class FlyConfig:
     no_gimbal: bool = False
     """The camera is fixed straight down: no gimbal check, the search only (see
     ``MissionParams.gimbal``). The built-in vehicle then boots without a mount."""
+    vehicles: int = 1
+    """How many built-in vehicles fly (more than one: a fleet, :func:`uavtool.runner.fleet.
+    fly_fleet`)."""
+    offset_line: tuple[float, float] = (90.0, 10.0)
+    """A fleet's homes: vehicle i's is i × spacing (m) from the scene's home along the bearing
+    (degrees): (bearing, spacing)."""
     scene_origin: str = "vehicle"
     """With the sim camera and another vehicle: ``"vehicle"`` puts the scene at the vehicle's
     home, ``"scene"`` keeps the scene's own geographic origin (refused when the vehicle is
@@ -393,6 +399,8 @@ def describe(
         size_px=config.size_px,
         target=("file" if config.target else "scene") if has_target else "none",
         no_gimbal=config.no_gimbal,
+        vehicles=config.vehicles,
+        offset_line=config.offset_line,
         tool_version=__version__,
     )
 

@@ -9,9 +9,10 @@ heartbeat, and vehicle time for command acknowledgements.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 from uavtool.autopilot import COMMAND_NAMES, RESULT_NAMES, Autopilot, for_vehicle
@@ -92,6 +93,7 @@ class Runner:
         vehicle_says: VehicleSays | None = None,
         fixed_camera: bool = False,
         autopilot: Autopilot | None = None,
+        steps: Iterator[int] | None = None,
     ) -> None:
         self.link = link
         self.autopilot = autopilot or for_vehicle(link.state.heartbeat)
@@ -109,6 +111,9 @@ class Runner:
         self.scene_origin = scene_origin
         self.true_pose = true_pose
         self.step = 0
+        self._steps = steps if steps is not None else itertools.count(1)
+        """Numbers the observations fed to the mission (a fleet's runners share one: the
+        members' observations then have one order)."""
         self.frames = 0
         self.coalesced = 0  # telemetry snapshots superseded before the mission saw them
         self.route: list[tuple[int, tuple[float, float, float]]] = []  # (time_boot_ms, ENU)
@@ -122,6 +127,7 @@ class Runner:
         self._lost_reported = 0.0
         self._link_lost = False
         self._last_heartbeat: float | None = None
+        self._last_rx = 0.0
         self._target: GoTo | None = None  # the position target to send again, and when sent
         self._target_sent = 0.0
         self._target_left = math.inf  # how far the vehicle was from it then
@@ -130,6 +136,13 @@ class Runner:
     # --- the loop ---------------------------------------------------------------------------
 
     def run(self) -> Outcome:
+        self.begin()
+        while not self.turn(self.config.poll_s):
+            pass
+        return self.finish()
+
+    def begin(self) -> None:
+        """Start the mission (its first outputs executed); then :meth:`turn` until done."""
         home = self.link.state.home
         if home is None:
             raise RuntimeError("Runner.run needs the vehicle's home (VehicleLink.wait_vehicle)")
@@ -138,29 +151,40 @@ class Runner:
             east, north, _ = enu_from_geo(self.scene_origin, home)
             self.scene_offset = (east, north)
         self._handle(guarded(self.mission.start))
-        clock = self.link.clock
-        last_rx = clock()
-        while True:
-            self._drain()
-            if self.mission.done:
-                break
-            msgs = self.link.poll(self.config.poll_s)
-            now = clock()
-            if msgs:
-                if self._link_lost:
-                    self._link_lost = False
-                    self._queue.append(LinkRestored(self._silent_s(now, last_rx)))
-                last_rx = now
-                for msg in msgs:
-                    self._on_message(msg)
-            else:
-                self._check_silence(now, last_rx)
-            if self._last_heartbeat is None or now - self._last_heartbeat > self.config.heartbeat_s:
-                self._heartbeat(now)
-            if self._resend_due(now):
-                assert self._target is not None
-                self.autopilot.send(self.link, self._target, home)
-            self.autopilot.tick(self.link, now, home)
+        self._last_rx = self.link.clock()
+
+    def turn(self, timeout_s: float) -> bool:
+        """One turn of the loop: feed the mission what is queued, read the link for up to
+        ``timeout_s`` (0: what has arrived; a fleet steps the world itself), keep the link
+        alive. True once the mission is done."""
+        self._drain()
+        if self.mission.done:
+            return True
+        msgs = self.link.poll(timeout_s)
+        now = self.link.clock()
+        if msgs:
+            if self._link_lost:
+                self._link_lost = False
+                self._queue.append(LinkRestored(self._silent_s(now, self._last_rx)))
+            self._last_rx = now
+            for msg in msgs:
+                self._on_message(msg)
+        else:
+            self._check_silence(now, self._last_rx)
+        if self._last_heartbeat is None or now - self._last_heartbeat > self.config.heartbeat_s:
+            self._heartbeat(now)
+        if self._resend_due(now):
+            assert self._target is not None
+            self.autopilot.send(self.link, self._target, self.home)
+        self.autopilot.tick(self.link, now, self.home)
+        return False
+
+    @property
+    def busy(self) -> bool:
+        """Whether observations wait to be fed to the mission (the next turn has work)."""
+        return bool(self._queue)
+
+    def finish(self) -> Outcome:
         assert self.mission.outcome is not None
         return self.mission.outcome
 
@@ -182,7 +206,7 @@ class Runner:
     def _drain(self) -> None:
         while self._queue and self.mission.outcome is None:
             obs = self._queue.popleft()
-            self.step += 1
+            self.step = next(self._steps)
             # A photo is encoded once, for the recording and the live view alike; without a
             # live view, the recording's writer encodes it (a writer process, off this path).
             png = None

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import json
+import math
 from typing import TYPE_CHECKING
 
 from uavtool.mission import Status, Telemetry
 from uavtool.terminal import counted, safe_text
 
 if TYPE_CHECKING:
+    from uavtool.runner.fleet import FleetSummary
     from uavtool.runner.fly import FlightSummary
 
 
@@ -85,3 +87,32 @@ def _search_lines(s: FlightSummary) -> list[str]:
     else:
         lines.append("model          not built")
     return lines
+
+
+def format_fleet_summary(s: FleetSummary) -> str:
+    breach = s.closest_approach_m < s.separation_m
+    lines = [
+        "",
+        f"outcome        {s.status.value}: {s.reason}",
+        f"fleet          {counted(len(s.vehicles), 'vehicle')}, mission {safe_text(s.mission)}, "
+        f"{s.vehicle_time_s:.1f} s sim, {s.wall_time_s:.1f} s wall",
+    ]
+    if math.isfinite(s.closest_approach_m):
+        a, b = s.closest_pair
+        lines.append(
+            f"separation     {s.closest_approach_m:.2f} m between vehicles {a} and {b} at the "
+            f"closest ({'BREACHED: less than' if breach else 'kept:'} {s.separation_m:g} m)"
+        )
+    for v in s.vehicles:
+        o = v.outcome
+        lines.append(
+            f"vehicle {v.sysid:<6d} {o.status.value}: {safe_text(o.reason)}; "
+            f"{v.flight_time_s:.1f} s, route {v.route_length_m:.1f} m, {counted(v.frames, 'photo')}"
+        )
+        for result in v.results:
+            values = safe_text(json.dumps(result.values))
+            lines.append(f"  result       {safe_text(result.tag)}: {values[:200]}")
+        if v.clearance_m is not None:
+            lines.append(f"  clearance    {v.clearance_m:.2f} m from the nearest building")
+    lines.append(f"recording      {s.recording if s.recording else '(not recorded)'}")
+    return "\n".join(lines)

@@ -115,9 +115,11 @@ def fleet_configs(
 
 @dataclass(frozen=True, slots=True)
 class Approach:
-    """The least gap between two vehicles' bodies so far (m; ≤ 0: they touched), while at
-    least one of them was off the ground, and which two (system ids)."""
+    """The least distance between two vehicles so far, while at least one of them was off
+    the ground: between their positions (``distance_m``) and between their bodies (``gap_m``;
+    ≤ 0: they touched), and which two (system ids)."""
 
+    distance_m: float = math.inf
     gap_m: float = math.inf
     sysids: tuple[int, int] = (0, 0)
     at_ns: int = 0
@@ -203,11 +205,10 @@ class Fleet:
                 b = vehicles[j]
                 if not (a_air or not b.autopilot.vehicle.state.on_ground):
                     continue
-                gap_m = _swept_distance(before[i], now[i], before[j], now[j]) - (
-                    a.config.body_radius_m + b.config.body_radius_m
-                )
+                distance_m = _swept_distance(before[i], now[i], before[j], now[j])
+                gap_m = distance_m - (a.config.body_radius_m + b.config.body_radius_m)
                 if gap_m < self.approach.gap_m:
-                    self.approach = Approach(gap_m, (a.sysid, b.sysid), a.now_ns)
+                    self.approach = Approach(distance_m, gap_m, (a.sysid, b.sysid), a.now_ns)
                 if gap_m < 0.0:
                     self._contact(a, b)
 

@@ -15,9 +15,11 @@ is not ours (MAVProxy, QGroundControl) cannot be stepped: ``uavtool sitl`` stays
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 
 from uavtool.camera import CameraPose
 from uavtool.sitl.config import SitlConfig
+from uavtool.sitl.fleet import Fleet
 from uavtool.sitl.mount import true_camera_pose
 from uavtool.sitl.server import Sitl
 
@@ -106,3 +108,120 @@ class LockstepTransport:
         due = self._wall0 + (self.vehicle.now_ns - self._sim0_ns) / _NS / self.speedup
         if due > now:
             time.sleep(due - now)
+
+
+class FleetLockstep:
+    """Several built-in vehicles in one world (:class:`~uavtool.sitl.fleet.Fleet`), stepped by
+    their clients: the fleet's flight is a function of its inputs, as one vehicle's is.
+
+    ``members[i]`` is vehicle ``i``'s :class:`~uavtool.link.transport.Transport`. Its
+    ``recv(timeout_s)`` returns what the vehicle has sent; with nothing waiting and a timeout,
+    it steps the whole world until the vehicle speaks (how each client connects, one after
+    another). A loop that serves every vehicle reads them with ``recv(0)``, which never steps,
+    and steps the world itself (:meth:`step_until_said`).
+    """
+
+    def __init__(self, configs: Sequence[SitlConfig], *, speedup: float | None = None) -> None:
+        if speedup is not None and not speedup > 0:
+            raise ValueError(f"speedup must be > 0 or None, got {speedup}")
+        self.fleet = Fleet(configs)
+        self.speedup = speedup
+        self.members = [_Member(self, vehicle) for vehicle in self.fleet.vehicles]
+        self._wall0: float | None = None
+        self._sim0_ns = 0
+
+    def clock(self) -> float:
+        """The world's time since boot, seconds: every vehicle's."""
+        return self.fleet.now_ns / _NS
+
+    def recording_ns(self) -> int:
+        return SIM_EPOCH_NS + self.fleet.now_ns
+
+    def camera_pose(self, index: int) -> CameraPose:
+        """Where vehicle ``index``'s camera really is (ENU around its own home)."""
+        ap = self.fleet.vehicles[index].autopilot
+        return true_camera_pose(ap.state, ap.gimbal, ap.mount)
+
+    def step(self) -> None:
+        """Every client's bytes delivered, then one physics step of the world."""
+        for member in self.members:
+            member.deliver()
+        self._pace()
+        self.fleet.step()
+
+    def step_until_said(self, timeout_s: float) -> None:
+        """Deliver every client's bytes, then step until a vehicle has said something to its
+        client or ``timeout_s`` of world time has passed."""
+        deadline_ns = self.fleet.now_ns + max(round(timeout_s * _NS), 0)
+        while True:
+            for member in self.members:
+                member.deliver()
+            if any(m.waiting for m in self.members) or self.fleet.now_ns >= deadline_ns:
+                return
+            self._pace()
+            self.fleet.step()
+
+    def close(self) -> None:
+        for member in self.members:
+            member.closed = True
+        self.fleet.close()
+
+    def _pace(self) -> None:
+        if self.speedup is None:
+            return
+        now = time.perf_counter()
+        if self._wall0 is None:
+            self._wall0, self._sim0_ns = now, self.fleet.now_ns
+            return
+        due = self._wall0 + (self.fleet.now_ns - self._sim0_ns) / _NS / self.speedup
+        if due > now:
+            time.sleep(due - now)
+
+
+class _Member:
+    """One vehicle's end of a :class:`FleetLockstep`."""
+
+    def __init__(self, world: FleetLockstep, vehicle: Sitl) -> None:
+        self.world = world
+        self.vehicle = vehicle
+        self.name = f"lockstep:builtin:{vehicle.sysid}"
+        self._to_client = bytearray()
+        self._to_vehicle = bytearray()
+        self._link = vehicle.attach(self.name, self._received)
+        self.closed = False
+        """Set when the client is done: what the vehicle says from then on is dropped."""
+
+    @property
+    def waiting(self) -> bool:
+        """Whether the vehicle has said something its client has not read."""
+        return bool(self._to_client)
+
+    def _received(self, data: bytes) -> None:
+        if not self.closed:
+            self._to_client += data
+
+    def deliver(self) -> None:
+        if self._to_vehicle:
+            data = bytes(self._to_vehicle)
+            self._to_vehicle.clear()
+            self.vehicle.deliver(self._link, data)
+
+    def send(self, data: bytes) -> None:
+        self._to_vehicle += data
+
+    def recv(self, timeout_s: float) -> bytes:
+        world = self.world
+        deadline_ns = world.fleet.now_ns + max(round(timeout_s * _NS), 0)
+        while True:
+            self.deliver()
+            if self._to_client:
+                data = bytes(self._to_client)
+                self._to_client.clear()
+                return data
+            if world.fleet.now_ns >= deadline_ns:
+                return b""
+            world.step()
+
+    def close(self) -> None:
+        self.closed = True
+        self._to_client.clear()

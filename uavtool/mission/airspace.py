@@ -1,0 +1,129 @@
+"""Keeping a fleet's vehicles apart: each vehicle flies only inside airspace it has claimed, and
+a claim is granted only when it lies at least the separation from every other vehicle's.
+
+Claims are simple solids in the fleet's frame (ENU metres around the first vehicle's home): a
+**point** (hovering, or standing on the ground), a **lane** (a horizontal segment flown at one
+altitude) and a **column** (a vertical cylinder between two altitudes: a take-off, a landing,
+a look down from lower). Every vehicle always holds exactly one claim, which covers where it
+is; it asks for the next before it moves, waits where it is while the answer is no, and shrinks
+its claim to a point when it arrives. Each claim is widened by how far a vehicle may stray from
+where it was sent (``margin_m``), so two granted claims keep the vehicles themselves apart.
+
+Two claims are apart when their vertical gap or their horizontal gap is at least the
+separation: a sufficient test (the distance between them is at least the larger of the two),
+never a guess.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+EN = tuple[float, float]
+
+
+@dataclass(frozen=True, slots=True)
+class Claim:
+    """Airspace one vehicle may fly in: the horizontal segment ``a``–``b`` (a point when they
+    are equal) swept sideways by ``radius_m``, between altitudes ``low_m`` and ``high_m``."""
+
+    a: EN
+    b: EN
+    radius_m: float
+    low_m: float
+    high_m: float
+    what: str = ""
+
+    @staticmethod
+    def point(at: EN, alt_m: float, what: str = "") -> Claim:
+        return Claim(at, at, 0.0, alt_m, alt_m, what)
+
+    @staticmethod
+    def lane(a: EN, b: EN, alt_m: float, what: str = "") -> Claim:
+        return Claim(a, b, 0.0, alt_m, alt_m, what)
+
+    @staticmethod
+    def column(at: EN, radius_m: float, low_m: float, high_m: float, what: str = "") -> Claim:
+        return Claim(at, at, radius_m, min(low_m, high_m), max(low_m, high_m), what)
+
+    def covers(self, at: EN, alt_m: float, tolerance_m: float) -> bool:
+        """Whether a vehicle at ``at``/``alt_m`` is inside (within ``tolerance_m``)."""
+        inside_up = self.low_m - tolerance_m <= alt_m <= self.high_m + tolerance_m
+        return inside_up and _point_segment(at, self.a, self.b) <= self.radius_m + tolerance_m
+
+
+def gap_m(p: Claim, q: Claim) -> float:
+    """A lower bound of the distance between two claims: the larger of their vertical and
+    horizontal gaps."""
+    vertical = max(q.low_m - p.high_m, p.low_m - q.high_m, 0.0)
+    horizontal = max(_segment_segment(p.a, p.b, q.a, q.b) - p.radius_m - q.radius_m, 0.0)
+    return max(vertical, horizontal)
+
+
+class Airspace:
+    """The claims of ``vehicles`` vehicles kept ``separation_m`` apart, each widened by
+    ``margin_m`` (how far a vehicle may stray from where it was sent). Vehicle ``i`` starts
+    holding a point at ``starts[i]`` (its home, on the ground)."""
+
+    def __init__(
+        self, starts: tuple[tuple[EN, float], ...], *, separation_m: float, margin_m: float
+    ) -> None:
+        if not (separation_m > 0.0 and margin_m >= 0.0):
+            raise ValueError("separation must be > 0 and the margin ≥ 0")
+        self.separation_m = separation_m
+        self.margin_m = margin_m
+        self.held: list[Claim] = [Claim.point(at, alt, "home") for at, alt in starts]
+        self.refusals = 0
+        """How many requests were refused (each one a wait of one telemetry period)."""
+
+    def blocker(self, vehicle: int, claim: Claim) -> int | None:
+        """The first other vehicle whose claim is nearer ``claim`` than the separation (with
+        both margins), or None."""
+        need = self.separation_m + 2.0 * self.margin_m
+        for other, held in enumerate(self.held):
+            if other != vehicle and gap_m(claim, held) < need:
+                return other
+        return None
+
+    def request(self, vehicle: int, claim: Claim) -> bool:
+        """Grant ``claim`` to ``vehicle`` (it replaces what it held) if it is apart from every
+        other vehicle's; False, and nothing changes, if not."""
+        if self.blocker(vehicle, claim) is not None:
+            self.refusals += 1
+            return False
+        self.held[vehicle] = claim
+        return True
+
+    def shrink(self, vehicle: int, at: EN, alt_m: float, what: str = "") -> None:
+        """The vehicle arrived: it holds only the point where it is (always granted: the point
+        lies inside what it held)."""
+        self.held[vehicle] = Claim.point(at, alt_m, what)
+
+
+def _point_segment(p: EN, a: EN, b: EN) -> float:
+    ax, ay = a
+    dx, dy = b[0] - ax, b[1] - ay
+    dd = dx * dx + dy * dy
+    t = 0.0 if dd == 0.0 else min(max(((p[0] - ax) * dx + (p[1] - ay) * dy) / dd, 0.0), 1.0)
+    return math.hypot(p[0] - ax - t * dx, p[1] - ay - t * dy)
+
+
+def _segment_segment(a: EN, b: EN, c: EN, d: EN) -> float:
+    """Least distance between the segments ``a``–``b`` and ``c``–``d`` in the plane."""
+    if _crosses(a, b, c, d):
+        return 0.0
+    return min(
+        _point_segment(a, c, d),
+        _point_segment(b, c, d),
+        _point_segment(c, a, b),
+        _point_segment(d, a, b),
+    )
+
+
+def _crosses(a: EN, b: EN, c: EN, d: EN) -> bool:
+    def side(p: EN, q: EN, r: EN) -> float:
+        return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
+
+    d1, d2 = side(c, d, a), side(c, d, b)
+    d3, d4 = side(a, b, c), side(a, b, d)
+    return ((d1 > 0 > d2) or (d1 < 0 < d2)) and ((d3 > 0 > d4) or (d3 < 0 < d4))
