@@ -25,6 +25,7 @@ from typing import Any
 from uavtool import __version__
 from uavtool.errors import FailureError, InputError, UavtoolError
 from uavtool.mission.base import FlightMission, MissionInputs
+from uavtool.mission.fleet import FleetMember
 from uavtool.mission.observations import Observation
 from uavtool.mission.outputs import Output
 from uavtool.mission.params import FlightParams, from_dict
@@ -226,9 +227,30 @@ class MissionCodeError(FailureError):
 
 
 def create_mission(cls: type[FlightMission], params: Any, inputs: MissionInputs) -> FlightMission:
-    """The mission object; a plug-in's own failure is a one-line error naming it."""
+    """The mission object; a plug-in's own failure is a one-line error naming it. A fleet
+    mission flown by one vehicle is a fleet of one."""
+    if issubclass(cls, FleetMember):
+        return create_fleet(cls, params, inputs, ((0.0, 0.0),))[0]
     try:
         return cls(params, inputs)
+    except InputError:
+        raise
+    except Exception as exc:
+        raise PluginError(
+            f"mission {cls.__name__} could not start: {type(exc).__name__}: {exc}"
+        ) from None
+
+
+def create_fleet(
+    cls: type[FleetMember],
+    params: Any,
+    inputs: MissionInputs,
+    homes_en_m: tuple[tuple[float, float], ...],
+) -> list[FleetMember]:
+    """A fleet mission's members, one per home (the fleet's frame); a plug-in's own failure
+    is a one-line error naming it."""
+    try:
+        return cls.fleet(params, inputs, homes_en_m)
     except InputError:
         raise
     except Exception as exc:

@@ -33,10 +33,16 @@ class Claim:
     low_m: float
     high_m: float
     what: str = ""
+    parked: bool = False
+    """A vehicle standing on the ground, motors off: it strays nowhere (no margin)."""
 
     @staticmethod
     def point(at: EN, alt_m: float, what: str = "") -> Claim:
         return Claim(at, at, 0.0, alt_m, alt_m, what)
+
+    @staticmethod
+    def parked_at(at: EN, what: str = "on the ground") -> Claim:
+        return Claim(at, at, 0.0, 0.0, 0.0, what, parked=True)
 
     @staticmethod
     def lane(a: EN, b: EN, alt_m: float, what: str = "") -> Claim:
@@ -62,28 +68,29 @@ def gap_m(p: Claim, q: Claim) -> float:
 
 class Airspace:
     """The claims of ``vehicles`` vehicles kept ``separation_m`` apart, each widened by
-    ``margin_m`` (how far a vehicle may stray from where it was sent). Vehicle ``i`` starts
-    holding a point at ``starts[i]`` (its home, on the ground)."""
+    ``margin_m`` (how far a vehicle may stray from where it was sent; a parked vehicle strays
+    nowhere). Vehicle ``i`` starts parked at ``starts[i]`` (its home)."""
 
-    def __init__(
-        self, starts: tuple[tuple[EN, float], ...], *, separation_m: float, margin_m: float
-    ) -> None:
+    def __init__(self, starts: tuple[EN, ...], *, separation_m: float, margin_m: float) -> None:
         if not (separation_m > 0.0 and margin_m >= 0.0):
             raise ValueError("separation must be > 0 and the margin ≥ 0")
         self.separation_m = separation_m
         self.margin_m = margin_m
-        self.held: list[Claim] = [Claim.point(at, alt, "home") for at, alt in starts]
+        self.held: list[Claim] = [Claim.parked_at(at, "home") for at in starts]
         self.refusals = 0
         """How many requests were refused (each one a wait of one telemetry period)."""
 
     def blocker(self, vehicle: int, claim: Claim) -> int | None:
         """The first other vehicle whose claim is nearer ``claim`` than the separation (with
-        both margins), or None."""
-        need = self.separation_m + 2.0 * self.margin_m
+        the margins of both), or None."""
         for other, held in enumerate(self.held):
-            if other != vehicle and gap_m(claim, held) < need:
+            if other != vehicle and gap_m(claim, held) < self.needed_m(claim, held):
                 return other
         return None
+
+    def needed_m(self, p: Claim, q: Claim) -> float:
+        """The gap two claims need: the separation and each one's margin."""
+        return self.separation_m + sum(0.0 if c.parked else self.margin_m for c in (p, q))
 
     def request(self, vehicle: int, claim: Claim) -> bool:
         """Grant ``claim`` to ``vehicle`` (it replaces what it held) if it is apart from every
@@ -98,6 +105,10 @@ class Airspace:
         """The vehicle arrived: it holds only the point where it is (always granted: the point
         lies inside what it held)."""
         self.held[vehicle] = Claim.point(at, alt_m, what)
+
+    def park(self, vehicle: int, at: EN) -> None:
+        """The vehicle landed and disarmed: it holds only where it stands."""
+        self.held[vehicle] = Claim.parked_at(at)
 
 
 def _point_segment(p: EN, a: EN, b: EN) -> float:

@@ -73,7 +73,7 @@ class Crew:
         self.homes_en_m = homes_en_m
         self.fleet = fleet
         self.airspace = Airspace(
-            tuple((home, 0.0) for home in homes_en_m),
+            homes_en_m,
             separation_m=fleet.separation_m,
             margin_m=fleet.margin_m,
         )
@@ -209,7 +209,7 @@ class FleetMember(FlightMission):
     def outcome_for(self, status: Status, reason: str) -> Outcome:
         if self.last is not None and self.last.landed and not self.last.armed:
             # Landed and disarmed: it holds only where it stands.
-            self.crew.airspace.shrink(self.index, self.to_fleet(self.last.pos_enu_m), 0.0, "landed")
+            self.crew.airspace.park(self.index, self.to_fleet(self.last.pos_enu_m))
         return super().outcome_for(status, reason)
 
 

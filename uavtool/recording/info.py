@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from uavtool.recording import foxglove
+from uavtool.recording.fleet import split_topic
 from uavtool.recording.reader import RecordingReader
 from uavtool.recording.topics import IMAGE
 from uavtool.recording.values import CompressedImage
@@ -54,6 +55,8 @@ class RecordingInfo:
     other_images: tuple[tuple[str, int], ...] = ()  # (topic, count): e.g. the target picture
     from_record: bool = False  # made by `uavtool record`: no mission, so no outcome to expect
     record_result: dict[str, str] | None = None  # what stopped `uavtool record`, if it did stop
+    vehicles: tuple[tuple[int, dict[str, str]], ...] = ()
+    """A fleet's vehicles: (system id, its outcome record), in system-id order."""
 
     @property
     def duration_s(self) -> float:
@@ -94,6 +97,11 @@ def summarize(path: str | Path, *, verify: bool = True) -> RecordingInfo:
         )
         metadata = reader.metadata
         outcome = _last(metadata, OUTCOME_METADATA)
+        # A fleet's frames are its vehicles' (/uavK/camera/image), counted as one flight's.
+        per_vehicle = [
+            t for t in images if split_topic(t) != (None, t) and split_topic(t)[1] == IMAGE
+        ]
+        fleet_frames = sum(images.pop(t) for t in per_vehicle)
         record_result = _last(metadata, RECORD_RESULT_METADATA)
         return RecordingInfo(
             path=str(path),
@@ -108,7 +116,7 @@ def summarize(path: str | Path, *, verify: bool = True) -> RecordingInfo:
             end_ns=end_ns,
             # the summary counts what was written; a scan counts only what it could read
             message_count=sum(counts.values()) + (0 if health.indexed else lost),
-            frame_count=images.pop(IMAGE, 0),
+            frame_count=images.pop(IMAGE, 0) + fleet_frames,
             other_images=tuple(sorted(images.items())),
             topics=topics,
             metadata_names=tuple(name for name, _ in metadata),
@@ -117,6 +125,7 @@ def summarize(path: str | Path, *, verify: bool = True) -> RecordingInfo:
             from_record=record_result is not None
             or any(name == RECORD_METADATA for name, _ in metadata),
             record_result=record_result,
+            vehicles=_vehicles(metadata),
             verified=verify,
             summary_problem=reader.summary_problem,
             damage=tuple(reader.describe(d) for d in damage),
@@ -135,6 +144,18 @@ def _mission(record: dict[str, str] | None) -> str:
         x for x in (record.get("class", ""), f"version {version}" if version else "") if x
     )
     return f"{name} ({where})" if where else name
+
+
+def _vehicles(
+    metadata: list[tuple[str, dict[str, str]]],
+) -> tuple[tuple[int, dict[str, str]], ...]:
+    """Each vehicle of a fleet with its outcome record (``outcome.uavK``)."""
+    found: dict[int, dict[str, str]] = {}
+    for name, record in metadata:
+        head, _, tail = name.partition(".uav")
+        if head == OUTCOME_METADATA and tail.isdigit() and len(tail) <= 3:
+            found[int(tail)] = dict(record)
+    return tuple(sorted(found.items()))
 
 
 def _last(metadata: list[tuple[str, dict[str, str]]], name: str) -> dict[str, str] | None:
@@ -162,6 +183,7 @@ def info_json(info: RecordingInfo) -> dict[str, Any]:
     data = dataclasses.asdict(info)
     data["duration_s"] = info.duration_s
     data["other_images"] = dict(info.other_images)
+    data["vehicles"] = {str(k): v for k, v in info.vehicles}
     return data
 
 
@@ -198,10 +220,18 @@ def format_info(info: RecordingInfo) -> str:
     )
     lines.append(f"messages:  {info.message_count}{readable}")
     others = "".join(f"; {n} on {topic}" for topic, n in info.other_images)
-    lines.append(f"frames:    {info.frame_count} on {IMAGE}{others}")
+    where = "/uavN" + IMAGE if info.vehicles else IMAGE
+    lines.append(f"frames:    {info.frame_count} on {where}{others}")
     if info.mission:
         lines.append(f"mission:   {info.mission}")
     lines.append(_ending(info))
+    for sysid, record in info.vehicles:
+        said = f"{record.get('status', '?')}: {record.get('reason', '?')}"
+        frames = record.get("frames")
+        lines.append(
+            f"vehicle {sysid}: {said}"
+            + (f" ({frames} photos, topics /uav{sysid}/…)" if frames else "")
+        )
     if info.metadata_names:
         lines.append("metadata:  " + ", ".join(info.metadata_names))
     lines.append("topics:")

@@ -9,7 +9,7 @@ from typing import Any
 
 from uavtool.mission import MissionInputs
 from uavtool.mission.fleet import FleetMember
-from uavtool.plugins import flight_params, guarded
+from uavtool.plugins import create_fleet, flight_params, guarded
 from uavtool.replay.load import RecordedFleet, ReplayInputError
 from uavtool.replay.replay import Comparison, Progress, ReplayResult
 
@@ -23,7 +23,8 @@ def replay_fleet(
             f"{fleet.path}: mission {fleet.mission_ref.name!r} is not a fleet mission"
         )
     p = params if params is not None else fleet.params
-    members = fleet.mission.fleet(p, MissionInputs(target_rgb=fleet.target_rgb), fleet.homes_en_m)
+    inputs = MissionInputs(target_rgb=fleet.target_rgb)
+    members = create_fleet(fleet.mission, p, inputs, fleet.homes_en_m)
     if len(members) != len(fleet.vehicles):
         raise ReplayInputError(
             f"{fleet.path}: {len(fleet.vehicles)} vehicles, {len(members)} homes"

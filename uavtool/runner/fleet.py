@@ -10,6 +10,7 @@ one vehicle's.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import json
 import math
@@ -30,7 +31,7 @@ from uavtool.mission import Level, MissionInputs, Outcome, Status, Telemetry
 from uavtool.mission.fleet import FleetMember
 from uavtool.mission.outputs import Result
 from uavtool.mission.params import with_overrides
-from uavtool.plugins import MissionRef, resolve
+from uavtool.plugins import MissionRef, create_fleet, resolve
 from uavtool.recording.cores import core_to_spare
 from uavtool.recording.files import atomic_output
 from uavtool.recording.fleet import CREW_METADATA, VehicleWriter
@@ -147,6 +148,7 @@ def fly_fleet(
     params = config.params if config.params is not None else mission_cls.params_type()
     if config.no_gimbal:
         params = with_overrides(params, {f"{mission_cls.flight_group}.gimbal": False})
+    config = dataclasses.replace(config, params=params)
     scene = config.scene if isinstance(config.scene, Scene) else load_scene(config.scene)
     w, h = config.size_px
     intrinsics = Intrinsics.from_hfov(width_px=w, height_px=h, hfov_deg=config.hfov_deg)
@@ -234,7 +236,7 @@ def fly_fleet(
             writer.add_metadata(
                 CREW_METADATA, {"homes_en_m": json.dumps([list(h) for h in homes_en])}
             )
-        members = mission_cls.fleet(params, MissionInputs(target_rgb=target_rgb), homes_en)
+        members = create_fleet(mission_cls, params, MissionInputs(target_rgb=target_rgb), homes_en)
         steps = itertools.count(1)  # one order for every member's observations
         runners = []
         for i, (link, autopilot, member, recorder) in enumerate(

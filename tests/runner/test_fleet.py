@@ -1,0 +1,173 @@
+"""``uavtool fly --vehicles N``: a fleet mission on built-in vehicles in one lockstep world,
+recorded in one file, replayed and re-flown byte for byte; and its errors."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from uavtool.cli import cli
+from uavtool.errors import InputError
+from uavtool.examples.fleet_survey import FleetSurveyParams
+from uavtool.mission import Status
+from uavtool.mission.fleet import FleetParams
+from uavtool.recording import RecordingReader, summarize
+from uavtool.replay import load_flight
+from uavtool.replay.fleet import replay_fleet
+from uavtool.replay.load import is_fleet, load_fleet
+from uavtool.replay.refly import refly
+from uavtool.runner.fleet import FleetSummary, fly_fleet
+from uavtool.runner.fly import FlyConfig
+
+
+def _config(path: Path | None, **kw: object) -> FlyConfig:
+    config = FlyConfig(mission="fleet-survey", vehicles=3, record=path, no_record=path is None)
+    return dataclasses.replace(config, **kw)  # type: ignore[arg-type]
+
+
+@pytest.fixture(scope="module")
+def survey(tmp_path_factory: pytest.TempPathFactory) -> tuple[FleetSummary, Path]:
+    path = tmp_path_factory.mktemp("fleet") / "fleet.mcap"
+    return fly_fleet(_config(path)), path
+
+
+def test_three_vehicles_survey_their_strips_apart(survey: tuple[FleetSummary, Path]) -> None:
+    s, _ = survey
+    assert s.status is Status.COMPLETED, s.reason
+    assert [v.sysid for v in s.vehicles] == [1, 2, 3]
+    assert all(v.outcome.status is Status.COMPLETED for v in s.vehicles)
+    # Each photographed its own strip, and the last to finish stitched the map of them all.
+    strips = [next(r.values for r in v.results if r.tag == "strip") for v in s.vehicles]
+    assert [x["vehicle"] for x in strips] == [1, 2, 3] and all(x["photos"] > 0 for x in strips)
+    mosaic = [r.values for v in s.vehicles for r in v.results if r.tag == "mosaic"]
+    assert len(mosaic) == 1 and mosaic[0]["covered"] == 1.0
+    assert mosaic[0]["photos"] == sum(x["photos"] for x in strips)
+    # The vehicles never came closer than the separation (the simulator's own measure).
+    assert s.closest_approach_m >= s.separation_m == FleetParams().separation_m
+
+
+def test_one_recording_holds_every_vehicle(survey: tuple[FleetSummary, Path]) -> None:
+    s, path = survey
+    assert is_fleet(path)
+    with RecordingReader(path) as reader:
+        topics = set(reader.topics())
+        meta = dict(reader.metadata)
+    for k in (1, 2, 3):
+        for topic in ("mission/observations", "mission/outputs", "camera/image", "vehicle/fix"):
+            assert f"/uav{k}/{topic}" in topics
+        assert meta[f"outcome.uav{k}"]["status"] == "completed"
+    assert "/mission/observations" not in topics  # no vehicle's topics outside its namespace
+    assert "/mavlink/in/HEARTBEAT" in topics  # the link's frames are shared, told by sysid
+    assert meta["fleet"] == {"vehicles": "3", "offset_line": "[90.0, 10.0]"}
+    assert len(json.loads(meta["crew"]["homes_en_m"])) == 3
+    assert meta["outcome"]["status"] == "completed"
+    assert float(meta["outcome"]["closest_approach_m"]) == pytest.approx(
+        s.closest_approach_m, abs=0.01
+    )
+    info = summarize(path)
+    assert [k for k, _ in info.vehicles] == [1, 2, 3]
+    assert info.frame_count == sum(v.frames for v in s.vehicles)
+
+
+def test_replay_feeds_every_member_and_finds_the_same_outputs(
+    survey: tuple[FleetSummary, Path],
+) -> None:
+    _, path = survey
+    fleet = load_fleet(path)
+    results = replay_fleet(fleet)
+    assert [r.identical and r.finished for r in results] == [True, True, True]
+    assert sum(r.steps for r in results) == sum(len(v.steps) for v in fleet.vehicles)
+    # Other parameters are a re-analysis: denser photos make the members decide otherwise.
+    denser = dataclasses.replace(
+        fleet.params,
+        survey=dataclasses.replace(fleet.params.survey, overlap=0.6),
+    )
+    assert isinstance(denser, FleetSurveyParams)
+    assert all(r.divergence is not None for r in replay_fleet(fleet, denser))
+
+
+def test_check_and_refly_from_the_command_line(survey: tuple[FleetSummary, Path]) -> None:
+    _, path = survey
+    result = CliRunner().invoke(cli, ["replay", "--check", str(path)])
+    assert result.exit_code == 0, result.output
+    assert "identical: every output of every vehicle equals the recorded one" in result.output
+    assert result.output.count("; identical") == 3
+    again = refly(path)
+    assert again.identical, again.first_difference
+    assert again.messages > 10_000
+
+
+def test_the_command_flies_and_prints_the_fleet(tmp_path: Path) -> None:
+    out = tmp_path / "f.mcap"
+    args = ["fly", "--vehicles", "2", "--mission", "fleet-survey", "-q", "-o", str(out)]
+    result = CliRunner().invoke(cli, args)
+    assert result.exit_code == 0, result.output
+    assert "fleet          2 vehicles, mission fleet-survey" in result.output
+    assert "separation     10.00 m between vehicles 1 and 2 at the closest (kept: 5 m)" in (
+        result.output
+    )
+    assert (
+        "vehicle 1      completed" in result.output and "vehicle 2      completed" in result.output
+    )
+    info = CliRunner().invoke(cli, ["info", str(out)])
+    assert "vehicle 2: completed" in info.output
+
+
+def test_homes_closer_than_the_claims_take_off_one_after_another() -> None:
+    # 8.5 m apart: more than the separation, less than two take-off columns with their
+    # margins (5 + 2 × 1.5 + 2 × 0.6 m), so the second waits for the first to reach its layer.
+    events: list[tuple[int, str]] = []
+    s = fly_fleet(
+        _config(None, vehicles=2, offset_line=(90.0, 8.5)),
+        progress=lambda sysid, text, _t: events.append((sysid, text)),
+    )
+    assert s.status is Status.COMPLETED, s.reason
+    assert (2, "take-off: waiting for vehicle 1 to clear the way") in events
+    assert s.closest_approach_m >= 5.0
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--vehicles", "3"], "mission 'search' flies one vehicle"),
+        (["--vehicles", "3", "--mission", "fleet-survey", "--connect", "tcp:127.0.0.1:1"],
+         "fleets of external vehicles are not supported yet"),
+        (["--vehicles", "3", "--mission", "fleet-survey", "--offset-line", "90,4"],
+         "the homes stand closer than the fleet's separation (5 m)"),
+        (["--vehicles", "3", "--mission", "fleet-survey", "--offset-line", "0,10"],
+         "vehicle 2's home 50.064790,19.945000 is in building 'purple'"),
+        (["--vehicles", "2", "--mission", "fleet-survey", "--offset-line", "90"],
+         "offset line '90'"),
+    ],
+)  # fmt: skip
+def test_bad_fleets_are_refused_on_the_ground(
+    args: list[str], message: str, tmp_path: Path
+) -> None:
+    out = tmp_path / "never.mcap"
+    result = CliRunner().invoke(cli, ["fly", *args, "-o", str(out)])
+    assert result.exit_code == 2, result.output
+    assert message in result.output
+    assert not out.exists() and not list(tmp_path.iterdir())
+
+
+def test_a_fleet_mission_on_one_vehicle_is_a_fleet_of_one(tmp_path: Path) -> None:
+    out = tmp_path / "one.mcap"
+    result = CliRunner().invoke(cli, ["fly", "--mission", "fleet-survey", "-q", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert not is_fleet(out)
+    check = CliRunner().invoke(cli, ["replay", "--check", str(out)])
+    assert check.exit_code == 0 and "identical" in check.output
+
+
+def test_a_fleet_recording_is_refused_where_it_is_not_supported(
+    survey: tuple[FleetSummary, Path], tmp_path: Path
+) -> None:
+    _, path = survey
+    result = CliRunner().invoke(cli, ["replay", str(path), "-o", str(tmp_path / "r.mcap")])
+    assert result.exit_code == 2 and "-o/--output and --vision-only not yet" in result.output
+    with pytest.raises(InputError, match="a fleet's recording"):
+        load_flight(path)
