@@ -104,6 +104,7 @@ def search(
     overview_shapes: tuple[Shape, ...],
     transit_m: float,
     roofless: frozenset[int] = frozenset(),
+    inspector: Callable[[int], Wait[Inspection]] | None = None,
 ) -> Wait[Found | None]:
     """Visit the points of interest in order (across at ``transit_m``, over every known
     roof); the best match (the first one unless ``visit_all``); ends the mission with
@@ -115,52 +116,12 @@ def search(
     best_score, best_poi = 0.0, -1
     matches: list[Found] = []  # every building that matched, in turn
     unjudged: list[tuple[int, _Look]] = []  # of the target's hue, never judged
-    ceiling_m = overview.pose.pos_enu_m[2]
     todo = list(order)
+    look_at = inspector or (lambda k: inspect(m, k, pois, overview, overview_shapes, transit_m))
     while todo:
         k = todo.pop(0)
         poi = pois[k]
-        x, y = poi.pos_en_m
-        # a roof of unknown height is looked at from over the highest it may be: a closer
-        # look follows only once a look has measured it
-        upper = None if poi.roof_measured else m.unknown.get(poi.shape_index, (None, ceiling_m))[1]
-        alt = min(look_altitude_m(m, poi, overview.intrinsics, upper), ceiling_m)
-        alt = max(alt, m.floor_at(x, y))
-        yield from m.travel((x, y, alt), None, transit_m, f"point of interest {k}")
-        m.visited.append(k)
-        looks = [(yield from _look(m, k, 1, alt, poi.colour_rgb))]
-        roof_m = poi.roof_m
-        for n in range(2, p.max_looks + 1):
-            closer = None
-            if not poi.roof_measured:
-                before = [(overview_shapes[poi.shape_index], overview)] + [
-                    (look.shapes[look.judgement.candidate], look.photo)
-                    for look in looks[:-1]
-                    if look.judgement.candidate >= 0
-                ]
-                closer = _closer_look(m, looks[-1], before, poi.shape_index)
-            if closer is not None:
-                pos, roof_m = closer
-                m.event(
-                    Level.INFO,
-                    f"point of interest {k}: score {looks[-1].judgement.score:.3f} just below "
-                    f"the threshold; its roof measured {roof_m:.1f} m above home: looking "
-                    f"again from closer, at {pos[2]:.1f} m",
-                )
-                yield from m.travel(pos, None, transit_m, f"point of interest {k}, look {n}")
-                looks.append((yield from _look(m, k, n, pos[2], poi.colour_rgb)))
-                continue
-            again = _look_again(m, looks[-1], roof_m, ceiling_m)
-            if again is None:
-                break
-            pos, why = again
-            m.event(
-                Level.INFO,
-                f"point of interest {k}: {why}; looking again from above its roof at "
-                f"{pos[2]:.1f} m",
-            )
-            yield from _shift(m, pos, f"point of interest {k}, look {n}")
-            looks.append((yield from _look(m, k, n, pos[2], poi.colour_rgb)))
+        looks, upper = yield from look_at(k)
         top = max(look.judgement.score for look in looks)
         if top > best_score:
             best_score, best_poi = top, k
@@ -222,6 +183,67 @@ def search(
         f"roof {best.roof_m:.1f} m above home",
     )
     return best
+
+
+Inspection = tuple[list["_Look"], float | None]
+"""What the looks at one point of interest found: the looks in order, and the highest its
+roof may be when its height is unknown (else None)."""
+
+
+def inspect(
+    m: SearchMission,
+    k: int,
+    pois: tuple[PointOfInterest, ...],
+    overview: Photo,
+    overview_shapes: tuple[Shape, ...],
+    transit_m: float,
+) -> Wait[Inspection]:
+    """Fly to point of interest ``k`` (across at ``transit_m``) and look at it, from closer
+    or again as the looks ask, up to ``mission.max_looks``."""
+    p = m.params.mission
+    ceiling_m = overview.pose.pos_enu_m[2]
+    poi = pois[k]
+    x, y = poi.pos_en_m
+    # a roof of unknown height is looked at from over the highest it may be: a closer
+    # look follows only once a look has measured it
+    upper = None if poi.roof_measured else m.unknown.get(poi.shape_index, (None, ceiling_m))[1]
+    alt = min(look_altitude_m(m, poi, overview.intrinsics, upper), ceiling_m)
+    alt = max(alt, m.floor_at(x, y))
+    yield from m.travel((x, y, alt), None, transit_m, f"point of interest {k}")
+    m.visited.append(k)
+    looks = [(yield from _look(m, k, 1, alt, poi.colour_rgb))]
+    roof_m = poi.roof_m
+    for n in range(2, p.max_looks + 1):
+        closer = None
+        if not poi.roof_measured:
+            before = [(overview_shapes[poi.shape_index], overview)] + [
+                (look.shapes[look.judgement.candidate], look.photo)
+                for look in looks[:-1]
+                if look.judgement.candidate >= 0
+            ]
+            closer = _closer_look(m, looks[-1], before, poi.shape_index)
+        if closer is not None:
+            pos, roof_m = closer
+            m.event(
+                Level.INFO,
+                f"point of interest {k}: score {looks[-1].judgement.score:.3f} just below "
+                f"the threshold; its roof measured {roof_m:.1f} m above home: looking "
+                f"again from closer, at {pos[2]:.1f} m",
+            )
+            yield from m.travel(pos, None, transit_m, f"point of interest {k}, look {n}")
+            looks.append((yield from _look(m, k, n, pos[2], poi.colour_rgb)))
+            continue
+        again = _look_again(m, looks[-1], roof_m, ceiling_m)
+        if again is None:
+            break
+        pos, why = again
+        m.event(
+            Level.INFO,
+            f"point of interest {k}: {why}; looking again from above its roof at {pos[2]:.1f} m",
+        )
+        yield from _shift(m, pos, f"point of interest {k}, look {n}")
+        looks.append((yield from _look(m, k, n, pos[2], poi.colour_rgb)))
+    return looks, upper
 
 
 def _judged_all(m: SearchMission, best: Found, unjudged: list[tuple[int, _Look]]) -> None:
