@@ -81,10 +81,10 @@ def test_replay_feeds_every_member_and_finds_the_same_outputs(
     results = replay_fleet(fleet)
     assert [r.identical and r.finished for r in results] == [True, True, True]
     assert sum(r.steps for r in results) == sum(len(v.steps) for v in fleet.vehicles)
-    # Other parameters are a re-analysis: denser photos make the members decide otherwise.
+    # Other parameters are a re-analysis: a wider square makes every member decide otherwise.
     denser = dataclasses.replace(
         fleet.params,
-        survey=dataclasses.replace(fleet.params.survey, overlap=0.6),
+        survey=dataclasses.replace(fleet.params.survey, half_side_m=55.0),
     )
     assert isinstance(denser, FleetSurveyParams)
     assert all(r.divergence is not None for r in replay_fleet(fleet, denser))

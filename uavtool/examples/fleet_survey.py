@@ -2,15 +2,15 @@
 into one strip per vehicle (west to east), each vehicle photographs its strip at its own layer,
 and the last to finish stitches every photo into one map.
 
-A fleet mission in a few lines: the members are one class (:class:`FleetMember`), take off
-with :meth:`~FleetMember.take_off_to_layer`, move with :meth:`~FleetMember.go` (which claims
-the airspace first, so the vehicles keep ``fleet.separation_m`` apart) and share their photos
-on the crew's board. ``uavtool fly --vehicles 3 --mission fleet-survey`` flies it.
+A fleet mission in a few lines: the members are one class (:class:`FleetMember`), live in
+the fleet's frame (around the first vehicle's home), take off with
+:meth:`~FleetMember.take_off`, move as any mission does (every move claims its airspace
+first, so the vehicles keep ``fleet.separation_m`` apart) and share their photos on the
+crew's board. ``uavtool fly --vehicles 3 --mission fleet-survey`` flies it.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -68,16 +68,15 @@ class FleetSurveyMission(FleetMember):
     def fly(self) -> Wait[str]:
         s = self.params.survey
         layer = self.layer_m()
-        yield from self.take_off_to_layer()
-        yield from self.go((0.0, 0.0, layer), 0.0, "facing north")
+        hx, hy = self.home_en_m
+        yield from self.take_off(layer)
+        yield from self.move((hx, hy, layer), 0.0, "facing north")
         first = yield from self.photo("home", NADIR_DEG)
         stops = strip_stops(s, first.intrinsics, layer, self.index, self.crew.size)
         self.event(Level.INFO, f"strip {self.index + 1} of {self.crew.size}: {len(stops)} photos")
-        for k, en in enumerate(stops):
-            x, y = self.from_fleet(en)
-            yield from self.go((x, y, layer), 0.0, f"photo {k + 1} of {len(stops)}")
-            photo = yield from self.photo(f"survey-{self.index + 1}-{k}", NADIR_DEG)
-            self.photos.append(self._in_fleet_frame(photo))
+        for k, (x, y) in enumerate(stops):
+            yield from self.move((x, y, layer), 0.0, f"photo {k + 1} of {len(stops)}")
+            self.photos.append((yield from self.photo(f"survey-{self.index + 1}-{k}", NADIR_DEG)))
         board = self.crew.board
         board.setdefault("photos", []).extend(self.photos)
         board["strips done"] = board.get("strips done", 0) + 1
@@ -90,13 +89,6 @@ class FleetSurveyMission(FleetMember):
         if covered < 0.99:
             raise self.end(Status.PARTIAL, f"the mosaic covers {covered:.1%} of the square")
         return f"the last strip; mosaic of {len(board['photos'])} photos"
-
-    def _in_fleet_frame(self, photo: Photo) -> Photo:
-        x, y, z = photo.pose.pos_enu_m
-        hx, hy = self.home_en_m
-        return dataclasses.replace(
-            photo, pose=dataclasses.replace(photo.pose, pos_enu_m=(x + hx, y + hy, z))
-        )
 
 
 def strip_stops(

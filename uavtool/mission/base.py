@@ -116,6 +116,9 @@ class FlightMission:
     """The parameters type: a frozen dataclass whose fields are groups of values."""
     needs_target: ClassVar[bool] = False
     """Whether the flight must give a target picture (``MissionInputs.target_rgb``)."""
+    go_home_after: ClassVar[frozenset[Status]] = _FLIES_HOME
+    """The outcomes after which :meth:`go_home` flies the way home before RTL (a fleet's
+    members fly it after an abort too: their RTL must keep clear of the others)."""
     flight_group: ClassVar[str] = "flight"
     """The group of ``params_type`` that is the :class:`FlightParams` (``--no-gimbal`` sets its
     ``gimbal``)."""
@@ -252,7 +255,7 @@ class FlightMission:
             self.event(Level.INFO, "still on the ground: LAND to disarm (RTL would climb)")
             yield from self.set_mode("LAND")
         elif not landed(self.last):
-            if status in _FLIES_HOME:
+            if status in self.go_home_after:
                 try:
                     yield from self.go_home()
                 except MissionEnd as exc:

@@ -18,7 +18,7 @@ the first vehicle's home (:attr:`FleetMember.home_en_m` is the difference).
 
 from __future__ import annotations
 
-import math
+import dataclasses
 from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any, ClassVar, Self
@@ -26,7 +26,8 @@ from typing import Any, ClassVar, Self
 from uavtool.checks import Range, check_fields
 from uavtool.mission.airspace import EN, Airspace, Claim
 from uavtool.mission.base import FlightMission, MissionInputs, Wait
-from uavtool.mission.outputs import Level, Outcome, Status, Vec3
+from uavtool.mission.observations import Observation, Photo, Telemetry
+from uavtool.mission.outputs import GoTo, Level, Outcome, Output, Status, Vec3
 
 
 @dataclass(frozen=True, slots=True)
@@ -92,13 +93,22 @@ class Crew:
 class FleetMember(FlightMission):
     """One vehicle's part of a fleet mission. Subclass it as a one-vehicle mission (declare
     ``params_type`` with a :class:`FleetParams` group named by ``fleet_group``), write ``fly``
-    with :meth:`take_off_to_layer` and :meth:`go` instead of ``arm_and_take_off`` and ``move``,
-    and read or write :attr:`crew`. uavtool builds the members with :meth:`fleet`."""
+    with :meth:`take_off` instead of ``arm_and_take_off``, and read or write :attr:`crew`.
+    uavtool builds the members with :meth:`fleet`.
+
+    A member lives in the fleet's frame: the telemetry and photos it is given, and the moves it
+    makes, are in ENU metres around the first vehicle's home (its own home is
+    :attr:`home_en_m`); the runner's vehicle still gets its position targets in its own frame.
+    Every :meth:`move` claims its airspace first (:class:`~uavtool.mission.airspace.Airspace`)
+    and waits, hovering, until the others leave it clear."""
 
     fleet_group: ClassVar[str] = "fleet"
     """The group of ``params_type`` that is the :class:`FleetParams`."""
     crew_type: ClassVar[type[Crew]] = Crew
     """The crew the members share (subclass :class:`Crew` to give it more)."""
+    go_home_after: ClassVar[frozenset[Status]] = frozenset(
+        {Status.COMPLETED, Status.PARTIAL, Status.NO_MATCH, Status.ABORTED}
+    )
 
     crew: Crew
     index: int
@@ -114,68 +124,85 @@ class FleetMember(FlightMission):
         crew.members = list(members)
         return members
 
-    # --- where it is --------------------------------------------------------------------------
+    # --- the fleet's frame --------------------------------------------------------------------
 
     @property
     def home_en_m(self) -> EN:
         """This vehicle's home in the fleet's frame."""
         return self.crew.homes_en_m[self.index]
 
-    def to_fleet(self, pos: Vec3 | EN) -> EN:
-        """A position of this vehicle's frame in the fleet's (east, north)."""
-        hx, hy = self.home_en_m
-        return (pos[0] + hx, pos[1] + hy)
+    def start(self) -> list[Output]:
+        return self._to_vehicle(super().start())
 
-    def from_fleet(self, en: EN) -> EN:
+    def step(self, observation: Observation) -> list[Output]:
+        return self._to_vehicle(super().step(self._to_fleet(observation)))
+
+    def _to_fleet(self, obs: Observation) -> Observation:
         hx, hy = self.home_en_m
-        return (en[0] - hx, en[1] - hy)
+        if isinstance(obs, Telemetry):
+            x, y, z = obs.pos_enu_m
+            return dataclasses.replace(obs, pos_enu_m=(x + hx, y + hy, z))
+        if isinstance(obs, Photo):
+            x, y, z = obs.pose.pos_enu_m
+            pose = dataclasses.replace(obs.pose, pos_enu_m=(x + hx, y + hy, z))
+            return dataclasses.replace(obs, pose=pose)
+        return obs
+
+    def _to_vehicle(self, outputs: list[Output]) -> list[Output]:
+        hx, hy = self.home_en_m
+        if hx == hy == 0.0:
+            return outputs
+        return [
+            dataclasses.replace(
+                o, pos_enu_m=(o.pos_enu_m[0] - hx, o.pos_enu_m[1] - hy, o.pos_enu_m[2])
+            )
+            if isinstance(o, GoTo)
+            else o
+            for o in outputs
+        ]
+
+    # --- layers -------------------------------------------------------------------------------
 
     def base_layer_m(self) -> float:
-        """The altitude of the lowest member's layer; a mission says which (default: the
-        flight's RTL altitude of ArduCopter, 15 m)."""
+        """The altitude of the first member's layer; a mission says which (default: 15 m,
+        ArduCopter's RTL altitude)."""
         return 15.0
 
     def layer_m(self, index: int | None = None) -> float:
         """The altitude (above home) at which member ``index`` (default: this one) flies from
-        place to place: the base layer, one layer step higher per member."""
+        place to place: the base layer, one layer step higher per member. Lanes on two layers
+        never meet: members fly across at once."""
         i = self.index if index is None else index
         return self.base_layer_m() + i * self.crew.fleet.layer_step_m
 
     # --- flying apart -------------------------------------------------------------------------
 
-    def take_off_to_layer(self) -> Wait[None]:
-        """Claim the column above home up to this member's layer, then take off to it."""
-        layer = self.layer_m()
-        home = self.to_fleet((0.0, 0.0))
-        yield from self.claim(
-            Claim.column(home, self.flight.arrive_radius_m, 0.0, layer, "take-off"), "take-off"
-        )
-        yield from self.arm_and_take_off(layer)
-        self.crew.airspace.shrink(self.index, home, layer, "at its layer")
+    def take_off(self, alt_m: float) -> Wait[None]:
+        """Claim the column above home up to ``alt_m``, then take off to it."""
+        home = self.home_en_m
+        column = Claim.column(home, self.flight.arrive_radius_m, 0.0, alt_m, "take-off")
+        yield from self.claim(column, "take-off")
+        yield from self.arm_and_take_off(alt_m)
+        self.crew.airspace.shrink(self.index, home, alt_m, "took off")
 
-    def go(self, pos_enu_m: Vec3, heading_deg: float | None, what: str) -> Wait[None]:
-        """Fly to a position (this vehicle's frame) inside claimed airspace: straight up or
-        down in a column, across at this member's layer in a lane, or up to the layer,
-        across, and down. Each part waits for its claim; arriving at the layer shrinks it."""
+    def move(self, pos_enu_m: Vec3, heading_deg: float | None, what: str) -> Wait[None]:
+        """Claim the airspace of the straight way there (widened by the arrival radius), wait
+        until it is granted, fly it, and hold only the point arrived at."""
         last = self.last
-        assert last is not None, "go() needs telemetry: take off first"
+        assert last is not None, "move() needs telemetry: take off first"
         here = last.pos_enu_m
         x, y, z = pos_enu_m
-        tol = self.flight.arrive_radius_m
-        layer = self.layer_m()
-        if math.hypot(x - here[0], y - here[1]) <= tol:
-            claim = Claim.column(self.to_fleet(here), tol, here[2], z, what)
-        elif abs(here[2] - layer) <= tol and abs(z - layer) <= tol:
-            claim = Claim.lane(self.to_fleet(here), self.to_fleet(pos_enu_m), layer, what)
-        else:
-            yield from self.go((here[0], here[1], layer), None, f"{what}: up to the layer")
-            yield from self.go((x, y, layer), None, f"{what}: across")
-            yield from self.go(pos_enu_m, heading_deg, what)
-            return
+        claim = Claim(
+            (here[0], here[1]),
+            (x, y),
+            self.flight.arrive_radius_m,
+            min(here[2], z),
+            max(here[2], z),
+            what,
+        )
         yield from self.claim(claim, what)
-        yield from self.move(pos_enu_m, heading_deg, what)
-        if abs(z - layer) <= tol:
-            self.crew.airspace.shrink(self.index, self.to_fleet(pos_enu_m), z, what)
+        yield from super().move(pos_enu_m, heading_deg, what)
+        self.crew.airspace.shrink(self.index, (x, y), z, what)
 
     def claim(self, claim: Claim, what: str) -> Wait[None]:
         """Wait (hovering where it is) until the airspace grants ``claim``; ABORTED after
@@ -199,17 +226,16 @@ class FleetMember(FlightMission):
         (the vehicle's RTL then descends straight)."""
         if self.last is None or self.last.landed:
             return
-        layer = self.layer_m()
-        yield from self.go((0.0, 0.0, layer), None, "home")
-        home = self.to_fleet((0.0, 0.0))
-        yield from self.claim(
-            Claim.column(home, self.flight.arrive_radius_m, 0.0, layer, "landing"), "landing"
-        )
+        layer = max(self.layer_m(), self.last.pos_enu_m[2])
+        home = self.home_en_m
+        yield from self.move((home[0], home[1], layer), None, "home")
+        column = Claim.column(home, self.flight.arrive_radius_m, 0.0, layer, "landing")
+        yield from self.claim(column, "landing")
 
     def outcome_for(self, status: Status, reason: str) -> Outcome:
         if self.last is not None and self.last.landed and not self.last.armed:
             # Landed and disarmed: it holds only where it stands.
-            self.crew.airspace.park(self.index, self.to_fleet(self.last.pos_enu_m))
+            self.crew.airspace.park(self.index, self.last.pos_enu_m[:2])
         return super().outcome_for(status, reason)
 
 
