@@ -39,9 +39,11 @@ BUILTIN: dict[str, str] = {
     "survey": "uavtool.examples.survey:SurveyMission",
     "orbit": "uavtool.examples.orbit:OrbitMission",
     "fleet-survey": "uavtool.examples.fleet_survey:FleetSurveyMission",
+    "fleet-search": "uavtool.mission.fleet_search:FleetSearchMission",
 }
-"""The missions uavtool ships: the paper's search-and-model, and three examples written on the
-public API alone (:mod:`uavtool.api`), one of them for a fleet."""
+"""The missions uavtool ships: the paper's search-and-model (and the same for a fleet), and
+three examples written on the public API alone (:mod:`uavtool.api`), one of them for a
+fleet."""
 
 _TARGET = re.compile(r"^[A-Za-z_][\w.]*:[A-Za-z_]\w*$")
 _NAME = re.compile(r"^[a-z][a-z0-9_-]*$")

@@ -139,6 +139,7 @@ class FlightMission:
         self._left_ground = False  # seen above home's height tolerance since the take-off
         self._landing = False  # RTL or LAND sent: a disarm on the ground at home is the landing
         self._deferred: list[Observation] = []
+        self._in_fly = False  # fly() is running: interrupt() may end it
         self._gen = self._run()
         self._started = False
 
@@ -210,12 +211,24 @@ class FlightMission:
 
     # --- the flight, and how it ends ----------------------------------------------------------
 
+    def interrupt(self, status: Status, reason: str) -> list[Output]:
+        """End :meth:`fly` now, from outside it, as if it had raised ``end(status, reason)``
+        where it waits (a fleet calls a member off); the way home follows as after any end.
+        Does nothing once ``fly`` has ended. Returns the outputs this makes."""
+        if not self._in_fly:
+            return []
+        with contextlib.suppress(StopIteration):
+            self._gen.throw(MissionEnd(status, reason))
+        return self._take()
+
     def _run(self) -> Wait[None]:
+        self._in_fly = True
         try:
             done = yield from self.fly()
             end = MissionEnd(Status.COMPLETED, done if isinstance(done, str) and done else "done")
         except MissionEnd as exc:
             end = exc
+        self._in_fly = False
         self.event(
             Level.INFO if end.status is Status.COMPLETED else Level.WARNING,
             f"mission ends: {end.status.value}: {end.reason}",

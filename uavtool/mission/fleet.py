@@ -39,7 +39,7 @@ class FleetParams:
     margin_m: float = 1.5
     """How far a vehicle may stray from the straight way it was sent along (tracking error in
     gusts, overshoot): every claim is widened by it."""
-    claim_wait_s: float = 600.0
+    claim_wait_s: float = 300.0
     """A member waits this long for airspace another holds, then aborts (RTL)."""
 
     RANGES: ClassVar[Any] = MappingProxyType(
@@ -89,6 +89,32 @@ class Crew:
     def done(self) -> bool:
         return all(m.done for m in self.members)
 
+    def call_off(self, index: int) -> str | None:  # noqa: ARG002 - for a crew that calls off
+        """Why member ``index`` should stop its work now (its way home follows), or None: the
+        runner asks before each observation. By default a member is never called off."""
+        return None
+
+    def outcome(self, outcomes: list[Outcome]) -> tuple[Status, str]:
+        """The fleet's outcome from its members' (one each, in order): by default a crash if
+        any crashed, else the worst of theirs (completed only when every member completed)."""
+        worst = min(range(len(outcomes)), key=lambda i: _WORST.index(outcomes[i].status))
+        o = outcomes[worst]
+        if o.status is Status.COMPLETED:
+            return o.status, "every vehicle completed"
+        return o.status, f"vehicle {worst + 1}: {o.reason}"
+
+
+_WORST = (
+    Status.CRASHED,
+    Status.LINK_LOST,
+    Status.TAKEOVER,
+    Status.ABORTED,
+    Status.NO_MATCH,
+    Status.PARTIAL,
+    Status.COMPLETED,
+)
+"""Statuses from the worst outcome to the best."""
+
 
 class FleetMember(FlightMission):
     """One vehicle's part of a fleet mission. Subclass it as a one-vehicle mission (declare
@@ -135,7 +161,13 @@ class FleetMember(FlightMission):
         return self._to_vehicle(super().start())
 
     def step(self, observation: Observation) -> list[Output]:
-        return self._to_vehicle(super().step(self._to_fleet(observation)))
+        out: list[Output] = []
+        reason = self.crew.call_off(self.index)
+        if reason is not None:
+            out = self.interrupt(Status.COMPLETED, f"called off: {reason}")
+        if not self.done:
+            out += super().step(self._to_fleet(observation))
+        return self._to_vehicle(out)
 
     def _to_fleet(self, obs: Observation) -> Observation:
         hx, hy = self.home_en_m
@@ -186,23 +218,31 @@ class FleetMember(FlightMission):
         self.crew.airspace.shrink(self.index, home, alt_m, "took off")
 
     def move(self, pos_enu_m: Vec3, heading_deg: float | None, what: str) -> Wait[None]:
-        """Claim the airspace of the straight way there (widened by the arrival radius), wait
-        until it is granted, fly it, and hold only the point arrived at."""
+        """A move inside claimed airspace. At or above this member's layer: the straight way
+        there, claimed, flown, then only the point arrived at held. Below it: the way's
+        airspace from the layer down to the lowest point of the way, held until the member is
+        back at its layer (a move inside it needs no other claim)."""
         last = self.last
         assert last is not None, "move() needs telemetry: take off first"
         here = last.pos_enu_m
         x, y, z = pos_enu_m
-        claim = Claim(
-            (here[0], here[1]),
-            (x, y),
-            self.flight.arrive_radius_m,
-            min(here[2], z),
-            max(here[2], z),
-            what,
-        )
-        yield from self.claim(claim, what)
+        tol = self.flight.arrive_radius_m
+        layer = self.layer_m()
+        airspace = self.crew.airspace
+        below = z < layer - tol
+        if here[2] >= layer - tol and not below:
+            lane = Claim((here[0], here[1]), (x, y), tol, min(here[2], z), max(here[2], z), what)
+            yield from self.claim(lane, what)
+        else:
+            held = airspace.held[self.index]
+            inside = held.covers((here[0], here[1]), here[2], 0.0) and held.covers((x, y), z, 0.0)
+            if not inside:
+                top = max(layer, here[2], z)
+                column = Claim((here[0], here[1]), (x, y), tol, min(here[2], z), top, what)
+                yield from self.claim(column, what)
         yield from super().move(pos_enu_m, heading_deg, what)
-        self.crew.airspace.shrink(self.index, (x, y), z, what)
+        if not below:
+            airspace.shrink(self.index, (x, y), z, what)
 
     def claim(self, claim: Claim, what: str) -> Wait[None]:
         """Wait (hovering where it is) until the airspace grants ``claim``; ABORTED after

@@ -10,7 +10,7 @@ which are not — so that no way crosses near a roof lower than the altitude tha
 from __future__ import annotations
 
 import math
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from uavtool.camera import Intrinsics
 from uavtool.mission.analysis import stepped, target_shapes
@@ -36,6 +36,12 @@ from uavtool.nav.geometry import (
     segment_polygon_distance,
 )
 from uavtool.vision.vectorize import enclosed_openings
+
+if TYPE_CHECKING:
+    from uavtool.mission.outputs import PointOfInterest
+    from uavtool.mission.search import Found, Inspector, Look
+    from uavtool.mission.survey import Survey
+    from uavtool.vision import Shape
 
 
 class SearchMission(FlightMission):
@@ -106,6 +112,39 @@ class SearchMission(FlightMission):
             raise self.end(Status.PARTIAL, f"target found; model not built: {self.no_model}")
         return "model built"
 
+    def above(self, altitude_m: float) -> float:
+        """The altitude this vehicle crosses at where the way asks for ``altitude_m`` (a
+        fleet's members each cross at a layer of their own)."""
+        return altitude_m
+
+    def take_off_to(self, alt_m: float) -> Wait[None]:
+        """Take off to ``alt_m`` above home (a fleet's member claims the airspace first)."""
+        yield from self.arm_and_take_off(alt_m)
+
+    def inspector(self, seen: Survey, transit_m: float) -> Inspector | None:  # noqa: ARG002
+        """Who looks at the points of interest: None, this vehicle (a fleet's leader hands
+        them out)."""
+        return None
+
+    def searched(self, found: Found | None) -> None:
+        """The search has decided (a fleet calls the others off here)."""
+
+    def measure_roof(
+        self, k: int, poi: PointOfInterest, look: Look, shape: Shape
+    ) -> Wait[float | None]:
+        """The height of a matched roof the overview could not tell (a fleet's helper that
+        took the look has measured it already)."""
+        from uavtool.mission.search import measure_from_another_altitude  # noqa: PLC0415
+
+        return (yield from measure_from_another_altitude(self, k, poi, look, shape))
+
+    def model_target(self, found: Found, seen: Survey, transit_m: float) -> Wait[None]:
+        """Photograph the target from three sides and build its model (a fleet's leader
+        hands this to the vehicle at the target)."""
+        from uavtool.mission.modelling import photograph_and_model  # noqa: PLC0415 - uses this
+
+        yield from photograph_and_model(self, found, seen, transit_m)
+
     def go_home(self) -> Wait[None]:
         if self.transit_m is not None:
             # The vehicle's RTL flies straight home at its own altitude: go home over every
@@ -155,13 +194,14 @@ class SearchMission(FlightMission):
             and not self.over_seen_ground(x, y)
             and not (yield from peek(self, x, y, what, f"peek-{len(self.peeks) + 1}"))
         ):  # nothing is known below: the ceiling is as low as it goes there
-            yield from self.move((x, y, self.ceiling_m), heading_deg, f"{what}: at the ceiling")
+            ceiling = self.above(self.ceiling_m)
+            yield from self.move((x, y, ceiling), heading_deg, f"{what}: at the ceiling")
             return
         cruise = max(transit_m, z)
         here = self.last.pos_enu_m if self.last is not None else (x, y, cruise)
         over = self._over_unknown(here, (x, y))
         if over > cruise:
-            cruise = over
+            cruise = self.above(over)
             self.event(
                 Level.INFO,
                 f"{what}: a roof of unknown height near the way: across at {cruise:.1f} m",
@@ -171,7 +211,7 @@ class SearchMission(FlightMission):
             and cruise < self.ceiling_m
             and not self._seen_way((here[0], here[1]), (x, y))
         ):
-            cruise = self.ceiling_m
+            cruise = self.above(self.ceiling_m)
             self.event(
                 Level.INFO,
                 f"{what}: the way leaves the ground the overview saw: across at {cruise:.1f} m",

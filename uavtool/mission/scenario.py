@@ -6,7 +6,6 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from uavtool.mission.measure import measure_from_above
-from uavtool.mission.modelling import photograph_and_model
 from uavtool.mission.outputs import Level, Plan, Status
 from uavtool.mission.search import search
 from uavtool.mission.survey import Survey, overview_heading_deg, survey
@@ -31,7 +30,7 @@ def fly(m: SearchMission) -> Wait[None]:
         yield from m.set_mode("GUIDED")
         m.airborne(flying=True)
     else:
-        yield from m.arm_and_take_off(p.overview_alt_m)
+        yield from m.take_off_to(p.overview_alt_m)
     here = m.last.pos_enu_m if m.last else (0.0, 0.0, 0.0)
     heading = overview_heading_deg(m.last.heading_deg if m.last else 0.0)
     yield from m.move((here[0], here[1], p.overview_alt_m), heading, "overview position")
@@ -60,14 +59,16 @@ def fly(m: SearchMission) -> Wait[None]:
         overview_shapes=seen.shapes,
         transit_m=transit_m,
         roofless=seen.roofless,
+        inspector=m.inspector(seen, transit_m),
     )
+    m.searched(found)
     if found is None:
         return
     m.matched_poi = found.poi.index
     m.match_score = found.score
     if not p.gimbal:
         raise m.end(Status.PARTIAL, NO_GIMBAL_REASON)
-    yield from photograph_and_model(m, found, seen, transit_m)
+    yield from m.model_target(found, seen, transit_m)
 
 
 def _points(seen: Survey) -> list[tuple[float, float]]:

@@ -62,6 +62,10 @@ class _Look:
     alt_m: float  # the altitude commanded for the photo
 
 
+Look = _Look
+"""One look at a point of interest: its photo, the shapes in it and their judgement."""
+
+
 def photo_shapes(
     m: SearchMission,
     photo: Photo,
@@ -104,7 +108,7 @@ def search(
     overview_shapes: tuple[Shape, ...],
     transit_m: float,
     roofless: frozenset[int] = frozenset(),
-    inspector: Callable[[int], Wait[Inspection]] | None = None,
+    inspector: Inspector | None = None,
 ) -> Wait[Found | None]:
     """Visit the points of interest in order (across at ``transit_m``, over every known
     roof); the best match (the first one unless ``visit_all``); ends the mission with
@@ -117,11 +121,13 @@ def search(
     matches: list[Found] = []  # every building that matched, in turn
     unjudged: list[tuple[int, _Look]] = []  # of the target's hue, never judged
     todo = list(order)
-    look_at = inspector or (lambda k: inspect(m, k, pois, overview, overview_shapes, transit_m))
+    look_at: Inspector = inspector or (
+        lambda k, _todo: inspect(m, k, pois, overview, overview_shapes, transit_m)
+    )
     while todo:
         k = todo.pop(0)
         poi = pois[k]
-        looks, upper = yield from look_at(k)
+        looks, upper = yield from look_at(k, todo)
         top = max(look.judgement.score for look in looks)
         if top > best_score:
             best_score, best_poi = top, k
@@ -157,7 +163,7 @@ def search(
             seen = overview_shapes[poi.shape_index]
             roof = roof_between(seen, overview, shape, look.photo)
             if roof is None or roof > p.assumed_roof_m:  # beyond the tallest expected: a
-                roof = yield from _measure_from_another_altitude(m, k, poi, look, shape)  # mismatch
+                roof = yield from m.measure_roof(k, poi, look, shape)  # mismatch
             best = _found(poi, look, roof)
             matches.append(best)
             if not p.visit_all:
@@ -188,6 +194,11 @@ def search(
 Inspection = tuple[list["_Look"], float | None]
 """What the looks at one point of interest found: the looks in order, and the highest its
 roof may be when its height is unknown (else None)."""
+
+
+Inspector = Callable[[int, list[int]], "Wait[Inspection]"]
+"""How the search has point of interest ``k`` looked at, told which are still to come (a
+fleet's leader hands them to the others ahead of time)."""
 
 
 def inspect(
@@ -457,7 +468,7 @@ def _rivals(
     return rivals
 
 
-def _measure_from_another_altitude(
+def measure_from_another_altitude(
     m: SearchMission, k: int, poi: PointOfInterest, look: _Look, shape: Shape
 ) -> Wait[float | None]:
     """The matched roof's height when the overview could not tell it (cut by its border):

@@ -40,6 +40,7 @@ from uavtool.recording.topics import TARGET
 from uavtool.recording.values import CompressedImage
 from uavtool.runner.backends import BOOT_ONLY_PARAMS
 from uavtool.runner.camera import open_camera
+from uavtool.runner.evaluate import Evaluation, evaluate
 from uavtool.runner.fly import (
     FlyConfig,
     _flight_time,
@@ -93,21 +94,13 @@ class FleetSummary:
     wall_time_s: float
     mission: str
     recording: Path | None = None
+    evaluation: Evaluation | None = None
+    """The first vehicle's mission judged against the scene (a search: the building it
+    matched and the model's overlap with it)."""
 
     @property
     def flight_wall_s(self) -> float:
         return self.wall_time_s
-
-
-_WORST = (
-    Status.CRASHED,
-    Status.LINK_LOST,
-    Status.TAKEOVER,
-    Status.ABORTED,
-    Status.NO_MATCH,
-    Status.PARTIAL,
-    Status.COMPLETED,
-)
 
 
 def fly_fleet(
@@ -281,9 +274,14 @@ def fly_fleet(
                 links, runners, outcomes, fleet.vehicles, strict=True
             )
         )
-        summary = _summarise(
-            summaries, fleet, fleet_params.separation_m, vehicle_s, wall0, ref.name, path
-        )
+        fleet_status, reason = members[0].crew.outcome(list(outcomes))
+        summary = dataclasses.replace(
+            _summarise(
+                summaries, fleet_status, reason, fleet, fleet_params.separation_m, vehicle_s,
+                wall0, ref.name, path,
+            ),
+            evaluation=evaluate(runners[0], scene),
+        )  # fmt: skip
         for s, recorder in zip(summaries, recorders, strict=True):
             if recorder is not None:
                 recorder.outcome(_vehicle_record(s))
@@ -294,6 +292,8 @@ def fly_fleet(
 
 def _summarise(
     summaries: tuple[VehicleSummary, ...],
+    status: Status,
+    reason: str,
     fleet: Fleet,
     separation_m: float,
     vehicle_s: float,
@@ -301,14 +301,9 @@ def _summarise(
     mission: str,
     path: Path | None,
 ) -> FleetSummary:
-    worst = min(summaries, key=lambda s: _WORST.index(s.outcome.status))
-    if worst.outcome.status is Status.COMPLETED:
-        reason = "every vehicle completed"
-    else:
-        reason = f"vehicle {worst.sysid}: {worst.outcome.reason}"
     approach = fleet.approach
     return FleetSummary(
-        worst.outcome.status,
+        status,
         reason,
         summaries,
         approach.distance_m,
@@ -333,6 +328,12 @@ def fleet_record(s: FleetSummary) -> dict[str, str]:
     if math.isfinite(s.closest_approach_m):
         record["closest_approach_m"] = f"{s.closest_approach_m:.2f}"
         record["closest_pair"] = json.dumps(list(s.closest_pair))
+    e = s.evaluation
+    if e is not None and e.matched_building:
+        record["matched_building"] = e.matched_building
+        record["target_building"] = e.target_building
+    if e is not None and e.model_iou is not None:
+        record["model_iou"] = f"{e.model_iou:.4f}"
     return record
 
 

@@ -97,6 +97,14 @@ def format_fleet_summary(s: FleetSummary) -> str:
         f"fleet          {counted(len(s.vehicles), 'vehicle')}, mission {safe_text(s.mission)}, "
         f"{s.vehicle_time_s:.1f} s sim, {s.wall_time_s:.1f} s wall",
     ]
+    e = s.evaluation
+    if e is not None and e.matched_building:
+        right = "right" if e.matched_building == e.target_building else "WRONG"
+        iou = f", model IoU {e.model_iou:.3f}" if e.model_iou is not None else ""
+        lines.append(
+            f"match          building {e.matched_building!r} ({right}: the target is "
+            f"{e.target_building!r}){iou}"
+        )
     if math.isfinite(s.closest_approach_m):
         a, b = s.closest_pair
         lines.append(
