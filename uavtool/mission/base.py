@@ -518,6 +518,19 @@ class FlightMission:
         if not climbed:
             raise MissionEnd(Status.ABORTED, f"take-off: {alt_m:g} m never reached")
 
+    def land(self, what: str) -> Wait[None]:
+        """LAND where it is and wait until it has landed and disarmed, mid-mission (a fleet's
+        leader waits on the ground); :meth:`arm_and_take_off` flies it again. A disarm away
+        from home's height is still a crash."""
+        self.event(Level.INFO, f"landing: {what}")
+        self._landing = True
+        yield from self.set_mode("LAND")
+        landed = yield from self.wait_until(self._landed_and_disarmed, self.flight.land_timeout_s)
+        if not landed:
+            raise MissionEnd(Status.ABORTED, f"landing ({what}): not landed in time")
+        self._airborne = self._landing = self._left_ground = False
+        self.event(Level.INFO, "landed and disarmed, waiting")
+
     def airborne(self, *, flying: bool = False) -> None:
         """From now until the return home, a vehicle that disarms has crashed; one that
         disarms on the ground before it was ever seen above home's height tolerance never took

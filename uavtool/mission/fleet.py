@@ -210,12 +210,22 @@ class FleetMember(FlightMission):
     # --- flying apart -------------------------------------------------------------------------
 
     def take_off(self, alt_m: float) -> Wait[None]:
-        """Claim the column above home up to ``alt_m``, then take off to it."""
-        home = self.home_en_m
-        column = Claim.column(home, self.flight.arrive_radius_m, 0.0, alt_m, "take-off")
+        """Claim the column above where it stands up to ``alt_m``, then take off to it."""
+        last = self.last
+        at = (last.pos_enu_m[0], last.pos_enu_m[1]) if last is not None else self.home_en_m
+        column = Claim.column(at, self.flight.arrive_radius_m, 0.0, alt_m, "take-off")
         yield from self.claim(column, "take-off")
         yield from self.arm_and_take_off(alt_m)
-        self.crew.airspace.shrink(self.index, home, alt_m, "took off")
+        self.crew.airspace.shrink(self.index, at, alt_m, "took off")
+
+    def land_at_home(self, what: str) -> Wait[None]:
+        """Back over home at this member's layer (the column down claimed), land, and hold
+        only where it stands."""
+        yield from self.go_home()
+        yield from self.land(what)
+        last = self.last
+        assert last is not None
+        self.crew.airspace.park(self.index, (last.pos_enu_m[0], last.pos_enu_m[1]))
 
     def move(self, pos_enu_m: Vec3, heading_deg: float | None, what: str) -> Wait[None]:
         """A move inside claimed airspace. At or above this member's layer: the straight way
@@ -224,10 +234,14 @@ class FleetMember(FlightMission):
         back at its layer (a move inside it needs no other claim)."""
         last = self.last
         assert last is not None, "move() needs telemetry: take off first"
+        layer = self.layer_m()
+        if last.landed and not last.armed:  # it landed to wait (land()): up first
+            yield from self.take_off(layer)
+            last = self.last
+            assert last is not None
         here = last.pos_enu_m
         x, y, z = pos_enu_m
         tol = self.flight.arrive_radius_m
-        layer = self.layer_m()
         airspace = self.crew.airspace
         below = z < layer - tol
         if here[2] >= layer - tol and not below:

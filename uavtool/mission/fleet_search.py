@@ -156,14 +156,6 @@ class FleetSearchMission(FleetMember, SearchMission):
     def above(self, altitude_m: float) -> float:
         return altitude_m + self.layer_m() - self.base_layer_m()
 
-    def _waiting_m(self) -> float:
-        """Where the leader waits for a helper's looks: a layer step above the highest any
-        helper crosses at (the ceiling, on the highest helper's layer)."""
-        shared = self.crew.shared
-        assert shared is not None
-        highest = max(shared.transit_m, shared.ceiling_m or 0.0)
-        return highest + (self.crew.size - 1) * self.crew.fleet.layer_step_m
-
     # --- the leader ---------------------------------------------------------------------------
 
     def fly(self) -> Wait[str]:
@@ -219,6 +211,8 @@ class FleetSearchMission(FleetMember, SearchMission):
         self.event(Level.INFO, f"vehicle {h + 1}, at the target, photographs it and models it")
         crew.model_job = (found, seen)
         helper = crew.members[h]
+        # Home meanwhile: the leader's part in the air is done.
+        yield from self.land_at_home(f"vehicle {h + 1} builds the model")
         yield from self.wait_until(
             lambda _t: crew.model_done or helper.done, self.flight.land_timeout_s * 10
         )
@@ -264,6 +258,14 @@ class FleetSearchMission(FleetMember, SearchMission):
         if last is not None and last.pos_enu_m[2] < top - self.flight.arrive_radius_m:
             x, y, _ = last.pos_enu_m
             yield from self.move((x, y, top), None, f"waiting for the helpers at {top:.1f} m")
+
+    def _waiting_m(self) -> float:
+        """Where the leader waits for a helper's looks: a layer step above the highest any
+        helper crosses at (the ceiling, on the highest helper's layer)."""
+        shared = self.crew.shared
+        assert shared is not None
+        highest = max(shared.transit_m, shared.ceiling_m or 0.0)
+        return highest + (self.crew.size - 1) * self.crew.fleet.layer_step_m
 
     def learn_roof(
         self, index: int, footprint: tuple[tuple[float, float], ...], roof_m: float
