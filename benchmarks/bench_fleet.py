@@ -70,6 +70,7 @@ def main() -> None:
                 seed=seed,
                 mission="fleet-search",
                 vehicles=args.vehicles,
+                offset_line=None,  # the first line clear of the buildings around home
             ),
             progress=lambda _v, text, t, out=fleet_model: _model_time(text, t, out),
         )

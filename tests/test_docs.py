@@ -261,3 +261,25 @@ def test_the_mission_example_in_docs_missions_flies_and_replays(
     assert "completed: 2 photos" in result.output
     result = CliRunner().invoke(cli, ["replay", "--check", str(rec), "--mission", mission])
     assert result.exit_code == 0, result.output
+
+
+def test_the_fleet_mission_example_in_docs_fleets_flies_and_replays(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """docs/fleets.md's SpreadMission, pasted into my_missions/spread.py as the page says."""
+    page = (DOCS / "fleets.md").read_text(encoding="utf-8")
+    (code,) = [b for b in re.findall(r"```python\n(.*?)```", page, re.S) if "SpreadMission" in b]
+    assert code.startswith("# my_missions/spread.py\n")
+    (tmp_path / "my_missions").mkdir()
+    (tmp_path / "my_missions" / "spread.py").write_text(textwrap.dedent(code))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    rec = tmp_path / "spread.mcap"
+    mission = "my_missions.spread:SpreadMission"
+    args = ["fly", "-q", "--vehicles", "3", "--mission", mission, "-o", str(rec)]
+    result = CliRunner().invoke(cli, args)
+    assert result.exit_code == 0, result.output
+    assert "completed: every vehicle completed" in result.output
+    assert "(kept: 5 m)" in result.output
+    result = CliRunner().invoke(cli, ["replay", "--check", str(rec), "--mission", mission])
+    assert result.exit_code == 0, result.output
+    assert "identical: every output of every vehicle" in result.output

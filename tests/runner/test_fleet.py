@@ -21,7 +21,7 @@ from uavtool.replay.fleet import replay_fleet
 from uavtool.replay.load import is_fleet, load_fleet
 from uavtool.replay.refly import refly
 from uavtool.runner.fleet import FleetSummary, fly_fleet
-from uavtool.runner.fly import FlyConfig
+from uavtool.runner.fly import FlyConfig, fly
 
 
 def _config(path: Path | None, **kw: object) -> FlyConfig:
@@ -171,3 +171,52 @@ def test_a_fleet_recording_is_refused_where_it_is_not_supported(
     assert result.exit_code == 2 and "-o/--output and --vision-only not yet" in result.output
     with pytest.raises(InputError, match="a fleet's recording"):
         load_flight(path)
+
+
+@pytest.fixture(scope="module")
+def search(tmp_path_factory: pytest.TempPathFactory) -> tuple[FleetSummary, Path, list[str]]:
+    path = tmp_path_factory.mktemp("fleet-search") / "search.mcap"
+    said: list[str] = []
+    summary = fly_fleet(
+        FlyConfig(mission="fleet-search", vehicles=3, record=path),
+        progress=lambda sysid, text, _t: said.append(f"{sysid}: {text}"),
+    )
+    return summary, path, said
+
+
+def test_a_fleet_finds_and_models_the_target_apart(
+    search: tuple[FleetSummary, Path, list[str]],
+) -> None:
+    s, _, said = search
+    assert s.status is Status.COMPLETED, s.reason
+    e = s.evaluation
+    assert e is not None and e.matched_building == e.target_building == "red"
+    assert e.model_iou is not None and e.model_iou > 0.8
+    assert s.closest_approach_m >= s.separation_m
+    # The helpers looked at points of interest for the leader; one of them, at the target,
+    # built the model while the leader landed.
+    assert any(": looking at it for vehicle 1" in line for line in said if line[0] in "23")
+    modeller = [v for v in s.vehicles if v.outcome.reason == "model built for vehicle 1"]
+    assert len(modeller) == 1 and modeller[0].sysid in (2, 3)
+    assert s.vehicles[0].outcome.reason == "model built" and s.vehicles[0].outcome.model_built
+    assert not any(v.outcome.status is Status.CRASHED for v in s.vehicles)
+
+
+def test_a_fleets_search_replays_and_reflies_identically(
+    search: tuple[FleetSummary, Path, list[str]],
+) -> None:
+    _, path, _ = search
+    results = replay_fleet(load_fleet(path))
+    assert all(r.identical and r.finished for r in results)
+    again = refly(path)
+    assert again.identical, again.first_difference
+
+
+def test_a_search_fleet_of_one_decides_as_the_search() -> None:
+    one = fly(FlyConfig(no_record=True))
+    alone = fly(FlyConfig(mission="fleet-search", no_record=True))
+    a, b = one.outcome, alone.outcome
+    assert (a.status, a.visited, a.matched_poi, a.model_built) == (
+        b.status, b.visited, b.matched_poi, b.model_built,
+    )  # fmt: skip
+    assert one.vehicle_time_s == alone.vehicle_time_s

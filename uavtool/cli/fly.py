@@ -192,7 +192,8 @@ _WRITERS: dict[str, bool | None] = {"auto": None, "process": False, "thread": Tr
     show_default=True,
     metavar="BEARING,SPACING",
     help="With --vehicles: vehicle i's home is i·SPACING m from the scene's home along BEARING "
-    "degrees (as ArduPilot's sim_vehicle.py --auto-offset-line).",
+    "degrees (as ArduPilot's sim_vehicle.py --auto-offset-line); auto: the first line of "
+    "homes 10 m apart clear of every building.",
 )
 @click.option("-q", "--quiet", is_flag=True, help="Print only the summary.")
 def fly(
@@ -310,9 +311,11 @@ def _fly_fleet(config: FlyConfig, vehicles: int, offset_line: str, echo: Echo) -
     from uavtool.runner.summary import format_fleet_summary, format_progress
     from uavtool.sitl.fleet import parse_offset_line
 
-    line = parse_offset_line(offset_line)
+    line = None if offset_line.strip() == "auto" else parse_offset_line(offset_line)
     config = dataclasses.replace(
-        config, vehicles=vehicles, offset_line=(line.bearing_deg, line.spacing_m)
+        config,
+        vehicles=vehicles,
+        offset_line=None if line is None else (line.bearing_deg, line.spacing_m),
     )
     summary = fly_fleet(
         config,

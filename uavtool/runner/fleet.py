@@ -63,6 +63,8 @@ if TYPE_CHECKING:
     from uavtool.sitl.lockstep import FleetLockstep
 
 MAX_VEHICLES = 16
+AUTO_SPACING_M = 10.0
+"""The spacing of an automatic offset line (``--offset-line auto``): ArduPilot's default."""
 """The most vehicles ``fly --vehicles`` flies in one world."""
 
 
@@ -115,6 +117,7 @@ def fly_fleet(
     from uavtool.sitl import SitlConfig  # noqa: PLC0415 - a real vehicle needs no simulator
     from uavtool.sitl.fleet import (  # noqa: PLC0415
         OffsetLine,
+        clear_line,
         fleet_configs,
         line_homes,
         vehicle_seed,
@@ -152,6 +155,23 @@ def fly_fleet(
         target_png = target_picture(scene, intrinsics)
     target_rgb = None if target_png is None else png_decode(target_png, where="target")
     fleet_params = getattr(params, mission_cls.fleet_group)
+    if line is None:  # automatic: the first line whose homes are clear of every building
+        found = clear_line(
+            scene.home,
+            vehicles,
+            lambda h: scene_obstacles(scene, home=h),
+            spacing_m=AUTO_SPACING_M,
+            clear_m=fleet_params.separation_m,
+        )
+        if found is None:
+            raise InputError(
+                f"--offset-line auto: no line of {vehicles} homes {AUTO_SPACING_M:g} m apart "
+                f"keeps {fleet_params.separation_m:g} m from every building; give one "
+                "(--offset-line BEARING,SPACING)"
+            )
+        line = (found.bearing_deg, found.spacing_m)
+        say(f"homes on the offset line {found} (automatic)")
+        config = dataclasses.replace(config, offset_line=line)
     spacing = line[1]
     if spacing < fleet_params.separation_m:
         raise InputError(

@@ -96,9 +96,9 @@ class FlyConfig:
     vehicles: int = 1
     """How many built-in vehicles fly (more than one: a fleet, :func:`uavtool.runner.fleet.
     fly_fleet`)."""
-    offset_line: tuple[float, float] = (90.0, 10.0)
+    offset_line: tuple[float, float] | None = (90.0, 10.0)
     """A fleet's homes: vehicle i's is i × spacing (m) from the scene's home along the bearing
-    (degrees): (bearing, spacing)."""
+    (degrees): (bearing, spacing); None: the first line clear of every building."""
     scene_origin: str = "vehicle"
     """With the sim camera and another vehicle: ``"vehicle"`` puts the scene at the vehicle's
     home, ``"scene"`` keeps the scene's own geographic origin (refused when the vehicle is
@@ -400,7 +400,7 @@ def describe(
         target=("file" if config.target else "scene") if has_target else "none",
         no_gimbal=config.no_gimbal,
         vehicles=config.vehicles,
-        offset_line=config.offset_line,
+        offset_line=config.offset_line or (90.0, 10.0),
         tool_version=__version__,
     )
 

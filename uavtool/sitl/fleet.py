@@ -80,6 +80,30 @@ def line_homes(first: GeoPoint, count: int, line: OffsetLine) -> tuple[GeoPoint,
     )
 
 
+AUTO_BEARINGS_DEG = (90.0, 270.0, 0.0, 180.0, 45.0, 135.0, 225.0, 315.0)
+"""The bearings an automatic offset line tries, in order: ArduPilot's east first."""
+
+
+def clear_line(
+    first: GeoPoint,
+    count: int,
+    obstacles_for: Callable[[GeoPoint], tuple[Prism, ...]],
+    *,
+    spacing_m: float,
+    clear_m: float,
+) -> OffsetLine | None:
+    """The first offset line (of :data:`AUTO_BEARINGS_DEG`, ``spacing_m`` apart) whose every
+    home lies at least ``clear_m`` from every obstacle, None when none does."""
+    for bearing in AUTO_BEARINGS_DEG:
+        line = OffsetLine(bearing, spacing_m)
+        if all(
+            ObstacleField(obstacles_for(home)).nearest(0.0, 0.0, 0.0)[0] >= clear_m
+            for home in line_homes(first, count, line)[1:]
+        ):
+            return line
+    return None
+
+
 def vehicle_seed(seed: int, index: int) -> int:
     """The seed of vehicle ``index``'s gusts and sensor noise. The first keeps the flight's own
     (a fleet of one flies as one vehicle does); each other draws from a seed derived from both,
