@@ -220,3 +220,36 @@ def test_a_search_fleet_of_one_decides_as_the_search() -> None:
         b.status, b.visited, b.matched_poi, b.model_built,
     )  # fmt: skip
     assert one.vehicle_time_s == alone.vehicle_time_s
+
+
+def test_export_takes_each_vehicles_frames_and_the_model_out(
+    search: tuple[FleetSummary, Path, list[str]], tmp_path: Path
+) -> None:
+    s, path, _ = search
+    frames = tmp_path / "frames"
+    result = CliRunner().invoke(
+        cli, ["export", str(path), "--frames", str(frames), "--model", str(tmp_path / "m.glb")]
+    )
+    assert result.exit_code == 0, result.output
+    for v in s.vehicles:
+        pngs = sorted((frames / f"uav{v.sysid}").glob("frame_*.png"))
+        assert len(pngs) == v.frames
+    assert (tmp_path / "m.glb").read_bytes()[:4] == b"glTF"
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["view", "{rec}", "--save", "{tmp}/v.rrd"], "a fleet's recording (its vehicles' topics"),
+        (["export", "{rec}", "--layout", "{tmp}/l.json"], "--layout makes layouts for one vehicle"),
+    ],
+)
+def test_what_cannot_show_a_fleet_yet_says_so(
+    search: tuple[FleetSummary, Path, list[str]], tmp_path: Path, args: list[str], message: str
+) -> None:
+    _, path, _ = search
+    argv = [a.format(rec=path, tmp=tmp_path) for a in args]
+    result = CliRunner().invoke(cli, argv)
+    assert result.exit_code == 2, result.output
+    assert message in result.output
+    assert not list(tmp_path.iterdir())

@@ -131,16 +131,27 @@ def export(
 
         result = export_tlog(rec, tlog)
         click.echo(f"wrote {result.frames} MAVLink frames to {tlog}")
+    vehicles = _fleet(rec)
     if frames_dir is not None:
         from uavtool.recording.frames import export_frames
 
-        frames = export_frames(rec, frames_dir)
-        with_target = " and target.png" if frames.target else ""
-        click.echo(
-            f"wrote {frames.frames} frames ({frames.with_pose} with a pose){with_target} to "
-            f"{frames_dir}"
-        )
+        if vehicles and frames_dir.exists() and any(frames_dir.iterdir()):
+            raise InputError(f"{frames_dir}: exists and is not an empty folder: choose another")
+        for k in vehicles or (None,):
+            folder = frames_dir if k is None else frames_dir / f"uav{k}"
+            frames = export_frames(rec, folder, prefix="" if k is None else f"/uav{k}")
+            with_target = " and target.png" if frames.target else ""
+            click.echo(
+                f"wrote {frames.frames} frames ({frames.with_pose} with a pose){with_target} to "
+                f"{folder}"
+            )
     if layout is not None:
+        if vehicles:
+            raise InputError(
+                f"{rec}: a fleet's recording: --layout makes layouts for one vehicle only, so "
+                "far; open the file in Foxglove or Lichtblick as it is (each vehicle's topics "
+                "are under /uavN)"
+            )
         from uavtool.recording.foxglove_layout import export_layout
 
         panels = export_layout(rec, layout)["configById"]
@@ -156,6 +167,13 @@ def export(
     if cut:
         click.echo(f"incomplete: {cut}")
         sys.exit(INCOMPLETE_EXIT)
+
+
+def _fleet(rec: Path) -> tuple[int, ...]:
+    """A fleet's vehicles (system ids), () for one vehicle's recording."""
+    from uavtool.recording.info import summarize
+
+    return tuple(k for k, _ in summarize(rec, verify=False).vehicles)
 
 
 @click.command(name="import")

@@ -9,14 +9,15 @@ from pathlib import Path
 
 from uavtool.recording.errors import RecordingError
 from uavtool.recording.files import atomic_output
+from uavtool.recording.fleet import split_topic
 from uavtool.recording.reader import RecordingReader
 from uavtool.recording.topics import MODEL, TARGET
 from uavtool.recording.values import CompressedImage, Model3D
 
 
 def export_model(rec: str | Path, out: str | Path) -> int:
-    """Write the last model ``rec`` holds (a GLB) to ``out``; its size in bytes. Raises
-    `RecordingError` when the flight built no model."""
+    """Write the last model ``rec`` holds (a GLB) to ``out``; its size in bytes (a fleet's:
+    whichever vehicle built it). Raises `RecordingError` when the flight built no model."""
     return _export(
         rec,
         out,
@@ -56,8 +57,10 @@ def _last(
 ) -> bytes:
     found: bytes | None = None
     with RecordingReader(rec) as reader:
-        if topic in reader.topics():
-            for entry in reader.entries([topic]):
+        # the topic, or a fleet's vehicles' (/uavK + topic), in the order they were written
+        topics = [t for t in reader.topics() if split_topic(t)[1] == topic]
+        if topics:
+            for entry in reader.entries(topics):
                 data = pick(entry.value)
                 if data is not None:
                     found = data

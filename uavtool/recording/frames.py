@@ -43,10 +43,10 @@ class FramesResult:
     target: bool
 
 
-def export_frames(rec: str | Path, out_dir: str | Path) -> FramesResult:
+def export_frames(rec: str | Path, out_dir: str | Path, *, prefix: str = "") -> FramesResult:
     """Write every camera frame of ``rec`` into ``out_dir`` (which must not exist, or be
-    empty). Raises `TopicNotFoundError` without frames, `RecordingError` if ``out_dir`` is
-    not empty or cannot be written."""
+    empty): ``prefix`` names one vehicle of a fleet (``/uav2``). Raises `TopicNotFoundError`
+    without frames, `RecordingError` if ``out_dir`` is not empty or cannot be written."""
     out_dir = Path(out_dir)
     if out_dir.exists() and (not out_dir.is_dir() or any(out_dir.iterdir())):
         raise RecordingError(out_dir, "exists and is not an empty folder: choose another")
@@ -55,12 +55,13 @@ def export_frames(rec: str | Path, out_dir: str | Path) -> FramesResult:
     target: bytes | None = None
     with RecordingReader(rec) as reader:
         topics = reader.topics()
-        if IMAGE not in topics:
-            raise TopicNotFoundError(rec, IMAGE, topics)
-        wanted = [t for t in (IMAGE, FRAMES, OBSERVATIONS, TARGET) if t in topics]
+        image = prefix + IMAGE
+        if image not in topics:
+            raise TopicNotFoundError(rec, image, topics)
+        wanted = [t for t in (image, prefix + FRAMES, prefix + OBSERVATIONS, TARGET) if t in topics]
         for entry in reader.entries(wanted):
             value = entry.value
-            if entry.topic == IMAGE and isinstance(value, CompressedImage):
+            if entry.topic == image and isinstance(value, CompressedImage):
                 images.append((value.data, entry.log_time_ns))
             elif entry.topic == TARGET and isinstance(value, CompressedImage):
                 target = target or value.data

@@ -16,6 +16,7 @@ from uavtool.flight import mission_of
 from uavtool.geo import GeoPoint
 from uavtool.recording import CompressedImage, Entry, JsonDocument, LogEntry, RecordingReader
 from uavtool.recording.annotations import DETECTIONS
+from uavtool.recording.fleet import split_topic
 from uavtool.recording.topics import EVENTS, IMAGE, OBSERVATIONS, OUTPUTS, PICTURES, TARGET
 from uavtool.view.errors import ViewError, showing
 from uavtool.view.logger import MissionLogger
@@ -34,6 +35,14 @@ def log_recording(path: str | Path, logger: MissionLogger) -> None:
         if OBSERVATIONS not in present and is_recorded_flight(present):
             log_recorded_flight(path, reader, logger)  # from `uavtool record`: no mission
             return
+        if OBSERVATIONS not in present and any(
+            split_topic(t) == (k, OBSERVATIONS) for t in present for k in range(1, 65)
+        ):
+            raise ViewError(
+                f"{path}: a fleet's recording (its vehicles' topics under /uavN): view shows "
+                "one vehicle's flight so far; open it in Foxglove or Lichtblick, which show "
+                "every vehicle's topics"
+            )
         if OBSERVATIONS not in present:
             raise ViewError(f"{path}: no {OBSERVATIONS} topic: not a mission recording")
         reader.require_metadata(("scene", "mission"))  # else the view would lack them quietly
