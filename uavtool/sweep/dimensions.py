@@ -3,7 +3,8 @@
 Keys: ``seed`` (SITL wind/noise seed), ``wind_speed_ms``, ``wind_from_deg``, ``noise``
 (seeded camera noise), ``home_heading_deg`` (overrides the scene's), ``link_outages`` (a
 list of ``[start_s, duration_s]``), ``outage_start_s`` / ``outage_duration_s`` (one outage,
-for random draws), ``set.GROUP.NAME`` (a mission parameter, as ``uavtool fly --set``) and
+for random draws), ``vehicles`` (a fleet of that many built-in vehicles: the mission must be a
+fleet mission), ``set.GROUP.NAME`` (a mission parameter, as ``uavtool fly --set``) and
 ``param.NAME`` (a vehicle parameter, as ``uavtool fly --param``).
 """
 
@@ -50,6 +51,19 @@ def _flag(value: Any) -> bool:
     return value
 
 
+MAX_SWEEP_VEHICLES = 16
+
+
+def _vehicles(value: Any) -> int:
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, int)
+        or not 1 <= value <= MAX_SWEEP_VEHICLES
+    ):
+        raise ValueError(f"expected a whole number 1..{MAX_SWEEP_VEHICLES}, got {shown(value)}")
+    return value
+
+
 def _outages(value: Any) -> tuple[tuple[float, float], ...]:
     if not isinstance(value, list):
         raise ValueError(f"expected a list of [start_s, duration_s] pairs, got {shown(value)}")
@@ -73,6 +87,7 @@ _BUILTIN: dict[str, Check] = {
     "link_outages": _outages,
     "outage_start_s": _non_negative,
     "outage_duration_s": _non_negative,
+    "vehicles": _vehicles,
 }
 
 BUILTIN_KEYS: tuple[str, ...] = tuple(_BUILTIN)

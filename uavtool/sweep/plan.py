@@ -15,6 +15,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
+from uavtool.mission.fleet import FleetMember
 from uavtool.plugins import resolve
 from uavtool.sweep import dimensions
 from uavtool.sweep.errors import SpecError
@@ -30,6 +31,7 @@ _DEFAULTS: dict[str, Any] = {
     "noise": False,
     "home_heading_deg": None,  # the scene's own
     "link_outages": (),
+    "vehicles": 1,
 }
 
 
@@ -144,7 +146,9 @@ def plan_flights(spec: SweepSpec) -> list[FlightSpec]:
 def _flights(spec: SweepSpec) -> Iterator[FlightSpec]:
     keys = [k for k, _ in spec.grid]
     checked: dict[tuple[str, str], Any] = {}
-    params_type = resolve(spec.mission)[0].params_type  # once: the draws check against it
+    mission = resolve(spec.mission)[0]
+    params_type = mission.params_type  # once: the draws check against it
+    fleets = issubclass(mission, FleetMember)
     index = 0
     for source in spec.scenes:
         for seed in source.seeds or (None,):
@@ -160,6 +164,14 @@ def _flights(spec: SweepSpec) -> Iterator[FlightSpec]:
                             (k, _draw(k, law, rng, checked, spec, params_type))
                             for k, law in spec.random
                         ]
+                    vehicles = dict(inputs).get("vehicles", 1)
+                    if vehicles > 1 and not fleets:
+                        raise SpecError(
+                            spec.source,
+                            "vehicles",
+                            f"{vehicles} vehicles: the mission {spec.mission!r} flies one; a "
+                            'fleet flies a fleet mission (sweep.mission = "fleet-search")',
+                        )
                     yield FlightSpec(index, one, tuple(inputs), spec.mission)
                     index += 1
 

@@ -24,6 +24,8 @@ class Rate:
     flights: int
     correct: int
     completed: int
+    time_median_s: float | None = None
+    """The median vehicle time of these flights (what a fleet buys, by ``vehicles``)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -42,6 +44,10 @@ class Summary:
     conditions: tuple[tuple[str, tuple[Rate, ...]], ...]
     searched: bool = True
     """The flights flew the built-in search (else matches and models mean nothing)."""
+    closest_approach_m: float | None = None
+    """Fleets: the least distance between two vehicles of any flight."""
+    breaches: int = 0
+    """Fleets: flights whose vehicles came closer than their separation."""
 
     def to_json(self) -> dict[str, Any]:
         data = asdict(self)
@@ -63,6 +69,9 @@ def summarise(
         counts[str(r["status"])] = counts.get(str(r["status"]), 0) + 1
     clearances = [float(r["clearance_m"]) for r in rows if r.get("clearance_m") is not None]
     times = [float(r["flight_time_s"]) for r in rows if r.get("flight_time_s")]
+    approaches = [
+        float(r["closest_approach_m"]) for r in rows if r.get("closest_approach_m") is not None
+    ]
     return Summary(
         flights=len(rows),
         planned=planned,
@@ -81,6 +90,13 @@ def summarise(
             if len(rates := _rates(rows, key, searched)) > 1
         ),
         searched=searched,
+        closest_approach_m=min(approaches) if approaches else None,
+        breaches=sum(
+            1
+            for r in rows
+            if r.get("closest_approach_m") is not None
+            and float(r["closest_approach_m"]) < float(r.get("separation_m") or 0.0)
+        ),
     )
 
 
@@ -98,10 +114,15 @@ def _rates(rows: Sequence[dict[str, Any]], key: str, searched: bool) -> tuple[Ra
                 (bool(r.get("correct")) or not searched) and r.get("status") == "completed"
                 for r in group
             ),
+            _median([float(r["flight_time_s"]) for r in group if r.get("flight_time_s")]),
         )
         for label, group in groups.items()
         if group
     )
+
+
+def _median(values: list[float]) -> float | None:
+    return statistics.median(values) if values else None
 
 
 def _labels(values: list[Any], *, by_kind: bool) -> tuple[list[str], list[str]]:
@@ -170,6 +191,11 @@ def format_summary(s: Summary) -> str:
         lines.append(f"clearance      {s.clearance_min_m:.2f} m at the closest")
     if s.flight_time_median_s is not None:
         lines.append(f"flight time    median {s.flight_time_median_s:.1f} s (vehicle)")
+    if s.closest_approach_m is not None:
+        lines.append(
+            f"separation     {s.closest_approach_m:.2f} m between two vehicles at the closest; "
+            f"{counted(s.breaches, 'flight')} closer than its separation"
+        )
     if s.errors:
         lines.append(f"errors         {counted(s.errors, 'flight')} raised (see the error column)")
     for key, rates in s.conditions:
@@ -178,6 +204,11 @@ def format_summary(s: Summary) -> str:
             f"  {r.value:<22} "
             + (f"correct {_pct(r.correct, r.flights):<16} " if s.searched else "")
             + f"completed {_pct(r.completed, r.flights)}"
+            + (
+                f"  median {r.time_median_s:.0f} s (vehicle)"
+                if key == "vehicles" and r.time_median_s is not None
+                else ""
+            )
             for r in rates
         ]
     return "\n".join(lines)

@@ -26,6 +26,7 @@ from uavtool.sweep.scenes import load_source_scene
 
 if TYPE_CHECKING:
     from uavtool.mission import Telemetry
+    from uavtool.runner.fly import FlyConfig
 
 ERROR = "error"
 """The status of a flight that raised."""
@@ -84,6 +85,7 @@ def _fly(
     exit_codes: Mapping[str, int],
     timeout_s: float | None,
 ) -> dict[str, Any]:
+    from uavtool.mission import SearchMission  # noqa: PLC0415
     from uavtool.mission.params import with_overrides  # noqa: PLC0415
     from uavtool.plugins import resolve  # noqa: PLC0415
     from uavtool.runner.fly import FlyConfig, fly  # noqa: PLC0415
@@ -107,6 +109,11 @@ def _fly(
         wind=(float(flight.value("wind_speed_ms")), float(flight.value("wind_from_deg"))),
         link_outages_s=flight.link_outages_s(),
     )
+    vehicles = int(flight.value("vehicles"))
+    if vehicles > 1:
+        searched = issubclass(mission, SearchMission)
+        fleet = dataclasses.replace(config, vehicles=vehicles)
+        return _fly_fleet(fleet, exit_codes, timeout_s, searched=searched)
     s = fly(config, progress=None if timeout_s is None else VehicleDeadline(timeout_s))
     o, e = s.outcome, s.evaluation
     columns: dict[str, Any] = {
@@ -136,6 +143,46 @@ def _fly(
         "model_built": o.model_built,
         "iou": e.model_iou,
         "tunnel_kept": e.tunnel_kept,
+    }
+
+
+def _fly_fleet(
+    config: FlyConfig, exit_codes: Mapping[str, int], timeout_s: float | None, *, searched: bool
+) -> dict[str, Any]:
+    """A fleet's flight (homes on the first offset line clear of the buildings): the fleet's
+    outcome, and its first vehicle's match judged as one vehicle's is."""
+    from uavtool.runner.fleet import fly_fleet  # noqa: PLC0415
+
+    deadline = None if timeout_s is None else VehicleDeadline(timeout_s)
+    s = fly_fleet(
+        dataclasses.replace(config, offset_line=None),
+        progress=None if deadline is None else lambda _v, text, t: deadline(text, t),
+    )
+    clearances = [v.clearance_m for v in s.vehicles if v.clearance_m is not None]
+    columns: dict[str, Any] = {
+        "status": s.status.value,
+        "exit_code": exit_codes.get(s.status.value),
+        "reason": s.reason,
+        "error": None,
+        "clearance_m": min(clearances) if clearances else None,
+        "flight_time_s": s.vehicle_time_s,
+        "vehicle_time_s": s.vehicle_time_s,
+        "route_length_m": sum(v.route_length_m for v in s.vehicles),
+        "frames": sum(v.frames for v in s.vehicles),
+        "closest_approach_m": s.closest_approach_m if s.closest_approach_m < 1e9 else None,
+        "separation_m": s.separation_m,
+    }
+    e = s.evaluation
+    if e is None or not searched:
+        return columns
+    lead = s.vehicles[0].outcome
+    return columns | {
+        "target_building": e.target_building,
+        "matched_building": e.matched_building or None,
+        "correct": bool(e.matched_building) and e.matched_building == e.target_building,
+        "match_score": lead.match_score if lead.matched_poi >= 0 else None,
+        "model_built": lead.model_built,
+        "iou": e.model_iou,
     }
 
 
