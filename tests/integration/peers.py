@@ -72,9 +72,10 @@ def _copter_defaults() -> Path:
 
 
 @contextmanager
-def arducopter(tmp_path: Path, *, params: str = "", home: str) -> Iterator[int]:
-    """ArduCopter SITL with ``params`` (a .parm file's text) over its defaults; yields the
-    TCP port its MAVLink listens on."""
+def arducopter(tmp_path: Path, *, params: str = "", home: str, instance: int = 0) -> Iterator[int]:
+    """ArduCopter SITL with ``params`` (a .parm file's text) over its defaults, as instance
+    ``instance`` (``-I``: its simulator's own ports apart from the others'); yields the TCP
+    port its MAVLink listens on."""
     defaults = [str(_copter_defaults())]
     if params:
         parm = tmp_path / "extra.parm"
@@ -83,7 +84,7 @@ def arducopter(tmp_path: Path, *, params: str = "", home: str) -> Iterator[int]:
     port = free_port()
     cmd = [
         ARDUCOPTER, "--model", "+", "--home", home, "--defaults", ",".join(defaults),
-        "--serial0", f"tcp:{port}", "--wipe", "-I0", "--speedup", f"{SPEEDUP:g}",
+        "--serial0", f"tcp:{port}", "--wipe", f"-I{instance}", "--speedup", f"{SPEEDUP:g}",
     ]  # fmt: skip
     proc = subprocess.Popen(cmd, cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT)
     try:

@@ -9,12 +9,13 @@ in a defaults file it must complete. ArduCopter runs ``SPEEDUP`` times faster th
 from __future__ import annotations
 
 import subprocess
+from contextlib import ExitStack
 from pathlib import Path
 
 import pytest
 
-from tests.integration.peers import ARDUCOPTER, arducopter, check_photo_poses, fly
-from uavtool.geo import GeoPoint, enu_from_geo
+from tests.integration.peers import ARDUCOPTER, arducopter, check_photo_poses, fly, uavtool
+from uavtool.geo import GeoPoint, enu_from_geo, geo_from_enu
 from uavtool.recording import LocationFix, RecordingReader
 from uavtool.recording.topics import FIX
 
@@ -89,3 +90,43 @@ def test_beside_the_date_line_the_mission_flies_across_it(tmp_path: Path) -> Non
             west += fix.longitude_deg > 0
             east += fix.longitude_deg < 0  # across the line
     assert west and east
+
+
+def test_three_arducopters_fly_the_fleet_search(tmp_path: Path) -> None:
+    """Three ArduCopter SITL instances (``-I0``, ``-I1``, ``-I2``; MAV_SYSID 1–3, named
+    SYSID_THISMAV before 4.7; homes 10 m apart to the east, as ``sim_vehicle.py --count 3
+    --auto-offset-line 90,10`` starts them) fly the fleet's search: the right building found
+    and modelled, the vehicles kept apart, one recording that replays identically."""
+    start = GeoPoint(50.0647, 19.945, 219.0)
+    with ExitStack() as stack:
+        ports = []
+        for i in range(3):
+            home = geo_from_enu(start, 10.0 * i, 0.0, 0.0)
+            folder = tmp_path / f"v{i}"
+            folder.mkdir()
+            ports.append(
+                stack.enter_context(
+                    arducopter(
+                        folder,
+                        params=MOUNT_PARM + f"MAV_SYSID {i + 1}\n",
+                        home=f"{home.lat_deg:.7f},{home.lon_deg:.7f},219,0",
+                        instance=i,
+                    )
+                )
+            )
+        connects = [a for p in ports for a in ("--connect", f"tcp:127.0.0.1:{p}")]
+        result = subprocess.run(
+            uavtool("fly", "--mission", "fleet-search", *connects, "--timeout", "120",
+                    "--output", str(tmp_path / "f.mcap")),
+            capture_output=True, text=True, timeout=2400, check=False,
+        )  # fmt: skip
+    out = result.stdout + result.stderr
+    assert result.returncode == 0, out
+    assert "outcome        completed" in result.stdout, out
+    assert "match          building 'red' (right" in result.stdout, out
+    assert "(kept: 5 m)" in result.stdout, out
+    check = subprocess.run(
+        uavtool("replay", "--check", str(tmp_path / "f.mcap")),
+        capture_output=True, text=True, timeout=600, check=False,
+    )  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr

@@ -82,7 +82,10 @@ def test_the_api_example_flies(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) 
 @pytest.mark.parametrize(
     ("spec", "words"),
     [
-        ("nosuch", "no such mission; registered: fleet-survey, orbit, search, survey"),
+        (
+            "nosuch",
+            "no such mission; registered: fleet-search, fleet-survey, orbit, search, survey",
+        ),
         ("no_such_module:Mission", "cannot import no_such_module"),
         ("tests.plugins.hop:Missing", "tests.plugins.hop has no Missing"),
         ("tests.plugins.hop:NotAMission", "is not a mission (subclass uavtool.api.FlightMission)"),

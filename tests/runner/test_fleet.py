@@ -135,7 +135,7 @@ def test_homes_closer_than_the_claims_take_off_one_after_another() -> None:
     [
         (["--vehicles", "3"], "mission 'search' flies one vehicle"),
         (["--vehicles", "3", "--mission", "fleet-survey", "--connect", "tcp:127.0.0.1:1"],
-         "fleets of external vehicles are not supported yet"),
+         "with one --connect: give one --connect URL per vehicle"),
         (["--vehicles", "3", "--mission", "fleet-survey", "--offset-line", "90,4"],
          "the homes stand closer than the fleet's separation (5 m)"),
         (["--vehicles", "3", "--mission", "fleet-survey", "--offset-line", "0,10"],
@@ -253,3 +253,28 @@ def test_what_cannot_show_a_fleet_yet_says_so(
     assert result.exit_code == 2, result.output
     assert message in result.output
     assert not list(tmp_path.iterdir())
+
+
+def test_a_fleet_of_external_vehicles_flies_on_the_wall_clock(tmp_path: Path) -> None:
+    """Three vehicles served as ArduPilot's -I instances are (``uavtool sitl --vehicles 3``),
+    each on a TCP port of its own, flown with ``--connect`` three times: the same fleet mission
+    on the wall clock, its closest approach from the telemetry, one recording that replays."""
+    from uavtool.geo import GeoPoint
+    from uavtool.sitl import SitlConfig
+    from uavtool.sitl.fleet import Fleet, OffsetLine, fleet_configs, line_homes
+
+    mount = (("MNT1_TYPE", 1.0), ("SERVO9_FUNCTION", 7.0), ("SERVO10_FUNCTION", 6.0))
+    home = GeoPoint(50.0647, 19.945, 219.0)
+    base = SitlConfig(endpoints=("tcpin:127.0.0.1:0",), speedup=20.0, params=mount, home=home)
+    out = tmp_path / "ext.mcap"
+    with Fleet(fleet_configs(base, line_homes(home, 3, OffsetLine()))) as fleet:
+        connects = tuple(f"tcp:127.0.0.1:{v.ports[0]}" for v in fleet.vehicles)
+        s = fly_fleet(FlyConfig(mission="fleet-survey", connects=connects, record=out))
+        assert not any(v.crashed for v in fleet.vehicles)
+    assert s.status is Status.COMPLETED, s.reason
+    assert not s.lockstep and [v.sysid for v in s.vehicles] == [1, 2, 3]
+    assert s.separation_m <= s.closest_approach_m < 12.0  # homes 10 m apart
+    with RecordingReader(out) as reader:
+        meta = dict(reader.metadata)
+    assert meta["vehicle"]["clock"] == "wall" and meta["vehicle"]["connect"] == " ".join(connects)
+    assert all(r.identical for r in replay_fleet(load_fleet(out)))

@@ -42,10 +42,12 @@ _WRITERS: dict[str, bool | None] = {"auto": None, "process": False, "thread": Tr
 @click.command(cls=Command, old_spellings=(OldSpelling("--record", "--output", "-o/--output"),))
 @click.option(
     "--connect",
-    default=None,
+    "connects",
+    multiple=True,
     metavar="URL",
     help="Vehicle connection: tcp:HOST:PORT, udpin:HOST:PORT, udpout:HOST:PORT or "
-    "serial:DEVICE[:BAUD]. Default: start the built-in SITL in-process.",
+    "serial:DEVICE[:BAUD]; repeat it for a fleet (one per vehicle, with a fleet mission). "
+    "Default: start the built-in SITL in-process.",
 )
 @click.option(
     "--scene", default="paper", show_default=True, help="Built-in scene name or scene file."
@@ -197,7 +199,7 @@ _WRITERS: dict[str, bool | None] = {"auto": None, "process": False, "thread": Tr
 )
 @click.option("-q", "--quiet", is_flag=True, help="Print only the summary.")
 def fly(
-    connect: str | None,
+    connects: tuple[str, ...],
     scene: str,
     target: Path | None,
     camera: str,
@@ -240,7 +242,8 @@ def fly(
       uavtool fly --connect tcp:127.0.0.1:5760 --no-gimbal   # a camera fixed down
       uavtool fly --connect udpin:0.0.0.0:14540    # PX4 SITL (its API link)
       uavtool fly --mission orbit --set orbit.step_deg=30   # another mission
-      uavtool fly --vehicles 3 --mission fleet-survey --no-record   # a fleet
+      uavtool fly --vehicles 3 --mission fleet-search      # a fleet of built-in vehicles
+      uavtool fly --mission fleet-search --connect tcp:127.0.0.1:5760 --connect tcp:127.0.0.1:5770
     """
     from uavtool.mission.params import parse_settings, valid_keys, with_overrides
     from uavtool.plugins import resolve
@@ -263,9 +266,11 @@ def fly(
             raise InputError(f"--visit-all: the mission {mission!r} has no mission.visit_all")
         overrides["mission.visit_all"] = "true"
     params = with_overrides(mission_cls.params_type(), overrides)
+    connect = connects[0] if len(connects) == 1 else None
     config = FlyConfig(
         mission=mission,
         connect=connect,
+        connects=connects if len(connects) > 1 else (),
         scene=scene,
         target=target,
         camera=camera,
@@ -291,6 +296,12 @@ def fly(
         if not quiet:
             click.echo(text)
 
+    if len(connects) > 1:
+        if vehicles not in (1, len(connects)):
+            raise InputError(
+                f"--vehicles {vehicles} with {len(connects)} --connect: one --connect per vehicle"
+            )
+        vehicles = len(connects)
     if vehicles > 1:
         _fly_fleet(config, vehicles, offset_line, echo)
     summary = fly_mission(

@@ -38,9 +38,10 @@ from uavtool.recording.fleet import CREW_METADATA, VehicleWriter
 from uavtool.recording.process import ProcessWriter
 from uavtool.recording.topics import TARGET
 from uavtool.recording.values import CompressedImage
-from uavtool.runner.backends import BOOT_ONLY_PARAMS
+from uavtool.runner.backends import BOOT_ONLY_PARAMS, ExternalBackend
 from uavtool.runner.camera import open_camera
 from uavtool.runner.evaluate import Evaluation, evaluate
+from uavtool.runner.fleet_worlds import BuiltinWorld, ExternalWorld
 from uavtool.runner.fly import (
     FlyConfig,
     _flight_time,
@@ -57,10 +58,10 @@ from uavtool.runner.runner import Progress, Runner
 from uavtool.world import Scene, load_scene
 
 if TYPE_CHECKING:
-    from uavtool.camera import CameraPose
+    from uavtool.link import Transport
+    from uavtool.mission.base import Envelope
     from uavtool.recording.protocol import MessageWriter
-    from uavtool.sitl.fleet import Fleet
-    from uavtool.sitl.lockstep import FleetLockstep
+    from uavtool.sitl.config import SitlConfig
 
 MAX_VEHICLES = 16
 AUTO_SPACING_M = 10.0
@@ -97,6 +98,8 @@ class FleetSummary:
     mission: str
     recording: Path | None = None
     evaluation: Evaluation | None = None
+    lockstep: bool = True
+    """Built-in vehicles in lockstep (times are vehicle time), else the wall clock."""
     """The first vehicle's mission judged against the scene (a search: the building it
     matched and the model's overlap with it)."""
 
@@ -111,29 +114,27 @@ def fly_fleet(
     progress: Callable[[int, str, Telemetry | None], None] | None = None,
     status: Callable[[str], None] | None = None,
 ) -> FleetSummary:
-    """Fly ``config.vehicles`` built-in vehicles, homes on ``config.offset_line`` from the
-    scene's home, with the fleet mission ``config.mission``, and record them in one file.
-    ``progress`` hears each member's events (with its sysid and latest telemetry)."""
-    from uavtool.sitl import SitlConfig  # noqa: PLC0415 - a real vehicle needs no simulator
+    """Fly a fleet with the fleet mission ``config.mission`` and record it in one file: the
+    vehicles of ``config.connects`` (one connection each, on the wall clock), or else
+    ``config.vehicles`` built-in vehicles in lockstep, homes on ``config.offset_line`` from
+    the scene's home. ``progress`` hears each member's events (with its sysid and latest
+    telemetry)."""
     from uavtool.sitl.fleet import (  # noqa: PLC0415
-        OffsetLine,
         clear_line,
-        fleet_configs,
-        line_homes,
         vehicle_seed,
     )
-    from uavtool.sitl.lockstep import SIM_EPOCH_UNIX_S, FleetLockstep  # noqa: PLC0415
     from uavtool.world.obstacles import scene_obstacles  # noqa: PLC0415
 
     say = status or (lambda _text: None)
     wall0 = time.monotonic()
+    if config.connects:
+        config = dataclasses.replace(config, vehicles=len(config.connects), offset_line=None)
     vehicles, line = config.vehicles, config.offset_line
     if not 1 <= vehicles <= MAX_VEHICLES:
         raise InputError(f"--vehicles {vehicles}: a fleet flies 1 to {MAX_VEHICLES} vehicles")
     if config.connect is not None:
         raise InputError(
-            "--vehicles with --connect: fleets of external vehicles are not supported yet "
-            "(fly the built-in vehicles, or one external vehicle)"
+            f"--vehicles {vehicles} with one --connect: give one --connect URL per vehicle"
         )
     mission_cls, ref = resolve(config.mission)
     if not issubclass(mission_cls, FleetMember):
@@ -155,7 +156,7 @@ def fly_fleet(
         target_png = target_picture(scene, intrinsics)
     target_rgb = None if target_png is None else png_decode(target_png, where="target")
     fleet_params = getattr(params, mission_cls.fleet_group)
-    if line is None:  # automatic: the first line whose homes are clear of every building
+    if line is None and not config.connects:  # the first line of homes clear of buildings
         found = clear_line(
             scene.home,
             vehicles,
@@ -172,12 +173,133 @@ def fly_fleet(
         line = (found.bearing_deg, found.spacing_m)
         say(f"homes on the offset line {found} (automatic)")
         config = dataclasses.replace(config, offset_line=line)
-    spacing = line[1]
-    if spacing < fleet_params.separation_m:
+    spacing = line[1] if line is not None else math.inf
+    if line is not None and spacing < fleet_params.separation_m:
         raise InputError(
             f"--offset-line {line[0]:g},{spacing:g}: the homes stand closer than the fleet's "
             f"separation ({fleet_params.separation_m:g} m); space them wider"
         )
+    external = bool(config.connects)
+    world: BuiltinWorld | ExternalWorld
+    if external:
+        world = ExternalWorld(config.connects, timeout_s=config.connect_timeout_s, say=say)
+        say(f"{vehicles} vehicles on {', '.join(config.connects)}, scene {scene.name!r}")
+    else:
+        assert line is not None
+        world = BuiltinWorld(_builtin_configs(config, scene, line), speedup=config.speedup)
+        pace = "as fast as it can" if config.speedup is None else f"≤ {config.speedup:g}x"
+        say(f"{vehicles} built-in vehicles in lockstep ({pace}), scene {scene.name!r}")
+    with ExitStack() as stack:
+        stack.callback(world.close)
+        flown: list[bool] = []  # set once the mission starts: from then on the file is kept
+        writer, path = _open_writer(stack, config, scene, ref, target_png, flown)
+        if writer is not None and target_png is not None:
+            picture = CompressedImage(target_png, frame_id="target")
+            writer.write(TARGET, picture, log_time_ns=world.clock_ns())
+        envelope = mission_cls.envelope(params, intrinsics)
+        links = [_connect(t, world, writer, config, envelope, say) for t in world.transports]
+        sysids = [link.target_system for link in links]
+        if len(set(sysids)) != len(sysids):
+            raise InputError(
+                f"the vehicles answer with system ids {sysids}: a fleet needs one each "
+                "(set MAV_SYSID, SYSID_THISMAV before ArduPilot 4.7, or MAV_SYS_ID on PX4)"
+            )
+        homes = [link.state.home for link in links]
+        first = homes[0]
+        assert first is not None
+        homes_en = tuple(enu_from_geo(first, h)[:2] for h in homes if h is not None)
+        _check_apart(homes_en, sysids, fleet_params.separation_m)
+        origin = scene.home
+        if external and config.camera == "sim":
+            origin = ExternalBackend(world.transports[0], config.scene_origin).scene_origin(
+                scene, first, say
+            )
+        if writer is not None:  # an input of the mission: replay builds the crew from it
+            writer.add_metadata(
+                CREW_METADATA, {"homes_en_m": json.dumps([list(h) for h in homes_en])}
+            )
+        members = create_fleet(mission_cls, params, MissionInputs(target_rgb=target_rgb), homes_en)
+        steps = itertools.count(1)  # one order for every member's observations
+        runners = []
+        for i, (link, member) in enumerate(zip(links, members, strict=True)):
+            camera = open_camera(
+                config.camera,
+                scene=scene,
+                intrinsics=intrinsics,
+                noise_seed=vehicle_seed(config.seed, i) if config.noise else None,
+            )
+            stack.callback(camera.close)
+            recorder = None
+            if writer is not None:
+                recorder = MissionRecorder(
+                    VehicleWriter(writer, link.target_system), clock_ns=world.clock_ns
+                )
+                recorder.home = link.state.home
+                said = f"connected to sysid {link.target_system} on {link.name}"
+                recorder.note(Level.INFO, said)
+            runners.append(
+                Runner(
+                    link,
+                    camera,
+                    member,
+                    recorder=recorder,
+                    scene_origin=origin if config.camera == "sim" else None,
+                    true_pose=world.true_pose(i),
+                    progress=_told(progress, link.target_system),
+                    autopilot=for_vehicle(link.state.heartbeat),
+                    config=world.runner_config,
+                    steps=steps,
+                )
+            )
+        vehicle0 = world.clock()
+        flown.append(True)
+        outcomes = world.run(runners)
+        vehicle_s = world.clock() - vehicle0
+        summaries = tuple(
+            VehicleSummary(
+                link.target_system,
+                outcome,
+                _route_length(runner.route),
+                _flight_time(runner.route),
+                runner.frames,
+                world.clearance(i, runner, scene),
+                tuple(runner.results),
+            )
+            for i, (link, runner, outcome) in enumerate(zip(links, runners, outcomes, strict=True))
+        )
+        fleet_status, reason = members[0].crew.outcome(list(outcomes))
+        distance_m, pair = world.approach()
+        summary = FleetSummary(
+            fleet_status,
+            reason,
+            summaries,
+            distance_m,
+            pair,
+            fleet_params.separation_m,
+            vehicle_s,
+            time.monotonic() - wall0,
+            ref.name,
+            path,
+            evaluate(runners[0], scene if config.camera == "sim" else None),
+            lockstep=not external,
+        )
+        for s, recorder in zip(summaries, (r.recorder for r in runners), strict=True):
+            if recorder is not None:
+                recorder.outcome(_vehicle_record(s))
+        if writer is not None:
+            writer.add_metadata("outcome", fleet_record(summary))
+    return summary
+
+
+def _builtin_configs(
+    config: FlyConfig, scene: Scene, line: tuple[float, float]
+) -> tuple[SitlConfig, ...]:
+    """The built-in vehicles: booted as ``fly`` boots one, homes on the offset line."""
+    from uavtool.sitl import SitlConfig  # noqa: PLC0415 - a real vehicle needs no simulator
+    from uavtool.sitl.fleet import OffsetLine, fleet_configs, line_homes  # noqa: PLC0415
+    from uavtool.sitl.lockstep import SIM_EPOCH_UNIX_S  # noqa: PLC0415
+    from uavtool.world.obstacles import scene_obstacles  # noqa: PLC0415
+
     mount = 0.0 if config.no_gimbal else 1.0
     boot: tuple[tuple[str, float], ...] = (("MNT1_TYPE", mount), ("WP_YAW_BEHAVIOR", 0.0))
     boot += tuple((n, v) for n, v in config.vehicle_params if n in BOOT_ONLY_PARAMS)
@@ -192,148 +314,54 @@ def fly_fleet(
         link_outages_s=config.link_outages_s,
         start_unix_us=SIM_EPOCH_UNIX_S * 1_000_000,
     )
-    homes = line_homes(scene.home, vehicles, OffsetLine(*line))
-    configs = fleet_configs(base, homes, obstacles_for=lambda h: scene_obstacles(scene, home=h))
-    with ExitStack() as stack:
-        world = FleetLockstep(configs, speedup=config.speedup)
-        stack.callback(world.close)
-        pace = "as fast as it can" if config.speedup is None else f"≤ {config.speedup:g}x"
-        say(f"{vehicles} built-in vehicles in lockstep ({pace}), scene {scene.name!r}")
-        flown: list[bool] = []  # set once the mission starts: from then on the file is kept
-        writer, path = _open_writer(stack, config, scene, ref, target_png, flown)
-        recorders = [
-            None
-            if writer is None
-            else MissionRecorder(
-                VehicleWriter(writer, c.sysid + c.instance), clock_ns=world.recording_ns
-            )
-            for c in configs
-        ]
-        if writer is not None and target_png is not None:
-            picture = CompressedImage(target_png, frame_id="target")
-            writer.write(TARGET, picture, log_time_ns=world.recording_ns())
-        links, autopilots = [], []
-        for transport, recorder in zip(world.members, recorders, strict=True):
-            link = VehicleLink(
-                transport,
-                tap=recorder.mavlink if recorder else None,
-                clock=world.clock,
-                announce=False,
-            )
-            link.wait_vehicle(config.connect_timeout_s)
-            autopilot = for_vehicle(link.state.heartbeat)
-            autopilot.prepare(link)
-            if config.vehicle_params:
-                set_vehicle_params(link, config.vehicle_params, autopilot)
-            check_home(link)
-            if not config.no_gimbal:
-                check_gimbal(link, autopilot)
-            check_fence(link, autopilot, mission_cls.envelope(params, intrinsics))
-            home = link.state.home
-            assert home is not None
-            where = f"{home.lat_deg:.6f},{home.lon_deg:.6f}"
-            say(f"vehicle {link.target_system} on {link.name}, home {where}")
-            if recorder is not None:
-                recorder.home = home
-                said = f"connected to sysid {link.target_system} on {link.name}"
-                recorder.note(Level.INFO, said)
-            links.append(link)
-            autopilots.append(autopilot)
-        first = links[0].state.home
-        assert first is not None
-        homes_en = tuple(
-            enu_from_geo(first, link.state.home)[:2]  # type: ignore[arg-type]
-            for link in links
-        )
-        if writer is not None:  # an input of the mission: replay builds the crew from it
-            writer.add_metadata(
-                CREW_METADATA, {"homes_en_m": json.dumps([list(h) for h in homes_en])}
-            )
-        members = create_fleet(mission_cls, params, MissionInputs(target_rgb=target_rgb), homes_en)
-        steps = itertools.count(1)  # one order for every member's observations
-        runners = []
-        for i, (link, autopilot, member, recorder) in enumerate(
-            zip(links, autopilots, members, recorders, strict=True)
-        ):
-            camera = open_camera(
-                config.camera,
-                scene=scene,
-                intrinsics=intrinsics,
-                noise_seed=vehicle_seed(config.seed, i) if config.noise else None,
-            )
-            stack.callback(camera.close)
-            runners.append(
-                Runner(
-                    link,
-                    camera,
-                    member,
-                    recorder=recorder,
-                    scene_origin=scene.home,
-                    true_pose=_pose_of(world, i),
-                    progress=_told(progress, link.target_system),
-                    autopilot=autopilot,
-                    steps=steps,
-                )
-            )
-        vehicle0 = world.clock()
-        flown.append(True)
-        outcomes = _run(world, runners)
-        vehicle_s = world.clock() - vehicle0
-        fleet = world.fleet
-        summaries = tuple(
-            VehicleSummary(
-                link.target_system,
-                outcome,
-                _route_length(runner.route),
-                _flight_time(runner.route),
-                runner.frames,
-                _finite(vehicle.closest_clearance_m),
-                tuple(runner.results),
-            )
-            for link, runner, outcome, vehicle in zip(
-                links, runners, outcomes, fleet.vehicles, strict=True
-            )
-        )
-        fleet_status, reason = members[0].crew.outcome(list(outcomes))
-        summary = dataclasses.replace(
-            _summarise(
-                summaries, fleet_status, reason, fleet, fleet_params.separation_m, vehicle_s,
-                wall0, ref.name, path,
-            ),
-            evaluation=evaluate(runners[0], scene),
-        )  # fmt: skip
-        for s, recorder in zip(summaries, recorders, strict=True):
-            if recorder is not None:
-                recorder.outcome(_vehicle_record(s))
-        if writer is not None:
-            writer.add_metadata("outcome", fleet_record(summary))
-    return summary
+    homes = line_homes(scene.home, config.vehicles, OffsetLine(*line))
+    return fleet_configs(base, homes, obstacles_for=lambda h: scene_obstacles(scene, home=h))
 
 
-def _summarise(
-    summaries: tuple[VehicleSummary, ...],
-    status: Status,
-    reason: str,
-    fleet: Fleet,
-    separation_m: float,
-    vehicle_s: float,
-    wall0: float,
-    mission: str,
-    path: Path | None,
-) -> FleetSummary:
-    approach = fleet.approach
-    return FleetSummary(
-        status,
-        reason,
-        summaries,
-        approach.distance_m,
-        approach.sysids,
-        separation_m,
-        vehicle_s,
-        time.monotonic() - wall0,
-        mission,
-        path,
+def _connect(
+    transport: Transport,
+    world: BuiltinWorld | ExternalWorld,
+    writer: MessageWriter | None,
+    config: FlyConfig,
+    envelope: Envelope,
+    say: Callable[[str], None],
+) -> VehicleLink:
+    """One vehicle's link, its every frame recorded on the shared MAVLink channels, checked
+    on the ground as ``fly`` checks one vehicle."""
+    link = VehicleLink(
+        transport,
+        tap=None if writer is None else writer.mavlink_tap(world.clock_ns),
+        clock=world.clock,
+        announce=world.announce,
     )
+    link.wait_vehicle(config.connect_timeout_s)
+    autopilot = for_vehicle(link.state.heartbeat)
+    learnt = autopilot.prepare(link)
+    if learnt:
+        say(learnt)
+    if config.vehicle_params:
+        set_vehicle_params(link, config.vehicle_params, autopilot)
+    check_home(link)
+    if not config.no_gimbal:
+        check_gimbal(link, autopilot)
+    check_fence(link, autopilot, envelope)
+    home = link.state.home
+    assert home is not None
+    say(f"vehicle {link.target_system} on {link.name}, home {home.lat_deg:.6f},{home.lon_deg:.6f}")
+    return link
+
+
+def _check_apart(
+    homes_en: tuple[tuple[float, float], ...], sysids: list[int], separation_m: float
+) -> None:
+    for i, a in enumerate(homes_en):
+        for j in range(i):
+            apart = math.dist(a, homes_en[j])
+            if apart < separation_m:
+                raise InputError(
+                    f"vehicles {sysids[j]} and {sysids[i]} stand {apart:.1f} m apart, less than "
+                    f"the fleet's separation ({separation_m:g} m): give them homes farther apart"
+                )
 
 
 def fleet_record(s: FleetSummary) -> dict[str, str]:
@@ -401,29 +429,6 @@ def _open_writer(
 
         return stack.enter_context(RecordingWriter(partial, metadata=metadata)), path
     return stack.enter_context(ProcessWriter(partial, metadata=metadata)), path
-
-
-def _run(world: FleetLockstep, runners: list[Runner]) -> list[Outcome]:
-    """Turn every runner until each mission is done; step the world when none has anything
-    left to read or feed."""
-    for runner in runners:
-        runner.begin()
-    done = [False] * len(runners)
-    poll_s = runners[0].config.poll_s
-    while True:
-        for i, runner in enumerate(runners):
-            if not done[i] and runner.turn(0.0):
-                done[i] = True
-                world.members[i].close()  # what it says from now on is nobody's
-        if all(done):
-            return [r.finish() for r in runners]
-        if any(r.busy for i, r in enumerate(runners) if not done[i]):
-            continue
-        world.step_until_said(poll_s)
-
-
-def _pose_of(world: FleetLockstep, index: int) -> Callable[[], CameraPose]:
-    return lambda: world.camera_pose(index)
 
 
 def _told(

@@ -93,6 +93,9 @@ class FlyConfig:
     no_gimbal: bool = False
     """The camera is fixed straight down: no gimbal check, the search only (see
     ``MissionParams.gimbal``). The built-in vehicle then boots without a mount."""
+    connects: tuple[str, ...] = ()
+    """A fleet of external vehicles, one connection string each (``fly --connect URL
+    --connect URL …``); empty: built-in vehicles."""
     vehicles: int = 1
     """How many built-in vehicles fly (more than one: a fleet, :func:`uavtool.runner.fleet.
     fly_fleet`)."""
@@ -380,13 +383,19 @@ def describe(
 ) -> FlightDescription:
     """What the flight is, as the recording stores it: a function of the flight's inputs alone
     (no paths, ports, dates or speed-up), so that the same inputs give the same file."""
-    builtin = config.connect is None
+    builtin = config.connect is None and not config.connects
     return FlightDescription(
         mission=mission,
         params=to_dict(config.params),
         scene=scene_to_dict(scene),
         scene_name=scene.name,
-        connect=CONNECT_BUILTIN if builtin else str(config.connect),
+        connect=(
+            " ".join(config.connects)
+            if config.connects
+            else CONNECT_BUILTIN
+            if builtin
+            else str(config.connect)
+        ),
         camera=config.camera,
         clock="lockstep" if builtin else "wall",
         scene_origin=_origin_name(config),

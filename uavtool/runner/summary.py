@@ -95,7 +95,8 @@ def format_fleet_summary(s: FleetSummary) -> str:
         "",
         f"outcome        {s.status.value}: {s.reason}",
         f"fleet          {counted(len(s.vehicles), 'vehicle')}, mission {safe_text(s.mission)}, "
-        f"{s.vehicle_time_s:.1f} s sim, {s.wall_time_s:.1f} s wall",
+        f"{s.vehicle_time_s:.1f} s {'sim' if s.lockstep else 'on the wall clock'}, "
+        f"{s.wall_time_s:.1f} s wall",
     ]
     e = s.evaluation
     if e is not None and e.matched_building:
