@@ -15,7 +15,9 @@ model was built and until the last vehicle landed, the fleet's closest approach;
 - lockstep wall time per vehicle-second of each, and their ratio (goal: <= 1.2: a fleet of
   N costs N vehicles' simulation and rendering, so per vehicle-second of *each* vehicle).
 
-    python benchmarks/bench_fleet.py [--first 61001] [--count 100] [--vehicles 3]
+    python benchmarks/bench_fleet.py [--first 61001] [--count 100] [--vehicles 3] [--quick]
+
+``--quick``: two scenes.
 """
 
 from __future__ import annotations
@@ -42,7 +44,10 @@ def main() -> None:
     ap.add_argument("--first", type=int, default=61001)
     ap.add_argument("--count", type=int, default=100)
     ap.add_argument("--vehicles", type=int, default=3)
+    ap.add_argument("--quick", action="store_true", help="two scenes")
     args = ap.parse_args()
+    if args.quick:
+        args.count = 2
     options = HardOptions(spread_m=SPREAD_M, min_buildings=6, max_buildings=9)
     one_params = with_overrides(Params(), {"mission.search_radius_m": RADIUS_M})
     fleet_params = with_overrides(FleetSearchParams(), {"mission.search_radius_m": RADIUS_M})
