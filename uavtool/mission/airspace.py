@@ -106,6 +106,11 @@ class Airspace:
         lies inside what it held)."""
         self.held[vehicle] = Claim.point(at, alt_m, what)
 
+    def narrow(self, vehicle: int, claim: Claim) -> None:
+        """The vehicle now needs only ``claim``, which lies inside what it held (always
+        granted: it takes nothing from anyone)."""
+        self.held[vehicle] = claim
+
     def park(self, vehicle: int, at: EN) -> None:
         """The vehicle landed and disarmed: it holds only where it stands."""
         self.held[vehicle] = Claim.parked_at(at)

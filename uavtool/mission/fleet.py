@@ -257,6 +257,8 @@ class FleetMember(FlightMission):
         yield from super().move(pos_enu_m, heading_deg, what)
         if not below:
             airspace.shrink(self.index, (x, y), z, what)
+        else:  # only the way back up to its layer is still needed
+            airspace.narrow(self.index, Claim.column((x, y), tol, z, max(layer, z), what))
 
     def claim(self, claim: Claim, what: str) -> Wait[None]:
         """Wait (hovering where it is) until the airspace grants ``claim``; ABORTED after
@@ -274,6 +276,16 @@ class FleetMember(FlightMission):
                 Status.ABORTED,
                 f"{what}: vehicle {_sysid(other)} held the way for {wait_s:g} s",
             )
+
+    def _landed_for_good(self, claim: Claim) -> bool:
+        """Whether what blocks ``claim`` is a member that has landed and ended: it will not
+        move again, so waiting is pointless."""
+        other = self.crew.airspace.blocker(self.index, claim)
+        return (
+            other is not None
+            and self.crew.airspace.held[other].parked
+            and (self.crew.members[other].done)
+        )
 
     def go_home(self) -> Wait[None]:
         """Back over home at this member's layer, then claim the column down for the landing
