@@ -20,7 +20,7 @@ import traceback
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from uavtool import __version__
 from uavtool.errors import FailureError, InputError, UavtoolError
@@ -29,6 +29,8 @@ from uavtool.mission.fleet import FleetMember
 from uavtool.mission.observations import Observation
 from uavtool.mission.outputs import Output
 from uavtool.mission.params import FlightParams, from_dict
+
+T = TypeVar("T")
 
 GROUP = "uavtool.missions"
 """The entry-point group installed packages register their missions in."""
@@ -233,14 +235,7 @@ def create_mission(cls: type[FlightMission], params: Any, inputs: MissionInputs)
     mission flown by one vehicle is a fleet of one."""
     if issubclass(cls, FleetMember):
         return create_fleet(cls, params, inputs, ((0.0, 0.0),))[0]
-    try:
-        return cls(params, inputs)
-    except InputError:
-        raise
-    except Exception as exc:
-        raise PluginError(
-            f"mission {cls.__name__} could not start: {type(exc).__name__}: {exc}"
-        ) from None
+    return _starting(cls, lambda: cls(params, inputs))
 
 
 def create_fleet(
@@ -251,8 +246,13 @@ def create_fleet(
 ) -> list[FleetMember]:
     """A fleet mission's members, one per home (the fleet's frame); a plug-in's own failure
     is a one-line error naming it."""
+    return _starting(cls, lambda: cls.fleet(params, inputs, homes_en_m))
+
+
+def _starting(cls: type[FlightMission], make: Callable[[], T]) -> T:
+    """``make()``; a plug-in's own exception becomes a PluginError naming ``cls``."""
     try:
-        return cls.fleet(params, inputs, homes_en_m)
+        return make()
     except InputError:
         raise
     except Exception as exc:

@@ -30,7 +30,7 @@ from uavtool.api import (
     Wait,
     png_encode,
 )
-from uavtool.examples.survey import Survey, mosaic
+from uavtool.examples.survey import Survey, SurveyMission, mosaic
 
 
 @dataclass(frozen=True, slots=True)
@@ -52,15 +52,9 @@ class FleetSurveyMission(FleetMember):
 
     @classmethod
     def envelope(cls, params: FleetSurveyParams, intrinsics: Intrinsics) -> Envelope:
-        s = params.survey
-        return Envelope(
-            altitude_m=s.altitude_m,
-            distance_m=s.half_side_m * math.sqrt(2.0),
-            why_up="for its lanes",
-            why_out="the square's corners are",
-            shrink_up="survey.altitude_m",
-            shrink_out="survey.half_side_m",
-        )
+        """The one-vehicle survey's: the same square at the same altitude (the layers above
+        it are a few metres more)."""
+        return SurveyMission.envelope(params, intrinsics)  # type: ignore[arg-type]
 
     def base_layer_m(self) -> float:
         return self.params.survey.altitude_m

@@ -8,7 +8,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 from uavtool.camera import CameraPose
 from uavtool.geo import GeoPoint
@@ -111,7 +111,7 @@ class ExternalBackend:
     def clearance(
         self, route: Sequence[tuple[float, float, float]], scene: Scene, offset: tuple[float, float]
     ) -> tuple[float, str]:
-        return closest_clearance(route, scene, body_radius_m=_body_radius_m(), offset_en=offset)
+        return closest_clearance(route, scene, body_radius_m=body_radius_m(), offset_en=offset)
 
 
 @contextmanager
@@ -126,27 +126,10 @@ def open_backend(
         finally:
             transport.close()
         return
-    from uavtool.sitl import SitlConfig  # noqa: PLC0415 - a real vehicle needs no simulator
-    from uavtool.sitl.lockstep import SIM_EPOCH_UNIX_S, LockstepTransport  # noqa: PLC0415
+    from uavtool.sitl.lockstep import LockstepTransport  # noqa: PLC0415 - only to simulate
     from uavtool.world.obstacles import scene_obstacles  # noqa: PLC0415
 
-    # The vehicle `fly` starts has a servo mount (ArduCopter's default has none) and holds
-    # its nose on the way (WP_YAW_BEHAVIOR 0): the mission photographs from known headings.
-    mount = 0.0 if config.no_gimbal else 1.0
-    boot: tuple[tuple[str, float], ...] = (("MNT1_TYPE", mount), ("WP_YAW_BEHAVIOR", 0.0))
-    boot += tuple((n, v) for n, v in config.vehicle_params if n in BOOT_ONLY_PARAMS)
-    sitl_config = SitlConfig(
-        params=boot,
-        endpoints=(),
-        obstacles=scene_obstacles(scene),
-        home=scene.home,
-        home_heading_deg=scene.home_heading_deg,
-        seed=config.seed,
-        wind_speed_ms=config.wind[0],
-        wind_dir_deg=config.wind[1],
-        link_outages_s=config.link_outages_s,
-        start_unix_us=SIM_EPOCH_UNIX_S * 1_000_000,
-    )
+    sitl_config = builtin_sitl_config(config, scene, obstacles=scene_obstacles(scene))
     lockstep = LockstepTransport(sitl_config, speedup=config.speedup)
     pace = "as fast as it can" if config.speedup is None else f"≤ {config.speedup:g}x"
     say(f"built-in SITL in lockstep ({pace}), scene {scene.name!r}")
@@ -156,11 +139,37 @@ def open_backend(
         lockstep.close()
 
 
-def _body_radius_m() -> float:
+def builtin_sitl_config(config: FlyConfig, scene: Scene, *, obstacles: Any) -> SitlConfig:
+    """How ``fly`` boots a built-in vehicle at the scene's home: with a servo mount
+    (ArduCopter's default has none) holding its nose on the way (WP_YAW_BEHAVIOR 0: the
+    mission photographs from known headings), its wind, seed and link faults, among
+    ``obstacles``; its clock starts at the simulation's epoch."""
+    from uavtool.sitl import SitlConfig  # noqa: PLC0415 - a real vehicle needs no simulator
+    from uavtool.sitl.lockstep import SIM_EPOCH_UNIX_S  # noqa: PLC0415
+
+    mount = 0.0 if config.no_gimbal else 1.0
+    boot: tuple[tuple[str, float], ...] = (("MNT1_TYPE", mount), ("WP_YAW_BEHAVIOR", 0.0))
+    boot += tuple((n, v) for n, v in config.vehicle_params if n in BOOT_ONLY_PARAMS)
+    return SitlConfig(
+        params=boot,
+        endpoints=(),
+        obstacles=obstacles,
+        home=scene.home,
+        home_heading_deg=scene.home_heading_deg,
+        seed=config.seed,
+        wind_speed_ms=config.wind[0],
+        wind_dir_deg=config.wind[1],
+        link_outages_s=config.link_outages_s,
+        start_unix_us=SIM_EPOCH_UNIX_S * 1_000_000,
+    )
+
+
+def body_radius_m() -> float:
     from uavtool.sitl import SitlConfig  # noqa: PLC0415 - the simulator's default body
 
     return SitlConfig().body_radius_m
 
 
 if TYPE_CHECKING:
+    from uavtool.sitl.config import SitlConfig
     from uavtool.sitl.lockstep import LockstepTransport

@@ -22,15 +22,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from uavtool.autopilot import for_vehicle
-from uavtool.camera import Intrinsics
 from uavtool.errors import InputError
 from uavtool.geo import enu_from_geo
-from uavtool.images import png_decode
 from uavtool.link import VehicleLink
 from uavtool.mission import Level, MissionInputs, Outcome, Status, Telemetry
 from uavtool.mission.fleet import FleetMember
 from uavtool.mission.outputs import Result
-from uavtool.mission.params import with_overrides
 from uavtool.plugins import MissionRef, create_fleet, resolve
 from uavtool.recording.cores import core_to_spare
 from uavtool.recording.files import atomic_output
@@ -38,24 +35,23 @@ from uavtool.recording.fleet import CREW_METADATA, VehicleWriter
 from uavtool.recording.process import ProcessWriter
 from uavtool.recording.topics import TARGET
 from uavtool.recording.values import CompressedImage
-from uavtool.runner.backends import BOOT_ONLY_PARAMS, ExternalBackend
+from uavtool.runner.backends import ExternalBackend, builtin_sitl_config
 from uavtool.runner.camera import open_camera
 from uavtool.runner.evaluate import Evaluation, evaluate
 from uavtool.runner.fleet_worlds import BuiltinWorld, ExternalWorld
 from uavtool.runner.fly import (
     FlyConfig,
     _flight_time,
-    _read_target,
     _route_length,
     default_recording_path,
     describe,
-    target_picture,
+    prepare,
 )
 from uavtool.runner.params import set_vehicle_params
 from uavtool.runner.preflight import check_fence, check_gimbal, check_home
 from uavtool.runner.record import MissionRecorder
 from uavtool.runner.runner import Progress, Runner
-from uavtool.world import Scene, load_scene
+from uavtool.world import Scene
 
 if TYPE_CHECKING:
     from uavtool.link import Transport
@@ -142,19 +138,9 @@ def fly_fleet(
             f"--vehicles {vehicles}: mission {ref.name!r} flies one vehicle; a fleet flies a "
             "fleet mission (e.g. --mission fleet-survey; see docs/fleets.md)"
         )
-    params = config.params if config.params is not None else mission_cls.params_type()
-    if config.no_gimbal:
-        params = with_overrides(params, {f"{mission_cls.flight_group}.gimbal": False})
-    config = dataclasses.replace(config, params=params)
-    scene = config.scene if isinstance(config.scene, Scene) else load_scene(config.scene)
-    w, h = config.size_px
-    intrinsics = Intrinsics.from_hfov(width_px=w, height_px=h, hfov_deg=config.hfov_deg)
-    target_png = None
-    if config.target:
-        target_png = _read_target(config.target)
-    elif mission_cls.needs_target:
-        target_png = target_picture(scene, intrinsics)
-    target_rgb = None if target_png is None else png_decode(target_png, where="target")
+    setup = prepare(config, mission_cls)
+    config, scene, intrinsics = setup.config, setup.scene, setup.intrinsics
+    params, target_png, target_rgb = config.params, setup.target_png, setup.target_rgb
     fleet_params = getattr(params, mission_cls.fleet_group)
     if line is None and not config.connects:  # the first line of homes clear of buildings
         found = clear_line(
@@ -295,25 +281,10 @@ def _builtin_configs(
     config: FlyConfig, scene: Scene, line: tuple[float, float]
 ) -> tuple[SitlConfig, ...]:
     """The built-in vehicles: booted as ``fly`` boots one, homes on the offset line."""
-    from uavtool.sitl import SitlConfig  # noqa: PLC0415 - a real vehicle needs no simulator
     from uavtool.sitl.fleet import OffsetLine, fleet_configs, line_homes  # noqa: PLC0415
-    from uavtool.sitl.lockstep import SIM_EPOCH_UNIX_S  # noqa: PLC0415
     from uavtool.world.obstacles import scene_obstacles  # noqa: PLC0415
 
-    mount = 0.0 if config.no_gimbal else 1.0
-    boot: tuple[tuple[str, float], ...] = (("MNT1_TYPE", mount), ("WP_YAW_BEHAVIOR", 0.0))
-    boot += tuple((n, v) for n, v in config.vehicle_params if n in BOOT_ONLY_PARAMS)
-    base = SitlConfig(
-        params=boot,
-        endpoints=(),
-        home=scene.home,
-        home_heading_deg=scene.home_heading_deg,
-        seed=config.seed,
-        wind_speed_ms=config.wind[0],
-        wind_dir_deg=config.wind[1],
-        link_outages_s=config.link_outages_s,
-        start_unix_us=SIM_EPOCH_UNIX_S * 1_000_000,
-    )
+    base = builtin_sitl_config(config, scene, obstacles=())
     homes = line_homes(scene.home, config.vehicles, OffsetLine(*line))
     return fleet_configs(base, homes, obstacles_for=lambda h: scene_obstacles(scene, home=h))
 

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 from uavtool.link import Transport, open_transport
 from uavtool.mission import Outcome
-from uavtool.runner.backends import _body_radius_m
+from uavtool.runner.backends import body_radius_m
 from uavtool.runner.evaluate import closest_clearance
 from uavtool.runner.runner import Runner, RunnerConfig
 from uavtool.world import Scene
@@ -134,7 +134,7 @@ class ExternalWorld:
         """Along the telemetry's route, as for one external vehicle."""
         route = [p for _, p in runner.route]
         value, _ = closest_clearance(
-            route, scene, body_radius_m=_body_radius_m(), offset_en=runner.scene_offset
+            route, scene, body_radius_m=body_radius_m(), offset_en=runner.scene_offset
         )
         return value if math.isfinite(value) else None
 

@@ -27,7 +27,7 @@ from uavtool.errors import InputError, LinkError
 from uavtool.flight import CONNECT_BUILTIN, FlightDescription
 from uavtool.images import png_decode, png_encode
 from uavtool.link import VehicleLink
-from uavtool.mission import Level, MissionInputs, Outcome, SearchMission
+from uavtool.mission import FlightMission, Level, MissionInputs, Outcome, SearchMission
 from uavtool.mission.outputs import Result
 from uavtool.mission.params import to_dict, with_overrides
 from uavtool.plugins import DEFAULT, MissionRef, create_mission, resolve
@@ -159,24 +159,23 @@ def target_picture(scene: Scene, intrinsics: Intrinsics) -> bytes:
     return png_encode(render(alone, CameraPose(centre, 0.0, -90.0), intrinsics))
 
 
-def fly(
-    config: FlyConfig,
-    *,
-    progress: Progress | None = None,
-    status: Callable[[str], None] | None = None,
-    vehicle_says: Callable[[str], None] | None = None,
-    autopilot_for: Callable[[object], Autopilot] = for_vehicle,
-) -> FlightSummary:
-    """Fly one mission; raises InputError on bad input or a failed pre-flight check
-    (:class:`PreflightError`, before arming), LinkError when the vehicle cannot be reached.
-    ``progress`` hears each mission event, ``status`` the set-up steps, ``vehicle_says`` the
-    vehicle's warnings and refusals as they arrive. ``autopilot_for`` picks the adapter from
-    the vehicle's HEARTBEAT (e.g. ``lambda _: PX4(movement="offboard")``)."""
-    say = status or (lambda _text: None)
-    wall0 = time.monotonic()
-    if config.scene_origin not in SCENE_ORIGINS:
-        raise InputError(f"--scene-origin {config.scene_origin}: expected vehicle or scene")
-    mission_cls, ref = resolve(config.mission)
+@dataclass(frozen=True, slots=True)
+class Setup:
+    """What a flight's inputs come to before any vehicle is reached: the config with the
+    mission's parameters filled in, the scene, the camera's intrinsics and the target
+    picture (PNG and pixels; None when the mission needs none)."""
+
+    config: FlyConfig
+    scene: Scene
+    intrinsics: Intrinsics
+    target_png: bytes | None
+    target_rgb: Any
+
+
+def prepare(config: FlyConfig, mission_cls: type[FlightMission]) -> Setup:
+    """Check and complete a flight's inputs for ``mission_cls`` (one vehicle's or a fleet's):
+    its parameters (``--no-gimbal`` applied), its scene loaded, its target picture read or
+    rendered. InputError names what is wrong."""
     params = config.params if config.params is not None else mission_cls.params_type()
     if not isinstance(params, mission_cls.params_type):
         raise InputError(
@@ -195,6 +194,30 @@ def fly(
     elif mission_cls.needs_target:
         target_png = target_picture(scene, intrinsics)
     target_rgb = None if target_png is None else png_decode(target_png, where="target")
+    return Setup(config, scene, intrinsics, target_png, target_rgb)
+
+
+def fly(
+    config: FlyConfig,
+    *,
+    progress: Progress | None = None,
+    status: Callable[[str], None] | None = None,
+    vehicle_says: Callable[[str], None] | None = None,
+    autopilot_for: Callable[[object], Autopilot] = for_vehicle,
+) -> FlightSummary:
+    """Fly one mission; raises InputError on bad input or a failed pre-flight check
+    (:class:`PreflightError`, before arming), LinkError when the vehicle cannot be reached.
+    ``progress`` hears each mission event, ``status`` the set-up steps, ``vehicle_says`` the
+    vehicle's warnings and refusals as they arrive. ``autopilot_for`` picks the adapter from
+    the vehicle's HEARTBEAT (e.g. ``lambda _: PX4(movement="offboard")``)."""
+    say = status or (lambda _text: None)
+    wall0 = time.monotonic()
+    if config.scene_origin not in SCENE_ORIGINS:
+        raise InputError(f"--scene-origin {config.scene_origin}: expected vehicle or scene")
+    mission_cls, ref = resolve(config.mission)
+    setup = prepare(config, mission_cls)
+    config, scene, intrinsics = setup.config, setup.scene, setup.intrinsics
+    params, target_png, target_rgb = config.params, setup.target_png, setup.target_rgb
     mission = create_mission(mission_cls, params, MissionInputs(target_rgb=target_rgb))
     camera = open_camera(
         config.camera,

@@ -25,7 +25,8 @@ from uavtool.sweep.plan import FlightSpec
 from uavtool.sweep.scenes import load_source_scene
 
 if TYPE_CHECKING:
-    from uavtool.mission import Telemetry
+    from uavtool.mission import Outcome, Telemetry
+    from uavtool.runner.evaluate import Evaluation
     from uavtool.runner.fly import FlyConfig
 
 ERROR = "error"
@@ -131,18 +132,28 @@ def _fly(
     if not s.searched:  # another mission: its outcome, not the search's findings
         return columns
     scores = recognition_scores(record, scene)
-    return columns | {
-        "target_building": scene.target,
+    return (
+        columns
+        | _match_columns(e, o)
+        | {
+            "target_scores": json.dumps(scores.target_looks),
+            "target_score": scores.target,
+            "other_score": scores.other,
+            "margin": scores.margin,
+            "tunnel_kept": e.tunnel_kept,
+        }
+    )
+
+
+def _match_columns(e: Evaluation, o: Outcome) -> dict[str, Any]:
+    """What the search found, judged against the scene (one vehicle's, or a fleet's first)."""
+    return {
+        "target_building": e.target_building,
         "matched_building": e.matched_building or None,
-        "correct": bool(e.matched_building) and e.matched_building == scene.target,
+        "correct": bool(e.matched_building) and e.matched_building == e.target_building,
         "match_score": o.match_score if o.matched_poi >= 0 else None,
-        "target_score": scores.target,
-        "target_scores": json.dumps(scores.target_looks),
-        "other_score": scores.other,
-        "margin": scores.margin,
         "model_built": o.model_built,
         "iou": e.model_iou,
-        "tunnel_kept": e.tunnel_kept,
     }
 
 
@@ -175,15 +186,7 @@ def _fly_fleet(
     e = s.evaluation
     if e is None or not searched:
         return columns
-    lead = s.vehicles[0].outcome
-    return columns | {
-        "target_building": e.target_building,
-        "matched_building": e.matched_building or None,
-        "correct": bool(e.matched_building) and e.matched_building == e.target_building,
-        "match_score": lead.match_score if lead.matched_poi >= 0 else None,
-        "model_built": lead.model_built,
-        "iou": e.model_iou,
-    }
+    return columns | _match_columns(e, s.vehicles[0].outcome)
 
 
 class VehicleDeadline:
