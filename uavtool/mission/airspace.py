@@ -16,8 +16,9 @@ never a guess.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+
+from uavtool.nav.geometry import point_segment_distance, segments_intersect
 
 EN = tuple[float, float]
 
@@ -55,7 +56,8 @@ class Claim:
     def covers(self, at: EN, alt_m: float, tolerance_m: float) -> bool:
         """Whether a vehicle at ``at``/``alt_m`` is inside (within ``tolerance_m``)."""
         inside_up = self.low_m - tolerance_m <= alt_m <= self.high_m + tolerance_m
-        return inside_up and _point_segment(at, self.a, self.b) <= self.radius_m + tolerance_m
+        near = point_segment_distance(at, self.a, self.b) <= self.radius_m + tolerance_m
+        return inside_up and near
 
 
 def gap_m(p: Claim, q: Claim) -> float:
@@ -116,30 +118,13 @@ class Airspace:
         self.held[vehicle] = Claim.parked_at(at)
 
 
-def _point_segment(p: EN, a: EN, b: EN) -> float:
-    ax, ay = a
-    dx, dy = b[0] - ax, b[1] - ay
-    dd = dx * dx + dy * dy
-    t = 0.0 if dd == 0.0 else min(max(((p[0] - ax) * dx + (p[1] - ay) * dy) / dd, 0.0), 1.0)
-    return math.hypot(p[0] - ax - t * dx, p[1] - ay - t * dy)
-
-
 def _segment_segment(a: EN, b: EN, c: EN, d: EN) -> float:
     """Least distance between the segments ``a``–``b`` and ``c``–``d`` in the plane."""
-    if _crosses(a, b, c, d):
+    if segments_intersect(a, b, c, d):
         return 0.0
     return min(
-        _point_segment(a, c, d),
-        _point_segment(b, c, d),
-        _point_segment(c, a, b),
-        _point_segment(d, a, b),
+        point_segment_distance(a, c, d),
+        point_segment_distance(b, c, d),
+        point_segment_distance(c, a, b),
+        point_segment_distance(d, a, b),
     )
-
-
-def _crosses(a: EN, b: EN, c: EN, d: EN) -> bool:
-    def side(p: EN, q: EN, r: EN) -> float:
-        return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
-
-    d1, d2 = side(c, d, a), side(c, d, b)
-    d3, d4 = side(a, b, c), side(a, b, d)
-    return ((d1 > 0 > d2) or (d1 < 0 < d2)) and ((d3 > 0 > d4) or (d3 < 0 < d4))
