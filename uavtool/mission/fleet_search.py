@@ -3,14 +3,14 @@
 The first vehicle (the leader) flies the search as one vehicle does — the overview, the
 points of interest, every decision — but it does not look at every point of interest itself:
 as soon as the overview is measured it shares what it knows (the points of interest, the roofs
-measured and those of unknown height, the ground it saw, the transit altitude) and hands the
-next points of its visiting order to the others, each to the nearest one that is free. A
-helper flies to its point, looks at it exactly as the leader would (:func:`~uavtool.mission.
-search.inspect`: the same looks, closer looks and looks again) and gives the leader its looks.
-The leader judges every point in the visiting order, from its own looks or a helper's, so the
-fleet decides as one vehicle decides: the same match, the same rivals, the same refusals. Once
-it has decided, the helpers are called off (they fly home and land), and the leader settles,
-photographs the target from three sides and builds the model.
+measured and those of unknown height, the ground it saw, the transit altitude); each helper
+then takes the next point of its visiting order that no one has. A helper flies to its point,
+looks at it as the leader would (:func:`~uavtool.mission.search.inspect`: the same looks,
+closer looks and looks again) and gives the leader its looks. The leader judges every point in
+the visiting order, from the helpers' looks (its own when no helper is left), with the
+search's own logic: the same match, rivals and refusals. Once it has decided, the helpers
+not needed are called off (they fly home and land); the helper at the target photographs it
+from three sides and builds the model while the leader lands.
 
 Each member crosses at a transit altitude of its own (the leader's, one layer step higher per
 helper) and claims every move's airspace (:class:`~uavtool.mission.fleet.FleetMember`), so the
