@@ -142,6 +142,10 @@ def test_homes_closer_than_the_claims_take_off_one_after_another() -> None:
          "vehicle 2's home 50.064790,19.945000 is in building 'purple'"),
         (["--vehicles", "2", "--mission", "fleet-survey", "--offset-line", "90"],
          "offset line '90'"),
+        (["--vehicles", "2", "--mission", "fleet-survey", "--rerun", "x.rrd"],
+         "--rerun with a fleet"),
+        (["--vehicles", "2", "--mission", "fleet-survey", "--camera", "opencv:0"],
+         "--camera opencv:0 with a fleet"),
     ],
 )  # fmt: skip
 def test_bad_fleets_are_refused_on_the_ground(

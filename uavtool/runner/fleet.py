@@ -132,6 +132,16 @@ def fly_fleet(
         raise InputError(
             f"--vehicles {vehicles} with one --connect: give one --connect URL per vehicle"
         )
+    if config.rerun is not None:
+        raise InputError(
+            "--rerun with a fleet: the live view shows one vehicle so far; record the fleet and "
+            "open the file in Foxglove or Lichtblick"
+        )
+    if config.camera != "sim":
+        raise InputError(
+            f"--camera {config.camera} with a fleet: each vehicle needs a camera of its own, and "
+            "a fleet flies with the simulated camera only so far"
+        )
     mission_cls, ref = resolve(config.mission)
     if not issubclass(mission_cls, FleetMember):
         raise InputError(
