@@ -85,10 +85,6 @@ class Crew:
     def size(self) -> int:
         return len(self.homes_en_m)
 
-    @property
-    def done(self) -> bool:
-        return all(m.done for m in self.members)
-
     def call_off(self, index: int) -> str | None:  # noqa: ARG002 - for a crew that calls off
         """Why member ``index`` should stop its work now (its way home follows), or None: the
         runner asks before each observation. By default a member is never called off."""
@@ -97,14 +93,14 @@ class Crew:
     def outcome(self, outcomes: list[Outcome]) -> tuple[Status, str]:
         """The fleet's outcome from its members' (one each, in order): by default a crash if
         any crashed, else the worst of theirs (completed only when every member completed)."""
-        worst = min(range(len(outcomes)), key=lambda i: _WORST.index(outcomes[i].status))
+        worst = min(range(len(outcomes)), key=lambda i: WORST.index(outcomes[i].status))
         o = outcomes[worst]
         if o.status is Status.COMPLETED:
             return o.status, "every vehicle completed"
         return o.status, f"vehicle {worst + 1}: {o.reason}"
 
 
-_WORST = (
+WORST = (
     Status.CRASHED,
     Status.LINK_LOST,
     Status.TAKEOVER,
@@ -114,6 +110,8 @@ _WORST = (
     Status.COMPLETED,
 )
 """Statuses from the worst outcome to the best."""
+FAILED = frozenset({Status.CRASHED, Status.LINK_LOST, Status.TAKEOVER, Status.ABORTED})
+"""Statuses of a flight that failed, whatever its mission achieved."""
 
 
 class FleetMember(FlightMission):

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 from uavtool.mission.airspace import Claim
 from uavtool.mission.analysis import roof_between
-from uavtool.mission.fleet import Crew, FleetMember, FleetParams
+from uavtool.mission.fleet import FAILED, WORST, Crew, FleetMember, FleetParams
 from uavtool.mission.mission import SearchMission
 from uavtool.mission.modelling import photograph_and_model
 from uavtool.mission.outputs import Level, Outcome, Status
@@ -111,17 +111,17 @@ class SearchCrew(Crew):
         return None
 
     def outcome(self, outcomes: list[Outcome]) -> tuple[Status, str]:
-        """The leader's (it judged and built the model): a crash anywhere is the fleet's."""
-        for i, o in enumerate(outcomes):
-            if o.status is Status.CRASHED:
-                return o.status, f"vehicle {i + 1}: {o.reason}"
+        """The leader's (it judged, and says whether the model was built), unless a member's
+        flight failed: a crash, a lost link, a takeover or an abort anywhere is the fleet's,
+        the worst first, with what the search found beside it."""
+        failed = [i for i, o in enumerate(outcomes) if o.status in FAILED]
         lead = outcomes[0]
-        trouble = [
-            f"vehicle {i + 1} {o.status.value}: {o.reason}"
-            for i, o in enumerate(outcomes[1:], start=1)
-            if o.status in (Status.ABORTED, Status.LINK_LOST, Status.TAKEOVER)
-        ]
-        return lead.status, lead.reason + (f" ({'; '.join(trouble)})" if trouble else "")
+        if not failed:
+            return lead.status, lead.reason
+        worst = min(failed, key=lambda i: WORST.index(outcomes[i].status))
+        o = outcomes[worst]
+        found = "" if worst == 0 else f"; the search: {lead.status.value}: {lead.reason}"
+        return o.status, f"vehicle {worst + 1}: {o.reason}{found}"
 
 
 class FleetSearchMission(FleetMember, SearchMission):
