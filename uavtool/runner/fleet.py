@@ -1,11 +1,12 @@
-"""``uavtool fly --vehicles N``: a fleet of built-in vehicles in one lockstep world, flown by
-one fleet mission (:class:`~uavtool.mission.fleet.FleetMember`, one member per vehicle).
+"""``uavtool fly --vehicles N`` (built-in vehicles in one lockstep world) and ``fly --connect
+URL --connect URL …`` (external vehicles on the wall clock): a fleet flown by one fleet mission
+(:class:`~uavtool.mission.fleet.FleetMember`, one member per vehicle), into one recording.
 
-Each vehicle has its own link, camera and :class:`Runner`, exactly as one vehicle has; one loop
-turns every runner (reading what its vehicle said, feeding its member) and steps the world only
-when no runner has anything left to do. So the members see their observations in one order
-that depends on nothing but the flight's inputs, and the fleet's flight is as reproducible as
-one vehicle's.
+Each vehicle has its own link, camera and :class:`Runner`, exactly as one vehicle has; the
+world (:mod:`uavtool.runner.fleet_worlds`) turns every runner in one loop, and the runners
+share one step counter, so the members see their observations in one order. In lockstep that
+order depends on nothing but the flight's inputs: the fleet's flight is as reproducible as one
+vehicle's.
 """
 
 from __future__ import annotations
@@ -28,11 +29,8 @@ from uavtool.link import VehicleLink
 from uavtool.mission import Level, MissionInputs, Outcome, Status, Telemetry
 from uavtool.mission.fleet import FleetMember
 from uavtool.mission.outputs import Result
-from uavtool.plugins import MissionRef, create_fleet, resolve
-from uavtool.recording.cores import core_to_spare
-from uavtool.recording.files import atomic_output
+from uavtool.plugins import create_fleet, resolve
 from uavtool.recording.fleet import CREW_METADATA, VehicleWriter
-from uavtool.recording.process import ProcessWriter
 from uavtool.recording.topics import TARGET
 from uavtool.recording.values import CompressedImage
 from uavtool.runner.backends import ExternalBackend, builtin_sitl_config
@@ -41,11 +39,10 @@ from uavtool.runner.evaluate import Evaluation, evaluate
 from uavtool.runner.fleet_worlds import BuiltinWorld, ExternalWorld
 from uavtool.runner.fly import (
     FlyConfig,
-    _flight_time,
-    _route_length,
-    default_recording_path,
-    describe,
+    flight_time,
+    open_recording,
     prepare,
+    route_length,
 )
 from uavtool.runner.params import set_vehicle_params
 from uavtool.runner.preflight import check_fence, check_gimbal, check_home
@@ -60,9 +57,9 @@ if TYPE_CHECKING:
     from uavtool.sitl.config import SitlConfig
 
 MAX_VEHICLES = 16
+"""The most vehicles ``fly --vehicles`` flies in one world."""
 AUTO_SPACING_M = 10.0
 """The spacing of an automatic offset line (``--offset-line auto``): ArduPilot's default."""
-"""The most vehicles ``fly --vehicles`` flies in one world."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -80,8 +77,7 @@ class VehicleSummary:
 @dataclass(frozen=True, slots=True)
 class FleetSummary:
     status: Status
-    """The fleet's: crashed if any vehicle crashed, else the worst of the members' statuses
-    (completed only when every member completed)."""
+    """The fleet's, as its mission's crew judges it from the members' (``Crew.outcome``)."""
     reason: str
     vehicles: tuple[VehicleSummary, ...]
     closest_approach_m: float
@@ -94,10 +90,10 @@ class FleetSummary:
     mission: str
     recording: Path | None = None
     evaluation: Evaluation | None = None
-    lockstep: bool = True
-    """Built-in vehicles in lockstep (times are vehicle time), else the wall clock."""
     """The first vehicle's mission judged against the scene (a search: the building it
     matched and the model's overlap with it)."""
+    lockstep: bool = True
+    """Built-in vehicles in lockstep (times are vehicle time), else the wall clock."""
 
     @property
     def flight_wall_s(self) -> float:
@@ -188,7 +184,7 @@ def fly_fleet(
     with ExitStack() as stack:
         stack.callback(world.close)
         flown: list[bool] = []  # set once the mission starts: from then on the file is kept
-        writer, path = _open_writer(stack, config, scene, ref, target_png, flown)
+        writer, path = open_recording(stack, config, scene, ref, target_png is not None, flown)
         if writer is not None and target_png is not None:
             picture = CompressedImage(target_png, frame_id="target")
             writer.write(TARGET, picture, log_time_ns=world.clock_ns())
@@ -205,8 +201,8 @@ def fly_fleet(
         assert first is not None
         homes_en = tuple(enu_from_geo(first, h)[:2] for h in homes if h is not None)
         _check_apart(homes_en, sysids, fleet_params.separation_m)
-        origin = scene.home
-        if external and config.camera == "sim":
+        origin = scene.home  # the fleet flies with the simulated camera only (checked above)
+        if external:
             origin = ExternalBackend(world.transports[0], config.scene_origin).scene_origin(
                 scene, first, say
             )
@@ -239,7 +235,7 @@ def fly_fleet(
                     camera,
                     member,
                     recorder=recorder,
-                    scene_origin=origin if config.camera == "sim" else None,
+                    scene_origin=origin,
                     true_pose=world.true_pose(i),
                     progress=_told(progress, link.target_system),
                     autopilot=for_vehicle(link.state.heartbeat),
@@ -255,8 +251,8 @@ def fly_fleet(
             VehicleSummary(
                 link.target_system,
                 outcome,
-                _route_length(runner.route),
-                _flight_time(runner.route),
+                route_length(runner.route),
+                flight_time(runner.route),
                 runner.frames,
                 world.clearance(i, runner, scene),
                 tuple(runner.results),
@@ -276,7 +272,7 @@ def fly_fleet(
             time.monotonic() - wall0,
             ref.name,
             path,
-            evaluate(runners[0], scene if config.camera == "sim" else None),
+            evaluate(runners[0], scene),
             lockstep=not external,
         )
         for s, recorder in zip(summaries, (r.recorder for r in runners), strict=True):
@@ -379,37 +375,6 @@ def _vehicle_record(v: VehicleSummary) -> dict[str, object]:
     if v.clearance_m is not None:
         record["closest_clearance_m"] = round(v.clearance_m, 2)
     return record
-
-
-def _open_writer(
-    stack: ExitStack,
-    config: FlyConfig,
-    scene: Scene,
-    ref: MissionRef,
-    target_png: bytes | None,
-    flown: list[bool],
-) -> tuple[MessageWriter | None, Path | None]:
-    """The fleet's recording, written whole or not at all (as one vehicle's)."""
-    if config.no_record:
-        return None, None
-    path = config.record or default_recording_path()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    partial = stack.enter_context(
-        atomic_output(
-            path,
-            inputs=(config.target, config.scene if isinstance(config.scene, str) else None),
-            keep_on_error=lambda _exc: bool(flown),
-        )
-    )
-    metadata = describe(config, scene, ref, target_png is not None).to_metadata()
-    in_process = config.record_in_process
-    if in_process is None:
-        in_process = not core_to_spare()
-    if in_process:
-        from uavtool.recording.writer import RecordingWriter  # noqa: PLC0415
-
-        return stack.enter_context(RecordingWriter(partial, metadata=metadata)), path
-    return stack.enter_context(ProcessWriter(partial, metadata=metadata)), path
 
 
 def _told(

@@ -229,30 +229,10 @@ def fly(
         stack.callback(camera.close)
         backend = stack.enter_context(open_backend(config, scene, say))
         clock, clock_ns = backend.clock, backend.clock_ns
-        path = None if config.no_record else (config.record or default_recording_path())
-        recorder = None
         flown: list[bool] = []  # set once the mission starts: from then on the file is kept
-        if path is not None:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            partial = stack.enter_context(
-                atomic_output(
-                    path,
-                    inputs=(config.target, config.scene if isinstance(config.scene, str) else None),
-                    keep_on_error=lambda _exc: bool(flown),
-                )
-            )
-            description = describe(config, scene, ref, target_png is not None)
-            metadata = description.to_metadata()
-            writer: MessageWriter
-            in_process = config.record_in_process
-            if in_process is None:
-                in_process = not core_to_spare()
-            if in_process:
-                from uavtool.recording.writer import RecordingWriter  # noqa: PLC0415 - only to write here
-
-                writer = stack.enter_context(RecordingWriter(partial, metadata=metadata))
-            else:
-                writer = stack.enter_context(ProcessWriter(partial, metadata=metadata))
+        writer, path = open_recording(stack, config, scene, ref, target_png is not None, flown)
+        recorder = None
+        if writer is not None:
             recorder = MissionRecorder(writer, clock_ns=clock_ns)
             if target_png is not None:
                 recorder.target(target_png)
@@ -336,8 +316,8 @@ def fly(
         summary = FlightSummary(
             outcome,
             evaluation,
-            _route_length(runner.route),
-            _flight_time(runner.route),
+            route_length(runner.route),
+            flight_time(runner.route),
             runner.frames,
             path,
             time.monotonic() - wall0,
@@ -355,6 +335,39 @@ def fly(
         if recorder is not None:
             recorder.outcome(summary_record(summary))
     return summary
+
+
+def open_recording(
+    stack: ExitStack,
+    config: FlyConfig,
+    scene: Scene,
+    ref: MissionRef,
+    has_target: bool,
+    flown: list[bool],
+) -> tuple[MessageWriter | None, Path | None]:
+    """The flight's recording writer and its path (both None with ``no_record``), entered on
+    ``stack``: written aside and renamed whole, kept on an error once ``flown`` is set; in a
+    process of its own when a core is free (``record_in_process``)."""
+    if config.no_record:
+        return None, None
+    path = config.record or default_recording_path()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = stack.enter_context(
+        atomic_output(
+            path,
+            inputs=(config.target, config.scene if isinstance(config.scene, str) else None),
+            keep_on_error=lambda _exc: bool(flown),
+        )
+    )
+    metadata = describe(config, scene, ref, has_target).to_metadata()
+    in_process = config.record_in_process
+    if in_process is None:
+        in_process = not core_to_spare()
+    if in_process:
+        from uavtool.recording.writer import RecordingWriter  # noqa: PLC0415 - only to write here
+
+        return stack.enter_context(RecordingWriter(partial, metadata=metadata)), path
+    return stack.enter_context(ProcessWriter(partial, metadata=metadata)), path
 
 
 def summary_record(s: FlightSummary) -> dict[str, object]:
@@ -470,12 +483,12 @@ def _failed(recorder: MissionRecorder | None, exc: Exception) -> None:
             )
 
 
-def _route_length(route: list[tuple[int, tuple[float, float, float]]]) -> float:
+def route_length(route: list[tuple[int, tuple[float, float, float]]]) -> float:
     total = 0.0
     for (_, a), (_, b) in itertools.pairwise(route):
         total += math.dist(a, b)
     return total
 
 
-def _flight_time(route: list[tuple[int, tuple[float, float, float]]]) -> float:
+def flight_time(route: list[tuple[int, tuple[float, float, float]]]) -> float:
     return (route[-1][0] - route[0][0]) / 1000.0 if len(route) > 1 else 0.0

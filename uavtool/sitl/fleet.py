@@ -29,10 +29,9 @@ from uavtool.geo import GeoPoint, enu_from_geo, geo_from_enu
 from uavtool.sitl.config import SitlConfig
 from uavtool.sitl.links import FrameTap
 from uavtool.sitl.obstacles import ObstacleField, Prism
-from uavtool.sitl.server import Sitl
+from uavtool.sitl.server import Sitl, serve_paced
 
 _NS = 1_000_000_000
-_MAX_LAG_S = 0.25  # as Sitl.run: at real-time-ish speed-ups, drop lag instead of bursting
 MAX_VEHICLES = 64
 """More vehicles than this in one world are refused (ports +10 each: 64 reach 6390 above the
 first's)."""
@@ -269,23 +268,19 @@ class Fleet:
         """Serve the fleet in this thread, paced by the wall clock at the slowest vehicle's
         ``SIM_SPEEDUP``, until :meth:`stop` (or for ``duration_s`` of sim time)."""
         end_ns = None if duration_s is None else self.now_ns + int(duration_s * _NS)
-        reset = True
-        wall0 = sim0 = 0.0
-        while not self._stop.is_set() and (end_ns is None or self.now_ns < end_ns):
-            speedup = min(v.speedup for v in self.vehicles)
-            if reset or speedup != self.speedup:
-                wall0, sim0, reset = time.perf_counter(), self.now_ns / _NS, False
-                self.speedup = speedup
-            self.step()
-            due = wall0 + (self.now_ns / _NS - sim0) / speedup
-            wait = due - time.perf_counter()
-            if wait < -_MAX_LAG_S and speedup < 100:
-                reset = True  # starved: do not burst to catch up
-            self.poll(wait)
-            while not reset and (wait := due - time.perf_counter()) > 0:
-                if self._stop.is_set():
-                    return
-                self.poll(wait)
+        serve_paced(
+            step=self.step,
+            poll=self.poll,
+            now_ns=lambda: self.now_ns,
+            speedup=self._slowest,
+            vehicles=self.vehicles,
+            stop=self._stop,
+            end_ns=end_ns,
+        )
+
+    def _slowest(self) -> float:
+        self.speedup = min(v.speedup for v in self.vehicles)
+        return self.speedup
 
     def start(self) -> Fleet:
         """Serve in a daemon thread; returns self."""

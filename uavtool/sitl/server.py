@@ -12,7 +12,7 @@ import logging
 import selectors
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from uavtool.mavlink.dialect import mavlink as M
@@ -39,6 +39,46 @@ _MAX_LAG_S = 0.25  # at real-time-ish speed-ups, drop lag beyond this instead of
 MAX_LINK_FAULTS = 10
 """Unexpected errors serving one peer before its link is dropped (each is logged and counted;
 the request that raised it is refused)."""
+
+
+def serve_paced(
+    *,
+    step: Callable[[], None],
+    poll: Callable[[float], None],
+    now_ns: Callable[[], int],
+    speedup: Callable[[], float],
+    vehicles: Sequence[Sitl],
+    stop: threading.Event,
+    end_ns: int | None,
+) -> None:
+    """Step and serve on the wall clock at ``speedup()`` times real time until ``stop`` (or
+    sim time ``end_ns``): one vehicle's loop, or a fleet's (its ``vehicles`` all stepped by
+    ``step``). Wall time only decides when a step runs. A vehicle's ``pacing_reset`` (its
+    SIM_SPEEDUP changed) restarts the pacing; so does falling behind by more than
+    ``_MAX_LAG_S`` below 100x, rather than bursting to catch up."""
+    wall0 = sim0 = 0.0
+    starved = False
+    while not stop.is_set() and (end_ns is None or now_ns() < end_ns):
+        if starved or any(v.pacing_reset for v in vehicles):
+            for v in vehicles:
+                v.pacing_reset = False
+            wall0, sim0, starved = time.perf_counter(), now_ns() / _NS, False
+        step()
+        rate = speedup()
+        due = wall0 + (now_ns() / _NS - sim0) / rate
+        wait = due - time.perf_counter()
+        if wait < -_MAX_LAG_S and rate < 100:
+            starved = True  # we were starved; don't burst to catch up
+        poll(wait)
+        # Serve what arrives until the next step is due: incoming traffic must not make sim
+        # time run ahead of the speed-up (a ground station's stream did, a flood 5x).
+        while (
+            not (starved or any(v.pacing_reset for v in vehicles))
+            and (wait := due - time.perf_counter()) > 0
+        ):
+            if stop.is_set():
+                return
+            poll(wait)
 
 
 class Sitl:
@@ -95,7 +135,7 @@ class Sitl:
         self._link_counter = 0
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
-        self._pacing_reset = True
+        self.pacing_reset = True
         self.steps = 0
         self._outages_ns = [(int(a * _NS), int((a + d) * _NS)) for a, d in config.link_outages_s]
         self.link_down = False
@@ -193,7 +233,7 @@ class Sitl:
         stored = self.autopilot.params.set(name, value)
         if name == "SIM_SPEEDUP" and stored > 0:
             self.speedup = stored
-            self._pacing_reset = True
+            self.pacing_reset = True
         self.autopilot.apply_params()
         return stored
 
@@ -311,22 +351,15 @@ class Sitl:
     def run(self, *, duration_s: float | None = None) -> None:
         """Run in this thread until ``stop()`` (or for ``duration_s`` of sim time)."""
         end_ns = None if duration_s is None else self.now_ns + int(duration_s * _NS)
-        wall0 = sim0 = 0.0
-        while not self._stop.is_set() and (end_ns is None or self.now_ns < end_ns):
-            if self._pacing_reset:
-                wall0, sim0, self._pacing_reset = time.perf_counter(), self.now_ns / _NS, False
-            self.step()
-            due = wall0 + (self.now_ns / _NS - sim0) / self.speedup
-            wait = due - time.perf_counter()
-            if wait < -_MAX_LAG_S and self.speedup < 100:
-                self._pacing_reset = True  # we were starved; don't burst to catch up
-            self.poll(wait)
-            # Serve what arrives until the next step is due: incoming traffic must not make
-            # sim time run ahead of the speed-up (a ground station's stream did, a flood 5x).
-            while not self._pacing_reset and (wait := due - time.perf_counter()) > 0:
-                if self._stop.is_set():
-                    return
-                self.poll(wait)
+        serve_paced(
+            step=self.step,
+            poll=self.poll,
+            now_ns=lambda: self.now_ns,
+            speedup=lambda: self.speedup,
+            vehicles=(self,),
+            stop=self._stop,
+            end_ns=end_ns,
+        )
 
     def start(self) -> Sitl:
         """Run in a daemon thread; returns self."""
