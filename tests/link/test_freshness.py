@@ -114,7 +114,7 @@ def test_the_link_hands_on_only_fresh_messages_and_taps_every_frame() -> None:
     order = [1000, 1200, 1100, 1300, 900]  # time_boot_ms as they arrive
     datagrams = [_frame(_heartbeat())] + [_frame(_position(t)) for t in order]
     tapped: list[bytes] = []
-    link = VehicleLink(_Scripted(list(datagrams)), tap=lambda _d, raw, _msg: tapped.append(raw))
+    link = VehicleLink(_Scripted(list(datagrams)), tap=lambda _d, raws, _msgs: tapped.extend(raws))
     seen: list[int] = []
     for _ in datagrams:
         for msg in link.poll(0.0):

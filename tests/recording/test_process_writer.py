@@ -250,8 +250,9 @@ def test_the_child_drains_the_pipe_while_its_writer_is_busy(
     the writer by more does wait."""
     monkeypatch.setattr(process_child, "BACKLOG_BYTES", 4 << 20)
     read, write = os.pipe()
+    wake, wake_write = os.pipe()
     try:
-        backlog = process_child._Backlog(read)
+        backlog = process_child._Backlog(read, wake)
         photo = bytes(range(256)) * 4096  # 1 MiB, as big as the pipe
         sent: list[int] = []
 
@@ -278,7 +279,33 @@ def test_the_child_drains_the_pipe_while_its_writer_is_busy(
     finally:
         os.close(write)
     assert backlog.next() is None  # the pipe's end
-    os.close(read)
+    for fd in (read, wake, wake_write):
+        os.close(fd)
+
+
+def test_a_flush_wakes_the_child_at_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The child's reader sleeps between looks at an empty pipe (`POLL_S`); what the flight
+    waits for (a flush, a close) is sent with a word on the wake pipe, which ends the sleep:
+    with a sleep of a minute, the batch is still read in well under one."""
+    monkeypatch.setattr(process_child, "POLL_S", (60.0, 60.0))
+    read, write = os.pipe()
+    wake, wake_write = os.pipe()
+    os.set_blocking(read, False)
+    os.set_blocking(wake, False)
+    got: list[object] = []
+    reader = threading.Thread(
+        target=lambda: got.append(process_child._read_framed(read, wake)[0]), daemon=True
+    )
+    try:
+        reader.start()
+        time.sleep(0.2)  # the reader found the pipe empty and sleeps
+        os.write(write, b"".join(process._framed(("flush",))))
+        os.write(wake_write, b"w")
+        reader.join(20)
+        assert got == [("flush",)]
+    finally:
+        for fd in (read, write, wake, wake_write):
+            os.close(fd)
 
 
 @pytest.mark.parametrize(

@@ -25,10 +25,12 @@ GCS_SYSID = 255
 GCS_COMPID = M.MAV_COMP_ID_MISSIONPLANNER
 ANNOUNCE_S = 1.0
 """How often a link that has not heard a vehicle yet sends its heartbeat (MAVProxy's rate)."""
-Tap = Callable[[str, bytes, Any], None]
-"""Called with ``("in" | "out", frame bytes, message)`` for every whole frame that crosses
-the link: for an incoming frame, the pymavlink message the link decoded from those bytes (in
-:data:`~uavtool.mavlink.dialect.DIALECT`); None for an outgoing one."""
+Tap = Callable[[str, list[bytes], list[Any] | None], None]
+"""Called with ``("in" | "out", frames' bytes, messages)`` for the whole frames that cross
+the link, once per read (several frames) or send (one): for incoming frames, the pymavlink
+messages the link decoded from those bytes (in :data:`~uavtool.mavlink.dialect.DIALECT`),
+one per frame; None for outgoing ones. A read's frames arrived together: a recording stamps
+them with one time (and a flight taps ~14,000 frames in ~2,600 reads)."""
 
 # What the runner needs, and how often (Hz); requested with SET_MESSAGE_INTERVAL.
 STREAMS: dict[int, float] = {
@@ -108,9 +110,10 @@ class VehicleLink:
         if not data:
             return []
         out = []
-        for frame in self._parser.feed(data):
-            if self.tap is not None:
-                self.tap("in", frame.raw, frame.msg)
+        frames = self._parser.feed(data)
+        if self.tap is not None and frames:
+            self.tap("in", [frame.raw for frame in frames], [frame.msg for frame in frames])
+        for frame in frames:
             msg = frame.msg
             if self._accept(msg) and self.freshness.fresh(msg):
                 self._update(msg)
@@ -175,7 +178,7 @@ class VehicleLink:
         frame = pack(msg, self._mav)
         self._mav.seq = (self._mav.seq + 1) % 256
         if self.tap is not None:
-            self.tap("out", frame, None)
+            self.tap("out", [frame], None)
         self.transport.send(frame)
 
     def heartbeat(self) -> None:

@@ -55,14 +55,17 @@ class _Tap:
     watch: VehicleWatch | None = None
     clock: Callable[[], float] = time.monotonic
 
-    def __call__(self, direction: str, frame: bytes, decoded: Any = None) -> None:
-        if self.recorder is not None:
-            self.recorder.mavlink(direction, frame, decoded)
-        else:
-            self.held.append((direction, frame, time.time_ns(), decoded))
-        watch = self.watch
-        if watch is not None and direction == "in" and frame_ids(frame)[0] != watch.target[0]:
-            watch.foreign(frame, self.clock())
+    def __call__(self, direction: str, frames: list[bytes], decoded: list[Any] | None) -> None:
+        now_ns = time.time_ns()
+        for i, frame in enumerate(frames):
+            msg = None if decoded is None else decoded[i]
+            if self.recorder is not None:
+                self.recorder.mavlink(direction, frame, msg)
+            else:
+                self.held.append((direction, frame, now_ns, msg))
+            watch = self.watch
+            if watch is not None and direction == "in" and frame_ids(frame)[0] != watch.target[0]:
+                watch.foreign(frame, self.clock())
 
 
 def record(

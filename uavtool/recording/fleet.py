@@ -121,7 +121,12 @@ class VehicleWriter:
             decoded=decoded,
         )
 
-    def mavlink_tap(self, clock_ns: Callable[[], int]) -> Callable[[str, bytes, Any], None]:
+    def hand_off(self) -> None:
+        self.writer.hand_off()
+
+    def mavlink_tap(
+        self, clock_ns: Callable[[], int]
+    ) -> Callable[[str, list[bytes], list[Any] | None], None]:
         return self.writer.mavlink_tap(clock_ns)
 
     def write_vehicle(

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
+import itertools
 import json
 import os
 import pickle
@@ -161,25 +162,32 @@ class ProcessWriter:
         self._closed = False
         self._message_count = 0
         file = create_file(self.path)
+        wake, self._wake = os.pipe()  # see `process_child.POLL_S`
+        os.set_blocking(self._wake, False)
         try:
-            self._proc = _spawn(file)
+            self._proc = _spawn(file, wake)
             init = (
                 str(self.path),
                 file.fileno(),
+                wake,
                 {k: dict(v) for k, v in (metadata or {}).items()},
                 dialect,
                 chunk_interval_ns,
                 chunk_bytes,
                 fsync,
             )
+        except BaseException:
+            os.close(self._wake)
+            raise
         finally:
-            file.close()  # the child has its own descriptor
+            file.close()  # the child has its own descriptors
+            os.close(wake)
         assert self._proc.stdin is not None
         assert self._proc.stdout is not None
         self._out = self._proc.stdin.fileno()
         self._replies = self._proc.stdout
         # dropped without close(): the child still ends (and keeps what it was sent)
-        self._finalizer = weakref.finalize(self, _abandon, self._proc)
+        self._finalizer = weakref.finalize(self, _abandon, self._proc, self._wake)
         self._send(init)
 
     # --- lifecycle ---------------------------------------------------------------------------
@@ -211,7 +219,16 @@ class ProcessWriter:
             self._check_open()
             self._add((_FLUSH,))
             self._ship(0)
+            self._wake_child()
             self._reply()
+
+    def hand_off(self) -> None:
+        """Send what is batched now, without waiting for the child: it writes it while the
+        flight's process does other work (a flight's evaluation) before `close`."""
+        with self._lock:
+            self._check_open()
+            if self._batch or self._frames:
+                self._ship(0)
 
     def close(self) -> None:
         """Send the rest, let the child write the summary, fsync and close the file, and wait
@@ -225,8 +242,13 @@ class ProcessWriter:
                 if self._failure is None:
                     self._add((_CLOSE,))
                     self._ship(0)
+                    self._wake_child()
                     reply = self._reply()
                     self._message_count = int(reply[1])
+                    # the file is whole and on disk; the child only exits now (~3 ms of
+                    # tearing down a process): reaped by a thread, not waited for
+                    self._finalizer.detach()
+                    _release(self._proc, self._wake, wait=False)
             finally:
                 self._finalizer()
             if self._failure is not None:
@@ -362,9 +384,11 @@ class ProcessWriter:
             op = _MAV_PUBLISHED_IN if direction is Direction.IN else _MAV_PUBLISHED_OUT
             self._queue((op, frame, log_time_ns, publish_time_ns), log_time_ns)
 
-    def mavlink_tap(self, clock_ns: Callable[[], int]) -> Callable[[str, bytes, Any], None]:
-        """`write_mavlink` as a link's tap, each frame stamped ``clock_ns()``; the decoded
-        message is not used (the child decodes the frame on another core)."""
+    def mavlink_tap(
+        self, clock_ns: Callable[[], int]
+    ) -> Callable[[str, list[bytes], list[Any] | None], None]:
+        """`write_mavlink` as a link's tap, the frames of each call stamped ``clock_ns()``; the
+        decoded messages are not used (the child decodes the frames on another core)."""
         ops = {"in": _MAV_IN, "out": _MAV_OUT}
         lock, frames, frame_ops, frame_times = (
             self._lock,
@@ -373,18 +397,21 @@ class ProcessWriter:
             self._frame_times,
         )
 
-        def tap(direction: str, frame: bytes, _decoded: Any) -> None:
+        def tap(direction: str, tapped: list[bytes], _decoded: list[Any] | None) -> None:
             t = clock_ns()
             if type(t) is not int or not 0 < t < _END_NS:
                 _check_time(t)
-            if type(frame) is not bytes:
-                frame = bytes(frame)
+            n = len(tapped)
+            for frame in tapped:
+                if type(frame) is not bytes:
+                    tapped = [bytes(f) for f in tapped]
+                    break
             with lock:
                 if self._closed or self._failure is not None:
                     self._check_open()
-                frames.append(frame)
-                frame_ops.append(ops[direction])
-                frame_times.append(t)
+                frames.extend(tapped)
+                frame_ops.extend(bytes((ops[direction],)) * n)
+                frame_times.extend(itertools.repeat(t, n))
                 if t >= self._ship_at or len(frames) >= BATCH_CALLS:
                     self._ship(t)
 
@@ -473,6 +500,11 @@ class ProcessWriter:
             self._fail(f"cannot hand the recording to its writer process: {exc.strerror or exc}")
         # anything else (Ctrl-C mid-write) leaves the rest in _pending: the next send ends it
 
+    def _wake_child(self) -> None:
+        """Have the child look at the pipe now, not at its next poll: the flight waits."""
+        with contextlib.suppress(OSError):  # full: it is awake already; closed: it ended
+            os.write(self._wake, b"w")
+
     def _reply(self) -> tuple[Any, ...]:
         """The child's answer to a flush or close; raises its failure."""
         try:
@@ -509,13 +541,13 @@ def _framed(value: Any) -> list[bytes | memoryview]:
     return [_HEADER.pack(len(data), len(raws)) + sizes, data, *raws]
 
 
-def _spawn(file: BinaryIO) -> subprocess.Popen[bytes]:
+def _spawn(file: BinaryIO, wake: int) -> subprocess.Popen[bytes]:
     try:
         proc = subprocess.Popen(
             [sys.executable, "-c", _CHILD, json.dumps(sys.path)],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
-            pass_fds=(file.fileno(),),
+            pass_fds=(file.fileno(), wake),
             start_new_session=True,  # Ctrl-C is the flight's to handle, not the writer's
             bufsize=0,
         )
@@ -529,10 +561,20 @@ def _spawn(file: BinaryIO) -> subprocess.Popen[bytes]:
     return proc
 
 
-def _abandon(proc: subprocess.Popen[bytes]) -> None:
-    """End the pipe (the child then writes what it holds and exits) and reap the child."""
+def _abandon(proc: subprocess.Popen[bytes], wake: int) -> None:
+    """End the pipes (the child then writes what it holds and exits) and reap the child."""
+    _release(proc, wake, wait=True)
+
+
+def _release(proc: subprocess.Popen[bytes], wake: int, *, wait: bool) -> None:
+    """End the pipes and reap the child: waiting for it, or by a thread of its own."""
+    with contextlib.suppress(OSError):
+        os.close(wake)
     for stream in (proc.stdin, proc.stdout):
         if stream is not None:
             with contextlib.suppress(OSError):
                 stream.close()
-    proc.wait()
+    if wait:
+        proc.wait()
+    elif proc.poll() is None:
+        threading.Thread(target=proc.wait, name="uavtool-recording-reaper", daemon=True).start()

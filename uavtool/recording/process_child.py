@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 import pickle
 import queue
+import select
 import struct
 import sys
 import threading
@@ -45,23 +46,24 @@ POLL_S = (0.001, 0.02)
 while it stays empty, to the longest. A reader asleep in ``read`` would be woken by each
 batch, and the flight's process pays for the waking (~20 us a batch in a virtual machine);
 a reader that looks every millisecond costs it nothing, and a few hundred wake-ups a second
-of its own on the other core. The longest is what a flush or a close may wait more."""
+of its own on the other core. A flush or a close, which the flight waits for, wakes it at
+once: its sleep is a wait on a second pipe, the wake pipe, that only those write to."""
 
 
-def _read_framed(fd: int) -> tuple[Any, int]:
+def _read_framed(fd: int, wake: int | None = None) -> tuple[Any, int]:
     """One framed value from the pipe ``fd``, and its size; `EOFError` at the pipe's end
     (or a frame cut short). Plain reads: no buffered stream's lock for a daemon thread to
     hold when the interpreter ends."""
-    size, count = _HEADER.unpack(_read_exactly(fd, _HEADER.size))
-    sizes = struct.unpack(f"<{count}Q", _read_exactly(fd, 8 * count))
-    data = _read_exactly(fd, size)
-    buffers = [_read_exactly(fd, n) for n in sizes]
+    size, count = _HEADER.unpack(_read_exactly(fd, _HEADER.size, wake))
+    sizes = struct.unpack(f"<{count}Q", _read_exactly(fd, 8 * count, wake))
+    data = _read_exactly(fd, size, wake)
+    buffers = [_read_exactly(fd, n, wake) for n in sizes]
     return pickle.loads(data, buffers=buffers), size + sum(sizes)
 
 
-def _read_exactly(fd: int, size: int) -> bytearray:
+def _read_exactly(fd: int, size: int, wake: int | None = None) -> bytearray:
     """``size`` bytes from ``fd``; on a non-blocking ``fd``, sleeping `POLL_S` between
-    looks while it is empty."""
+    looks while it is empty, or until the pipe ``wake`` has something to say."""
     data = bytearray(size)
     view = memoryview(data)
     done = 0
@@ -70,7 +72,13 @@ def _read_exactly(fd: int, size: int) -> bytearray:
         try:
             n = os.readv(fd, [view[done:]])
         except BlockingIOError:
-            time.sleep(pause)
+            if wake is None:
+                time.sleep(pause)
+            elif select.select((wake,), (), (), pause)[0]:
+                if not os.read(wake, 4096):  # the flight's process closed it: sleep from now
+                    wake = None
+                pause = POLL_S[0]
+                continue
             pause = min(2 * pause, POLL_S[1])
             continue
         if n == 0:
@@ -89,8 +97,9 @@ def serve() -> None:
     def reply(*answer: Any) -> None:
         replies.write(pickle.dumps(answer, protocol=pickle.HIGHEST_PROTOCOL))
 
-    (path, fd, metadata, dialect, interval_ns, budget, fsync), _ = _read_framed(source)
-    batches = _Backlog(source)  # the pipe drained from now on, while the writer is imported
+    (path, fd, wake, metadata, dialect, interval_ns, budget, fsync), _ = _read_framed(source)
+    os.set_blocking(wake, False)
+    batches = _Backlog(source, wake)  # the pipe drained from now on, while the writer is imported
     try:
         # the MCAP writer, imported here: the flight's process, which imports this module
         # too, never needs it
@@ -121,8 +130,8 @@ class _Backlog:
     write: the pipe is drained while a photo is compressed (zlib and zstd let go of the
     GIL). At most `BACKLOG_BYTES` are held; `None` marks the pipe's end."""
 
-    def __init__(self, source: int) -> None:
-        self._source = source
+    def __init__(self, source: int, wake: int) -> None:
+        self._source, self._wake = source, wake
         self._batches: queue.SimpleQueue[tuple[_Batch, int] | None] = queue.SimpleQueue()
         self._room = threading.Semaphore(BACKLOG_BYTES >> 16)  # in 64 KiB units
         threading.Thread(target=self._read, name="uavtool-recording-reader", daemon=True).start()
@@ -131,7 +140,7 @@ class _Backlog:
         os.set_blocking(self._source, False)  # looked at, not waited on: `POLL_S`
         while True:
             try:
-                batch, size = _read_framed(self._source)
+                batch, size = _read_framed(self._source, self._wake)
             except (EOFError, pickle.UnpicklingError, OSError):
                 self._batches.put(None)
                 return

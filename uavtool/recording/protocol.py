@@ -31,6 +31,11 @@ class MessageWriter(Protocol):
 
     def add_metadata(self, name: str, record: Mapping[str, str]) -> None: ...
 
+    def hand_off(self) -> None:
+        """Start on what is held now, without waiting (a writer process writes it while the
+        flight's process does other work); a writer that holds nothing back does nothing."""
+        ...
+
     def add_json_topic(
         self, topic: str, *, schema_name: str, schema: Mapping[str, Any]
     ) -> None: ...
@@ -74,10 +79,13 @@ class MessageWriter(Protocol):
         decoded: Any = None,
     ) -> None: ...
 
-    def mavlink_tap(self, clock_ns: Callable[[], int]) -> Callable[[str, bytes, Any], None]:
-        """A link's tap (``("in" | "out", frame, decoded message or None)``) that writes each
-        frame as `write_mavlink` does, stamped ``clock_ns()``: the same file, made with less
-        work per frame (a flight taps tens of thousands)."""
+    def mavlink_tap(
+        self, clock_ns: Callable[[], int]
+    ) -> Callable[[str, list[bytes], list[Any] | None], None]:
+        """A link's tap (``("in" | "out", frames, decoded messages or None)``, once per read
+        or send) that writes each frame as `write_mavlink` does, all of one call stamped with
+        one ``clock_ns()``: the same file, made with less work per frame (a flight taps tens
+        of thousands)."""
         ...
 
     def write_vehicle(

@@ -139,6 +139,9 @@ class RecordingWriter:
             self._sink.close_chunk()
         self._sink.wait_synced()
 
+    def hand_off(self) -> None:
+        """Nothing to do: every call is written as it is made (`MessageWriter.hand_off`)."""
+
     def close(self) -> None:
         """Wait for the chunks still being written, write the last one and the summary
         (indexes, statistics), fsync the file and close it. Idempotent. Raises
@@ -317,13 +320,18 @@ class RecordingWriter:
             sequence[channel_id] += 1
             self._message_count += 1
 
-    def mavlink_tap(self, clock_ns: Callable[[], int]) -> Callable[[str, bytes, Any], None]:
-        """`write_mavlink` as a link's tap, each frame stamped ``clock_ns()``."""
+    def mavlink_tap(
+        self, clock_ns: Callable[[], int]
+    ) -> Callable[[str, list[bytes], list[Any] | None], None]:
+        """`write_mavlink` as a link's tap, the frames of each call stamped ``clock_ns()``."""
         directions = {"in": Direction.IN, "out": Direction.OUT}
         write = self.write_mavlink
 
-        def tap(direction: str, frame: bytes, decoded: Any) -> None:
-            write(frame, direction=directions[direction], log_time_ns=clock_ns(), decoded=decoded)
+        def tap(direction: str, frames: list[bytes], decoded: list[Any] | None) -> None:
+            t, way = clock_ns(), directions[direction]
+            for i, frame in enumerate(frames):
+                msg = None if decoded is None else decoded[i]
+                write(frame, direction=way, log_time_ns=t, decoded=msg)
 
         return tap
 

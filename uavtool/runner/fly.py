@@ -100,6 +100,9 @@ class FlyConfig:
     """How many built-in vehicles fly (more than one: a fleet, :func:`uavtool.runner.fleet.
     fly_fleet`)."""
     offset_line: tuple[float, float] | None = (90.0, 10.0)
+    homes_m: tuple[tuple[float, float], ...] = ()
+    """A fleet's homes, one per built-in vehicle: metres east and north of the scene's home
+    (``--home E,N``); empty: on ``offset_line``."""
     """A fleet's homes: vehicle i's is i × spacing (m) from the scene's home along the bearing
     (degrees): (bearing, spacing); None: the first line clear of every building."""
     scene_origin: str = "vehicle"
@@ -307,6 +310,8 @@ def fly(
             _failed(recorder, exc)
             raise
         flight_wall_s, vehicle_s = time.perf_counter() - flight_wall0, clock() - vehicle0
+        if writer is not None:
+            writer.hand_off()  # a writer process writes the flight's end while this evaluates
         evaluation = evaluate(runner, scene if simulated else None)
         clearance_m: float | None = None
         clearance_building = ""
@@ -446,6 +451,7 @@ def describe(
         no_gimbal=config.no_gimbal,
         vehicles=config.vehicles,
         offset_line=config.offset_line or (90.0, 10.0),
+        homes_m=config.homes_m,
         tool_version=__version__,
     )
 
