@@ -77,6 +77,9 @@ class FlightDescription:
     offset_line: tuple[float, float] = (90.0, 10.0)
     """A fleet's homes: vehicle i's is i × spacing (m) from the first's along the bearing
     (degrees): (bearing, spacing)."""
+    homes_m: tuple[tuple[float, float], ...] = ()
+    """A fleet's homes given one by one (metres east and north of the scene's home), in place
+    of the offset line; empty: on the line."""
     tool_version: str = field(default="", compare=False)
     """The uavtool that flew it (not part of what the flight was)."""
 
@@ -123,6 +126,9 @@ class FlightDescription:
             records["fleet"] = {
                 "vehicles": str(self.vehicles),
                 "offset_line": json.dumps(list(self.offset_line)),
+                **(
+                    {"homes_m": json.dumps([list(h) for h in self.homes_m])} if self.homes_m else {}
+                ),
             }
         return records
 
@@ -161,6 +167,7 @@ class FlightDescription:
             no_gimbal=r.value(flight, "flight", "no_gimbal", _bool, default="false"),
             vehicles=r.value(fleet, "fleet", "vehicles", _vehicles, default="1"),
             offset_line=r.value(fleet, "fleet", "offset_line", _offset_line, default="[90, 10]"),
+            homes_m=r.value(fleet, "fleet", "homes_m", _homes, default="[]"),
             tool_version=r.text(meta["mission"], "mission", "tool_version", default=""),
         )
 
@@ -265,6 +272,8 @@ def _int(text: str) -> int:
 
 
 MAX_FLEET = 64
+MAX_HOME_M = 10_000.0
+"""How far from the scene's home a fleet's home given by hand may lie."""
 """The most vehicles a recording may say flew (as many as ``uavtool sitl`` serves)."""
 
 
@@ -283,6 +292,21 @@ def _offset_line(text: str) -> tuple[float, float]:
     if not 0.0 < spacing <= 1000.0:
         raise ValueError(f"spacing {spacing:g} m: expected (0, 1000]")
     return bearing, spacing
+
+
+def _homes(text: str) -> tuple[tuple[float, float], ...]:
+    value = _json(text)
+    if not isinstance(value, list) or len(value) > MAX_FLEET:
+        raise ValueError(f"expected a list of at most {MAX_FLEET} [east, north] pairs")
+    homes = []
+    for home in value:
+        if not (isinstance(home, list) and len(home) == 2):
+            raise ValueError("expected [east, north] pairs")
+        east, north = _number(home[0]), _number(home[1])
+        if max(abs(east), abs(north)) > MAX_HOME_M:
+            raise ValueError(f"home {east:g},{north:g}: more than {MAX_HOME_M:g} m from the scene")
+        homes.append((east, north))
+    return tuple(homes)
 
 
 def _bool(text: str) -> bool:

@@ -13,6 +13,7 @@ from click.testing import CliRunner
 from uavtool.cli import cli
 from uavtool.errors import InputError
 from uavtool.examples.fleet_survey import FleetSurveyParams
+from uavtool.flight import FlightDescription
 from uavtool.mission import Status
 from uavtool.mission.fleet import FleetParams
 from uavtool.recording import RecordingReader, summarize
@@ -117,6 +118,25 @@ def test_the_command_flies_and_prints_the_fleet(tmp_path: Path) -> None:
     assert "vehicle 2: completed" in info.output
 
 
+def test_homes_given_one_by_one_are_where_the_vehicles_fly_from(tmp_path: Path) -> None:
+    """``--home E,N`` once per vehicle: each boots there (its fix on the map), the recording
+    keeps them, and a re-flight boots them there again, byte for byte."""
+    out = tmp_path / "homes.mcap"
+    homes = ((0.0, 0.0), (40.0, 18.0), (-30.0, 25.0))
+    s = fly_fleet(_config(out, homes_m=homes))
+    assert s.status is Status.COMPLETED, s.reason
+    with RecordingReader(out) as reader:
+        meta = {name: dict(record) for name, record in reader.metadata}
+    crew = json.loads(meta["crew"]["homes_en_m"])
+    description = FlightDescription.from_metadata(meta, source=str(out))
+    assert [c for home in crew for c in home] == pytest.approx(
+        [c for home in homes for c in home], abs=0.01
+    )
+    assert description.homes_m == homes
+    again = refly(out)
+    assert again.identical, again.first_difference
+
+
 def test_homes_closer_than_the_claims_take_off_one_after_another() -> None:
     # 8.5 m apart: more than the separation, less than two take-off columns with their
     # margins (5 + 2 × 1.5 + 2 × 0.6 m), so the second waits for the first to reach its layer.
@@ -146,6 +166,17 @@ def test_homes_closer_than_the_claims_take_off_one_after_another() -> None:
          "--rerun with a fleet"),
         (["--vehicles", "2", "--mission", "fleet-survey", "--camera", "opencv:0"],
          "--camera opencv:0 with a fleet"),
+        (["--mission", "fleet-survey", "--home", "0,0"], "--home places a fleet's vehicles"),
+        (["--vehicles", "2", "--mission", "fleet-survey", "--home", "0,0"],
+         "--home given 1 times for 2 vehicles"),
+        (["--vehicles", "2", "--mission", "fleet-survey", "--home", "0,0", "--home", "20,0",
+          "--offset-line", "90,20"], "--home and --offset-line both place the vehicles"),
+        (["--vehicles", "2", "--mission", "fleet-survey", "--home", "0,0", "--home", "0,10"],
+         "--home 0,10 (vehicle 2): 0.0 m from a building"),
+        (["--vehicles", "2", "--mission", "fleet-survey", "--home", "0,0", "--home", "3,0"],
+         "vehicles 1 and 2 stand 3.0 m apart"),
+        (["--vehicles", "2", "--mission", "fleet-survey", "--home", "0,0", "--home", "1e9,0"],
+         "expected numbers within 10 km"),
     ],
 )  # fmt: skip
 def test_bad_fleets_are_refused_on_the_ground(

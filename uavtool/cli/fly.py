@@ -4,6 +4,7 @@ it."""
 from __future__ import annotations
 
 import dataclasses
+import math
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -197,6 +198,14 @@ _WRITERS: dict[str, bool | None] = {"auto": None, "process": False, "thread": Tr
     "degrees (as ArduPilot's sim_vehicle.py --auto-offset-line); auto: the first line of "
     "homes 10 m apart clear of every building.",
 )
+@click.option(
+    "--home",
+    "homes",
+    multiple=True,
+    metavar="E,N",
+    help="With --vehicles: a vehicle's home, metres east and north of the scene's home; give it "
+    "once per vehicle, in system-id order, in place of --offset-line.",
+)
 @click.option("-q", "--quiet", is_flag=True, help="Print only the summary.")
 def fly(
     connects: tuple[str, ...],
@@ -223,6 +232,7 @@ def fly(
     scene_origin: str,
     vehicles: int,
     offset_line: str,
+    homes: tuple[str, ...],
     quiet: bool,
 ) -> None:
     """Fly a mission and record everything to one MCAP file: by default the search mission,
@@ -302,8 +312,12 @@ def fly(
                 f"--vehicles {vehicles} with {len(connects)} --connect: one --connect per vehicle"
             )
         vehicles = len(connects)
+    if homes and vehicles == 1:
+        raise InputError("--home places a fleet's vehicles: give --vehicles N and N homes")
+    if homes and _given("offset_line"):
+        raise InputError("--home and --offset-line both place the vehicles: give one of them")
     if vehicles > 1:
-        _fly_fleet(config, vehicles, offset_line, echo)
+        _fly_fleet(config, vehicles, offset_line, tuple(map(_parse_home_m, homes)), echo)
     summary = fly_mission(
         config,
         progress=lambda text, t: echo(format_progress(text, t)),
@@ -317,7 +331,42 @@ def fly(
 _LIVE_VIEWERS = ("spawn", "web")
 
 
-def _fly_fleet(config: FlyConfig, vehicles: int, offset_line: str, echo: Echo) -> NoReturn:
+def _given(name: str) -> bool:
+    """Whether the option ``name`` was given on the command line (not its default)."""
+    source = click.get_current_context().get_parameter_source(name)
+    return source is not None and source is not click.core.ParameterSource.DEFAULT
+
+
+def _parse_home_m(text: str) -> tuple[float, float]:
+    """``E,N`` → (east, north) metres; InputError naming the bad value."""
+    parts = text.split(",")
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        east, north = (float(p) for p in parts)
+    except ValueError:
+        raise InputError(
+            f"--home {text!r}: expected E,N, metres east and north of the scene's home, e.g. 0,20"
+        ) from None
+    from uavtool.flight import MAX_HOME_M
+
+    if (
+        not (math.isfinite(east) and math.isfinite(north))
+        or max(abs(east), abs(north)) > MAX_HOME_M
+    ):
+        raise InputError(
+            f"--home {text!r}: expected numbers within {MAX_HOME_M / 1000:g} km of the scene's home"
+        )
+    return east, north
+
+
+def _fly_fleet(
+    config: FlyConfig,
+    vehicles: int,
+    offset_line: str,
+    homes_m: tuple[tuple[float, float], ...],
+    echo: Echo,
+) -> NoReturn:
     from uavtool.runner.fleet import fly_fleet
     from uavtool.runner.summary import format_fleet_summary, format_progress
     from uavtool.sitl.fleet import parse_offset_line
@@ -327,6 +376,7 @@ def _fly_fleet(config: FlyConfig, vehicles: int, offset_line: str, echo: Echo) -
         config,
         vehicles=vehicles,
         offset_line=None if line is None else (line.bearing_deg, line.spacing_m),
+        homes_m=homes_m,
     )
     summary = fly_fleet(
         config,

@@ -107,6 +107,7 @@ def refly_config(path: Path, *, out: Path, workdir: Path, mission: str | None = 
             no_gimbal=d.no_gimbal,
             vehicles=d.vehicles,
             offset_line=d.offset_line,
+            homes_m=d.homes_m,
         )
 
 

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 
 from uavtool.autopilot import for_vehicle
 from uavtool.errors import InputError
-from uavtool.geo import enu_from_geo
+from uavtool.geo import enu_from_geo, geo_from_enu
 from uavtool.link import VehicleLink
 from uavtool.mission import Level, MissionInputs, Outcome, Status, Telemetry
 from uavtool.mission.fleet import FleetMember
@@ -148,7 +148,9 @@ def fly_fleet(
     config, scene, intrinsics = setup.config, setup.scene, setup.intrinsics
     params, target_png, target_rgb = config.params, setup.target_png, setup.target_rgb
     fleet_params = getattr(params, mission_cls.fleet_group)
-    if line is None and not config.connects:  # the first line of homes clear of buildings
+    if config.homes_m:
+        line = _given_homes(config, scene, fleet_params.separation_m)
+    elif line is None and not config.connects:  # the first line of homes clear of buildings
         found = clear_line(
             scene.home,
             vehicles,
@@ -166,7 +168,7 @@ def fly_fleet(
         say(f"homes on the offset line {found} (automatic)")
         config = dataclasses.replace(config, offset_line=line)
     spacing = line[1] if line is not None else math.inf
-    if line is not None and spacing < fleet_params.separation_m:
+    if line is not None and not config.homes_m and spacing < fleet_params.separation_m:
         raise InputError(
             f"--offset-line {line[0]:g},{spacing:g}: the homes stand closer than the fleet's "
             f"separation ({fleet_params.separation_m:g} m); space them wider"
@@ -291,8 +293,42 @@ def _builtin_configs(
     from uavtool.world.obstacles import scene_obstacles  # noqa: PLC0415
 
     base = builtin_sitl_config(config, scene, obstacles=())
-    homes = line_homes(scene.home, config.vehicles, OffsetLine(*line))
+    if config.homes_m:
+        homes = tuple(geo_from_enu(scene.home, e, n, 0.0) for e, n in config.homes_m)
+    else:
+        homes = line_homes(scene.home, config.vehicles, OffsetLine(*line))
     return fleet_configs(base, homes, obstacles_for=lambda h: scene_obstacles(scene, home=h))
+
+
+def _given_homes(
+    config: FlyConfig, scene: Scene, separation_m: float
+) -> tuple[float, float] | None:
+    """Check the homes given one by one (``--home E,N``): one per built-in vehicle, each clear
+    of every building by the fleet's separation (the vehicles' spacing is checked once they
+    report their homes). Returns the offset line, which they replace."""
+    from uavtool.sitl.obstacles import ObstacleField  # noqa: PLC0415
+    from uavtool.world.obstacles import scene_obstacles  # noqa: PLC0415
+
+    homes = config.homes_m
+    if config.connects:
+        raise InputError(
+            "--home with --connect: external vehicles report their own homes; set them on the "
+            "vehicles (e.g. ArduPilot SITL's --home)"
+        )
+    if len(homes) != config.vehicles:
+        raise InputError(
+            f"--home given {len(homes)} times for {config.vehicles} vehicles: give it once per "
+            "vehicle, in system-id order"
+        )
+    for k, (east, north) in enumerate(homes, start=1):
+        here = geo_from_enu(scene.home, east, north, 0.0)
+        gap_m = ObstacleField(scene_obstacles(scene, home=here)).nearest(0.0, 0.0, 0.0)[0]
+        if gap_m < separation_m:
+            raise InputError(
+                f"--home {east:g},{north:g} (vehicle {k}): {max(gap_m, 0.0):.1f} m from a "
+                f"building, closer than the fleet's separation ({separation_m:g} m); move it"
+            )
+    return config.offset_line or (90.0, 10.0)
 
 
 def _connect(
