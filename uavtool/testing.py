@@ -1,4 +1,4 @@
-"""A pytest plugin: your recordings become regression tests.
+"""A pytest plugin: your recordings become regression tests (one vehicle's or a fleet's).
 
 Enabled automatically when uavtool is installed. Name folders of ``.mcap`` files in your
 pytest configuration::
@@ -48,14 +48,23 @@ def assert_replays_identically(path: str | Path, *, mission: str | None = None) 
     (step, output, field, recorded vs replayed) unless every output is equal. ``mission``
     (``module:Class``) names the mission's class when it is not registered (installed)."""
     from uavtool.replay import load_flight, replay  # noqa: PLC0415 - keep pytest start-up light
+    from uavtool.replay.fleet import replay_fleet  # noqa: PLC0415
+    from uavtool.replay.load import is_fleet, load_fleet  # noqa: PLC0415
 
-    result = replay(load_flight(path, mission=mission))
-    if result.first_difference is not None:
-        raise AssertionError(f"{path}: {result.first_difference.describe()}")
-    if result.divergence is not None:
-        raise AssertionError(
-            f"{path}: diverged at step {result.divergence.step}: {result.divergence.reason}"
-        )
+    if is_fleet(path):  # a fleet's: each vehicle's outputs, "uavK: " before a difference
+        fleet = load_fleet(path, mission=mission)
+        results = replay_fleet(fleet)
+        named = [(f"uav{v.sysid}: ", r) for v, r in zip(fleet.vehicles, results, strict=True)]
+    else:
+        named = [("", replay(load_flight(path, mission=mission)))]
+    for who, result in named:
+        if result.first_difference is not None:
+            raise AssertionError(f"{path}: {who}{result.first_difference.describe()}")
+        if result.divergence is not None:
+            raise AssertionError(
+                f"{path}: {who}diverged at step {result.divergence.step}: "
+                f"{result.divergence.reason}"
+            )
 
 
 def assert_reflies_identically(path: str | Path, *, mission: str | None = None) -> None:

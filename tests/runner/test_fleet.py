@@ -12,9 +12,9 @@ from click.testing import CliRunner
 
 from uavtool.cli import cli
 from uavtool.errors import InputError
-from uavtool.examples.fleet_survey import FleetSurveyParams
+from uavtool.examples.fleet_survey import FleetSurveyMission, FleetSurveyParams
 from uavtool.flight import FlightDescription
-from uavtool.mission import Status
+from uavtool.mission import Level, Status
 from uavtool.mission.fleet import FleetParams
 from uavtool.recording import RecordingReader, summarize
 from uavtool.replay import load_flight
@@ -23,6 +23,7 @@ from uavtool.replay.load import is_fleet, load_fleet
 from uavtool.replay.refly import refly
 from uavtool.runner.fleet import FleetSummary, fly_fleet
 from uavtool.runner.fly import FlyConfig, fly
+from uavtool.testing import assert_reflies_identically, assert_replays_identically
 
 
 def _config(path: Path | None, **kw: object) -> FlyConfig:
@@ -198,6 +199,25 @@ def test_a_fleet_mission_on_one_vehicle_is_a_fleet_of_one(tmp_path: Path) -> Non
     assert check.exit_code == 0 and "identical" in check.output
 
 
+def test_the_pytest_helpers_take_a_fleet_and_name_the_vehicle_that_differs(
+    survey: tuple[FleetSummary, Path],
+) -> None:
+    """A fleet's recording is a golden like any other (``uavtool.testing``): identical as
+    flown, and a different mission's outputs are a failure that names the vehicle."""
+    _, path = survey
+    assert_replays_identically(path)
+    assert_reflies_identically(path)
+    with pytest.raises(AssertionError, match=r"fleet\.mcap: uav1: .*'arming in GUIDED \(louder\)'"):
+        assert_replays_identically(path, mission=f"{__name__}:LouderSurvey")
+
+
+class LouderSurvey(FleetSurveyMission):
+    """The survey, every event it says with one more word: its outputs differ from the start."""
+
+    def event(self, level: Level, text: str) -> None:
+        super().event(level, f"{text} (louder)")
+
+
 def test_a_fleet_recording_is_refused_where_it_is_not_supported(
     survey: tuple[FleetSummary, Path], tmp_path: Path
 ) -> None:
@@ -272,22 +292,27 @@ def test_export_takes_each_vehicles_frames_and_the_model_out(
     assert (tmp_path / "m.glb").read_bytes()[:4] == b"glTF"
 
 
-@pytest.mark.parametrize(
-    ("args", "message"),
-    [
-        (["view", "{rec}", "--save", "{tmp}/v.rrd"], "a fleet's recording (its vehicles' topics"),
-        (["export", "{rec}", "--layout", "{tmp}/l.json"], "--layout makes layouts for one vehicle"),
-    ],
-)
-def test_what_cannot_show_a_fleet_yet_says_so(
-    search: tuple[FleetSummary, Path, list[str]], tmp_path: Path, args: list[str], message: str
+def test_view_shows_every_vehicle_of_the_fleet(
+    search: tuple[FleetSummary, Path, list[str]], tmp_path: Path
 ) -> None:
-    _, path, _ = search
-    argv = [a.format(rec=path, tmp=tmp_path) for a in args]
-    result = CliRunner().invoke(cli, argv)
-    assert result.exit_code == 2, result.output
-    assert message in result.output
-    assert not list(tmp_path.iterdir())
+    s, path, _ = search
+    out = tmp_path / "v.rrd"
+    result = CliRunner().invoke(cli, ["view", str(path), "--save", str(out)])
+    assert result.exit_code == 0, result.output
+    frames = sum(v.frames for v in s.vehicles)
+    assert result.output.startswith(f"wrote {out}: 3 vehicles, {frames} frames, ")
+
+
+def test_export_writes_a_layout_with_a_tab_for_every_vehicle(
+    search: tuple[FleetSummary, Path, list[str]], tmp_path: Path
+) -> None:
+    """(The fleet's layout itself: tests/recording/test_foxglove_layout.py.)"""
+    s, path, _ = search
+    out = tmp_path / "l.json"
+    result = CliRunner().invoke(cli, ["export", str(path), "--layout", str(out)])
+    assert result.exit_code == 0, result.output
+    tabs = json.loads(out.read_text())["configById"]["Tab!vehicles"]["tabs"]
+    assert [t["title"] for t in tabs] == [f"uav{v.sysid}" for v in s.vehicles]
 
 
 def test_a_fleet_of_external_vehicles_flies_on_the_wall_clock(tmp_path: Path) -> None:

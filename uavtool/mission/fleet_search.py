@@ -331,7 +331,8 @@ class FleetSearchMission(FleetMember, SearchMission):
             if not self.model_built:
                 raise self.end(Status.PARTIAL, f"target found; model not built: {self.no_model}")
             return "model built for vehicle 1"
-        return f"looked at {self.inspected} points of interest for vehicle 1"
+        points = "point" if self.inspected == 1 else "points"
+        return f"looked at {self.inspected} {points} of interest for vehicle 1"
 
     def _standby_m(self) -> float:
         """Where a helper waits over home for the leader's survey: low, under every

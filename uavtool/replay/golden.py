@@ -9,7 +9,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from uavtool.replay.load import RecordedOutput, load_flight
+from uavtool.replay.load import RecordedOutput, is_fleet, load_fleet, load_flight
 from uavtool.replay.refly import is_lockstep, refly
 from uavtool.replay.replay import replay
 from uavtool.replay.write import write_replay
@@ -22,6 +22,15 @@ def digest_path(recording: Path) -> Path:
 def digest(outputs: list[RecordedOutput] | tuple[RecordedOutput, ...]) -> str:
     """One line per output: number, step, type and its content, floats to 4 decimals."""
     return "".join(f"{o.n:4d} {o.step:5d} {_line(o.data)}\n" for o in outputs)
+
+
+def recorded_digest(recording: Path) -> str:
+    """The digest of the outputs ``recording`` holds: for a fleet, each vehicle's under a
+    ``## uavK`` line, in system-id order."""
+    if not is_fleet(recording):
+        return digest(load_flight(recording).outputs)
+    fleet = load_fleet(recording)
+    return "".join(f"## uav{v.sysid}\n{digest(v.outputs)}" for v in fleet.vehicles)
 
 
 def _line(data: dict[str, Any]) -> str:
@@ -57,7 +66,9 @@ def update_golden(recording: Path) -> tuple[int, int]:
     A lockstep flight of the built-in vehicle is flown again from its own metadata and
     replaced whole, so that it still re-flies identically. Any other recording keeps its
     observations and gets the outputs the mission produces from them now; that refuses a
-    replay that diverges."""
+    replay that diverges. A fleet's recording is re-flown (only a lockstep one is taken)."""
+    if is_fleet(recording):
+        return _update_fleet(recording)
     flight = load_flight(recording)
     if is_lockstep(recording):
         tmp = recording.with_suffix(".mcap.tmp")
@@ -84,3 +95,23 @@ def update_golden(recording: Path) -> tuple[int, int]:
     tmp.replace(recording)
     digest_path(recording).write_text(digest(result.outputs))
     return len(flight.outputs), len(result.outputs)
+
+
+def _update_fleet(recording: Path) -> tuple[int, int]:
+    """`update_golden` of a fleet's lockstep flight: flown again and replaced whole."""
+    from uavtool.replay.load import ReplayInputError  # noqa: PLC0415
+
+    if not is_lockstep(recording):
+        raise ReplayInputError(
+            f"{recording}: a fleet's golden must be a lockstep flight of built-in vehicles "
+            "(uavtool fly --vehicles N), which is flown again"
+        )
+    before = sum(len(v.outputs) for v in load_fleet(recording).vehicles)
+    tmp = recording.with_suffix(".mcap.tmp")
+    try:
+        refly(recording, out=tmp, compare=False)
+        tmp.replace(recording)
+    finally:
+        tmp.unlink(missing_ok=True)
+    digest_path(recording).write_text(recorded_digest(recording))
+    return before, sum(len(v.outputs) for v in load_fleet(recording).vehicles)
