@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from uavtool.camera import CameraPose
+from uavtool.geo import GeoPoint
 from uavtool.mission import Photo
 from uavtool.replay import load_flight
 from uavtool.world import load_scene, render
@@ -110,24 +111,40 @@ def _px4_build(tmp_path: Path) -> Path:
 
 
 @contextmanager
-def px4(tmp_path: Path, *, params: dict[str, str] | None = None) -> Iterator[int]:
-    """PX4 SITL with SIH (quadrotor X) and ``params`` set at boot, in a fresh rootfs; yields
-    the UDP port its API link sends to, once it says it is ready for take-off."""
+def px4(
+    tmp_path: Path,
+    *,
+    params: dict[str, str] | None = None,
+    instance: int = 0,
+    home: GeoPoint | None = None,
+) -> Iterator[int]:
+    """PX4 SITL with SIH (quadrotor X) and ``params`` set at boot, in a fresh rootfs, as
+    instance ``instance`` (``px4 -i N``: MAV_SYS_ID N + 1, its API link on 14540 + N), at
+    ``home`` (else PX4's own); yields the UDP port its API link sends to, once it says it is
+    ready for take-off."""
     build = _px4_build(tmp_path)
     rootfs = tmp_path / "rootfs"
     rootfs.mkdir()
+    at = {}
+    if home is not None:
+        at = {
+            "PX4_HOME_LAT": f"{home.lat_deg:.7f}",
+            "PX4_HOME_LON": f"{home.lon_deg:.7f}",
+            "PX4_HOME_ALT": f"{home.alt_amsl_m:.2f}",
+        }
     env = {
         **os.environ,
         "PX4_SYS_AUTOSTART": "10040",
         "PX4_SIM_MODEL": "sihsim_quadx",
         "PX4_SIMULATOR": "sihsim",
         "PX4_SIM_SPEED_FACTOR": f"{SPEEDUP:g}",
+        **at,
         **{f"PX4_PARAM_{k}": v for k, v in (params or {}).items()},
     }
     log = tmp_path / "px4.log"
     with log.open("wb") as out:
         proc = subprocess.Popen(
-            [str(build / "bin" / "px4"), "-d", str(build / "etc")],
+            [str(build / "bin" / "px4"), "-i", str(instance), "-d", str(build / "etc")],
             cwd=rootfs, env=env, stdout=out, stderr=subprocess.STDOUT, start_new_session=True,
         )  # fmt: skip
     try:
@@ -136,7 +153,7 @@ def px4(tmp_path: Path, *, params: dict[str, str] | None = None) -> Iterator[int
             if proc.poll() is not None or time.monotonic() > deadline:
                 raise RuntimeError(f"PX4 did not become ready:\n{log.read_text()[-2000:]}")
             time.sleep(0.2)
-        yield PX4_API_PORT
+        yield PX4_API_PORT + instance
     finally:
         os.killpg(proc.pid, signal.SIGTERM)
         try:

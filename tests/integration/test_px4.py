@@ -8,11 +8,13 @@ from __future__ import annotations
 import itertools
 import subprocess
 import time
+from contextlib import ExitStack
 from pathlib import Path
 
 import pytest
 
 from tests.integration.peers import PX4, PX4_GIMBAL, check_photo_poses, fly, px4, uavtool
+from uavtool.geo import GeoPoint, geo_from_enu
 from uavtool.recording import LogEntry, RecordingReader
 from uavtool.recording.topics import TELEMETRY, VEHICLE_EVENTS
 
@@ -118,3 +120,35 @@ def test_a_failsafe_is_a_takeover_in_px4s_own_words(tmp_path: Path) -> None:
     assert "vehicle: Critical battery level: switching to RTL" in said
     lines = [line for line in said.splitlines() if line.startswith("uavtool fly: vehicle:")]
     assert all(a != b for a, b in itertools.pairwise(lines)), lines  # said once, not twice
+
+
+def test_three_px4s_fly_the_fleet_search(tmp_path: Path) -> None:
+    """Three PX4 SITL instances (``px4 -i 0``, ``-i 1``, ``-i 2``: MAV_SYS_ID 1-3, API links
+    on 14540-14542, as PX4's multi-vehicle SITL starts them; homes 10 m apart to the east)
+    fly the fleet's search: the right building found and modelled, the vehicles kept apart,
+    one recording that replays identically."""
+    start = GeoPoint(47.397743, 8.545597, 489.55)  # PX4's own SITL home
+    with ExitStack() as stack:
+        ports = []
+        for i in range(3):
+            folder = tmp_path / f"v{i}"
+            folder.mkdir()
+            home = geo_from_enu(start, 10.0 * i, 0.0, 0.0)
+            ports.append(stack.enter_context(px4(folder, params=PX4_GIMBAL, instance=i, home=home)))
+        assert ports == [14540, 14541, 14542]
+        connects = [a for p in ports for a in ("--connect", f"udpin:0.0.0.0:{p}")]
+        result = subprocess.run(
+            uavtool("fly", "--mission", "fleet-search", *connects, "--timeout", "120",
+                    "--output", str(tmp_path / "f.mcap")),
+            capture_output=True, text=True, timeout=2400, check=False,
+        )  # fmt: skip
+    out = result.stdout + result.stderr
+    assert result.returncode == 0, out
+    assert "outcome        completed" in result.stdout, out
+    assert "match          building 'red' (right" in result.stdout, out
+    assert "(kept: 5 m)" in result.stdout, out
+    check = subprocess.run(
+        uavtool("replay", "--check", str(tmp_path / "f.mcap")),
+        capture_output=True, text=True, timeout=600, check=False,
+    )  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr
