@@ -36,7 +36,7 @@ from uavtool.terminal import counted
     type=click.Path(path_type=Path),
     default=None,
     metavar="OTHER.mcap",
-    help="A second recording (e.g. a replay) to show beside the first.",
+    help="A second recording (e.g. a replay) to show beside the first (one vehicle's).",
 )
 @click.option(
     "--web-port",
@@ -71,7 +71,9 @@ def view(
 ) -> None:
     """Show RECORDING (an MCAP file from `uavtool fly`) in Rerun: the scene, the route with
     the photo positions, each frame with its vectors, points of interest, scores,
-    telemetry, the built model next to the true building, and the text log.
+    telemetry, the built model next to the true building, and the text log. A fleet's
+    recording (`fly --vehicles N`) shows every vehicle so, in one world, each route where it
+    was flown, with a camera view per vehicle.
 
     \b
     Examples:
@@ -80,6 +82,7 @@ def view(
       uavtool view paper.mcap --web --web-port 8080 --grpc-port 8081
       uavtool view recordings/golden/paper.mcap --save paper.rrd
       uavtool view paper.mcap --compare paper-replay.mcap
+      uavtool view fleet.mcap --save fleet.rrd           # from fly --vehicles 3
     """
     from uavtool.view import view as show
 
@@ -104,8 +107,10 @@ def view(
         bind=bind,
     )
     c = result.counts
+    vehicles = len(result.vehicle_counts)  # a fleet's
     summary = (
-        f"{counted(c.frames, 'frame')}, {counted(c.telemetry, 'telemetry sample')}, "
+        (f"{counted(vehicles, 'vehicle')}, " if vehicles else "")
+        + f"{counted(c.frames, 'frame')}, {counted(c.telemetry, 'telemetry sample')}, "
         f"{counted(c.shapes, 'shape')}, {counted(c.recognitions, 'recognition')}, "
         f"{counted(c.models, 'model')}"
         + (f", {counted(c.pictures, 'picture')}" if c.pictures else "")

@@ -12,12 +12,17 @@ Live, the runner logs each observation and output through the same `MissionLogge
     viewer.logger.observation(step, obs_dict, image_png, log_time_ns=t)
     viewer.logger.output(n, out_dict, log_time_ns=t)
     viewer.close()
+
+A fleet's recording (``uavtool fly --vehicles N``) goes through a `FleetLogger`: one
+`MissionLogger` per vehicle, its entities under ``world/uavK/…`` placed at its home.
 """
 
 from uavtool.view.blueprint import default_blueprint
 from uavtool.view.errors import ViewError
+from uavtool.view.fleet import FleetLogger
+from uavtool.view.fleet_source import fleet_of, log_fleet_recording
 from uavtool.view.logger import LogCounts, MissionLogger, statustext_level
-from uavtool.view.paths import COMPARE_PREFIX, LOG_TIME, VEHICLE_TIME, Paths
+from uavtool.view.paths import COMPARE_PREFIX, LOG_TIME, VEHICLE_TIME, FleetVehicle, Paths
 from uavtool.view.session import APPLICATION_ID, Viewer, ViewResult, open_viewer, view
 from uavtool.view.source import log_recording
 
@@ -26,6 +31,8 @@ __all__ = [
     "COMPARE_PREFIX",
     "LOG_TIME",
     "VEHICLE_TIME",
+    "FleetLogger",
+    "FleetVehicle",
     "LogCounts",
     "MissionLogger",
     "Paths",
@@ -33,6 +40,8 @@ __all__ = [
     "ViewResult",
     "Viewer",
     "default_blueprint",
+    "fleet_of",
+    "log_fleet_recording",
     "log_recording",
     "open_viewer",
     "statustext_level",

@@ -3,24 +3,36 @@
 Left, the 3D world (buildings, route, photo positions, points of interest, viewpoints,
 model) above the camera (latest frame with its vectors); right, the plots, the target and
 the text log. With a second recording, its 3D view and camera stand beside the first and
-its plots are drawn on the same axes.
+its plots are drawn on the same axes. A fleet's 3D view holds every vehicle, with a camera
+view per vehicle below it; every vehicle's plots are drawn on the same axes.
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import rerun.blueprint as rrb
 
 from uavtool.view.paths import COMPARE_PREFIX, VEHICLE_TIME, Paths
 
 _ALL = rrb.TimeRangeBoundary.infinite()
+_CAMERAS_IN_A_ROW = 4
 
 
-def default_blueprint(*, compare: bool = False) -> rrb.Blueprint:
-    """The layout for one mission, or for one beside a second (under ``compare/``)."""
+def default_blueprint(*, compare: bool = False, fleet: Sequence[str] = ()) -> rrb.Blueprint:
+    """The layout for one mission, for one beside a second (under ``compare/``), or for a
+    fleet's (``fleet``: its vehicles' names, ``uav1`` …)."""
     main = Paths()
     other = Paths(COMPARE_PREFIX)
-    if compare:
+    plotted = [main, other] if compare else [main]
+    if fleet:
+        vehicles = [Paths(uav=name) for name in fleet]
         spatial: rrb.Container = rrb.Vertical(
+            _world(main, "3D"), _cameras(vehicles), row_shares=[3, 2]
+        )
+        plotted = vehicles
+    elif compare:
+        spatial = rrb.Vertical(
             rrb.Horizontal(_world(main, "3D: recording"), _world(other, "3D: compared")),
             rrb.Horizontal(_camera(main, "camera: recording"), _camera(other, "camera: compared")),
             row_shares=[3, 2],
@@ -28,7 +40,7 @@ def default_blueprint(*, compare: bool = False) -> rrb.Blueprint:
     else:
         spatial = rrb.Vertical(_world(main, "3D"), _camera(main, "camera"), row_shares=[3, 2])
     side = rrb.Vertical(
-        _plots(main, other if compare else None),
+        _plots(plotted, main),
         rrb.Horizontal(
             rrb.Spatial2DView(origin=main.target, name="target"),
             _logs(main, other if compare else None),
@@ -63,8 +75,17 @@ def _camera(paths: Paths, name: str) -> rrb.Spatial2DView:
     return rrb.Spatial2DView(origin=paths.image, name=name)
 
 
-def _plots(main: Paths, other: Paths | None) -> rrb.Tabs:
-    roots = [main] if other is None else [main, other]
+def _cameras(vehicles: Sequence[Paths]) -> rrb.Container:
+    """A fleet's cameras, one view per vehicle: in a row, or a grid when they are many."""
+    views = [_camera(p, f"camera: {p.uav}") for p in vehicles]
+    if len(views) <= _CAMERAS_IN_A_ROW:
+        return rrb.Horizontal(*views)
+    return rrb.Grid(*views, grid_columns=_CAMERAS_IN_A_ROW)
+
+
+def _plots(roots: Sequence[Paths], main: Paths) -> rrb.Tabs:
+    """Each series of every root (mission, compared mission, vehicle) on the same axes; the
+    map of ``main`` (all that is under it)."""
 
     def series(name: str, *subs: str) -> rrb.TimeSeriesView:
         contents = [f"+ /{p.plots}/{sub}" for sub in subs for p in roots]

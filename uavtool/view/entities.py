@@ -1,8 +1,10 @@
 """One function per thing a mission shows in Rerun: each logs at the stream's current time.
 
-Coordinates: the world is ENU metres around home (x east, y north, z up); image overlays
-are pixels. The mission's pixel coordinates put pixel centres on integers (OpenCV's
-convention) while Rerun puts the top-left pixel's centre at (0.5, 0.5), hence ``_PX``.
+Coordinates: the world is ENU metres around home (x east, y north, z up); a fleet's is
+around vehicle 1's home, and each vehicle's entities are in its own frame (around its own
+home), placed at its home by `log_fleet_vehicle`. Image overlays are pixels. The
+mission's pixel coordinates put pixel centres on integers (OpenCV's convention) while Rerun
+puts the top-left pixel's centre at (0.5, 0.5), hence ``_PX``.
 """
 
 from __future__ import annotations
@@ -33,12 +35,53 @@ _VECTOR_RGB = (0, 255, 255)  # shapes are drawn in one bright colour: in their o
 # they vanish against the roofs they outline
 
 
+_FLEET_RGB = (
+    _ROUTE_RGB,
+    (0, 200, 255),
+    (255, 90, 200),
+    (120, 230, 90),
+    (255, 140, 40),
+    (170, 130, 255),
+)
+
+
+def vehicle_rgb(sysid: int) -> tuple[int, int, int]:
+    """The colour of a fleet's vehicle ``sysid`` (its route, its marker): vehicle 1's is the
+    route colour of one vehicle, the others' stand apart from it and from each other."""
+    return _FLEET_RGB[(sysid - 1) % len(_FLEET_RGB)]
+
+
+def log_axes(rec: rr.RecordingStream, paths: Paths) -> None:
+    """The world's axes (ENU, z up); static."""
+    rec.log(paths.world, rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+
+
 def log_world(rec: rr.RecordingStream, paths: Paths) -> None:
     """The world's axes (ENU, z up) and the vehicle's marker; static."""
-    rec.log(paths.world, rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+    log_axes(rec, paths)
     rec.log(
         paths.vehicle_body,
         rr.Boxes3D(half_sizes=[[0.6, 0.6, 0.15]], colors=[(230, 230, 230)]),
+        rr.Arrows3D(vectors=[[1.6, 0.0, 0.0]], colors=[(255, 60, 60)]),
+        static=True,
+    )
+
+
+def log_fleet_vehicle(
+    rec: rr.RecordingStream,
+    paths: Paths,
+    *,
+    home_en_m: tuple[float, float],
+    rgb: tuple[int, int, int],
+) -> None:
+    """A fleet's vehicle: its frame (ENU metres around its own home, as its telemetry)
+    placed at its home in the fleet's frame, and its marker in its colour, named; static."""
+    rec.log(paths.world, rr.Transform3D(translation=(*home_en_m, 0.0)), static=True)
+    rec.log(
+        paths.vehicle_body,
+        rr.Boxes3D(
+            half_sizes=[[0.6, 0.6, 0.15]], colors=[rgb], labels=[paths.uav], show_labels=True
+        ),
         rr.Arrows3D(vectors=[[1.6, 0.0, 0.0]], colors=[(255, 60, 60)]),
         static=True,
     )
@@ -341,10 +384,16 @@ def log_model(
 
 
 def log_route_chunk(
-    rec: rr.RecordingStream, path: str, *, positions_enu_m: npt.NDArray[np.float64]
+    rec: rr.RecordingStream,
+    path: str,
+    *,
+    positions_enu_m: npt.NDArray[np.float64],
+    rgb: tuple[int, int, int] | None = None,
 ) -> None:
-    """One piece of the route flown so far; pieces are separate entities so all stay shown."""
-    rec.log(path, rr.LineStrips3D([positions_enu_m], colors=[_ROUTE_RGB], radii=0.15))
+    """One piece of the route flown so far, in ``rgb`` (None: the route's colour); pieces
+    are separate entities so all stay shown."""
+    colour = _ROUTE_RGB if rgb is None else rgb
+    rec.log(path, rr.LineStrips3D([positions_enu_m], colors=[colour], radii=0.15))
 
 
 def log_text(rec: rr.RecordingStream, path: str, *, text: str, level: str) -> None:

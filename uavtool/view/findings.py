@@ -21,11 +21,22 @@ Output = Mapping[str, Any]
 
 
 class Findings:
-    """State of the vision outputs for one mission; ``frame`` is the photo on screen."""
+    """State of the vision outputs for one mission; ``frame`` is the photo on screen.
 
-    def __init__(self, rec: rr.RecordingStream, paths: Paths) -> None:
+    ``home_en_m``: a fleet's vehicle's home in the fleet's frame. Its mission's positions
+    (points of interest, viewpoints, the model) are in the fleet's frame while its entities
+    are in its own, so they are drawn moved by minus its home."""
+
+    def __init__(
+        self,
+        rec: rr.RecordingStream,
+        paths: Paths,
+        *,
+        home_en_m: tuple[float, float] | None = None,
+    ) -> None:
         self.rec = rec
         self.paths = paths
+        self.home_en_m = home_en_m
         self.frame = -2  # no photo yet (−1 is the target picture)
         self.poi_height_m = 10.0
         self.threshold: float | None = None
@@ -103,7 +114,12 @@ class Findings:
 
     def _draw_viewpoints(self, views: list[Mapping[str, Any]]) -> list[str]:
         footprint, _ = self._viewpoints
-        ent.log_viewpoints(self.rec, self.paths, footprint_en_m=footprint, viewpoints=views)
+        ent.log_viewpoints(
+            self.rec,
+            self.paths,
+            footprint_en_m=[self._here(p) for p in footprint],
+            viewpoints=[self._here_view(v) for v in views],
+        )
         return [
             f"viewpoint {v.get('name')}: {v.get('reason', 'failed')}"
             for v in views
@@ -114,6 +130,8 @@ class Findings:
         verts: Sequence[Sequence[float]] = out.get("vertices_m") or []
         xs = [float(v[0]) for v in verts]
         offset = ((max(xs) - min(xs) + _MODEL_GAP_M) if xs else 0.0, 0.0, 0.0)
+        if self.home_en_m is not None:  # the vertices are in the fleet's frame
+            offset = (offset[0] - self.home_en_m[0], -self.home_en_m[1], 0.0)
         height_m, volume_m3 = float(out.get("height_m", 0.0)), float(out.get("volume_m3", 0.0))
         ent.log_model(
             self.rec,
@@ -142,9 +160,21 @@ class Findings:
         ent.log_pois(
             self.rec,
             self.paths,
-            positions_en_m=[p["pos_en_m"] for p in self.pois],
+            positions_en_m=[self._here(p["pos_en_m"]) for p in self.pois],
             labels=labels,
             colours_rgb=[p.get("colour_rgb") or (200, 200, 200) for p in self.pois],
             matched=[int(p["index"]) == self._matched for p in self.pois],
             height_m=self.poi_height_m,
         )
+
+    def _here(self, pos: Sequence[Any]) -> Sequence[Any]:
+        """A position of the mission's (east, north, …) in this vehicle's frame."""
+        if self.home_en_m is None:
+            return pos
+        east, north = self.home_en_m
+        return [float(pos[0]) - east, float(pos[1]) - north, *pos[2:]]
+
+    def _here_view(self, view: Mapping[str, Any]) -> Mapping[str, Any]:
+        if self.home_en_m is None or "pos_enu_m" not in view:
+            return view
+        return {**view, "pos_enu_m": self._here(view["pos_enu_m"])}

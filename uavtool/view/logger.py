@@ -19,7 +19,7 @@ from uavtool.camera import CameraPose, Intrinsics
 from uavtool.geo import GeoPoint
 from uavtool.view import entities as ent
 from uavtool.view.findings import Findings
-from uavtool.view.paths import Paths
+from uavtool.view.paths import FleetVehicle, Paths
 from uavtool.view.telemetry import Sample, TelemetryLog, log_series_styles, set_times
 from uavtool.world import Scene
 
@@ -50,16 +50,37 @@ def statustext_level(severity: int) -> str:
     return {3: "ERROR", 4: "WARN", 5: "INFO", 6: "INFO"}.get(severity, "DEBUG")
 
 
+def poi_height_m(scene: Scene) -> float:
+    """The height points of interest are drawn at: over the tallest building of ``scene``."""
+    tops = [blk.top_m for b in scene.buildings for blk in b.blocks]
+    return max(tops, default=8.0) + _POI_ABOVE_M
+
+
 class MissionLogger:
     """Logs one mission into ``rec`` under ``prefix``; ``batch`` telemetry samples per send
-    (small when live, so the viewer keeps up; large when converting a file)."""
+    (small when live, so the viewer keeps up; large when converting a file).
 
-    def __init__(self, rec: rr.RecordingStream, *, prefix: str = "", batch: int = 10) -> None:
+    With ``vehicle``, the mission of one vehicle of a fleet: its entities under its name
+    (``world/uav2/…``, in its own frame, placed at its home), the fleet's world and target
+    logged by a `~uavtool.view.fleet.FleetLogger`."""
+
+    def __init__(
+        self,
+        rec: rr.RecordingStream,
+        *,
+        prefix: str = "",
+        batch: int = 10,
+        vehicle: FleetVehicle | None = None,
+    ) -> None:
         self.rec = rec
-        self.paths = Paths(prefix)
+        self.paths = Paths(prefix, vehicle.name if vehicle is not None else "")
         self.batch = batch
-        self.telemetry = TelemetryLog(rec, self.paths)
-        self.findings = Findings(rec, self.paths)
+        self.vehicle = vehicle
+        colour = ent.vehicle_rgb(vehicle.sysid) if vehicle is not None else None
+        self.telemetry = TelemetryLog(rec, self.paths, route_rgb=colour)
+        self.findings = Findings(
+            rec, self.paths, home_en_m=vehicle.home_en_m if vehicle is not None else None
+        )
         self._vehicle_ns: int | None = None
         self._photo_pos: list[tuple[float, float, float]] = []
         self._photo_tags: list[str] = []
@@ -67,16 +88,20 @@ class MissionLogger:
         self._texts = 0
         self._pictures = 0
         self._detections = 0
-        ent.log_world(rec, self.paths)
-        log_series_styles(rec, self.paths)
+        if vehicle is None:
+            ent.log_world(rec, self.paths)
+            log_series_styles(rec, self.paths)
+        else:
+            rgb = ent.vehicle_rgb(vehicle.sysid)
+            ent.log_fleet_vehicle(rec, self.paths, home_en_m=vehicle.home_en_m, rgb=rgb)
+            log_series_styles(rec, self.paths, shade=vehicle.sysid - 1)
 
     # --- set-up --------------------------------------------------------------------------------
 
     def scene(self, scene: Scene) -> None:
         """The ground truth: buildings (static meshes) and the height to draw POIs at."""
         ent.log_scene(self.rec, self.paths, scene=scene)
-        tops = [blk.top_m for b in scene.buildings for blk in b.blocks]
-        self.findings.poi_height_m = max(tops, default=8.0) + _POI_ABOVE_M
+        self.findings.poi_height_m = poi_height_m(scene)
 
     def home(self, home: GeoPoint) -> None:
         """The vehicle's home: from now on positions also go on the map."""
@@ -161,6 +186,11 @@ class MissionLogger:
     def flush(self) -> None:
         """Send buffered telemetry."""
         self.telemetry.flush()
+
+    @property
+    def vehicle_ns(self) -> int | None:
+        """The vehicle time of the latest observation (None before the first)."""
+        return self._vehicle_ns
 
     @property
     def counts(self) -> LogCounts:

@@ -1,7 +1,10 @@
 """Entity paths and timeline names: the layout of a mission in Rerun.
 
 Everything one recording shows lives under one prefix ("" for the recording being viewed,
-``compare`` for a second one shown beside it), so two missions never share an entity.
+``compare`` for a second one shown beside it), so two missions never share an entity. A
+fleet's vehicle puts its entities one level down, under its name (``uav2``): ``world/uav2/…``,
+``plots/uav2/…``, ``log/uav2/…`` beside the other vehicles', around the fleet's shared world
+(the scene) and target.
 """
 
 from __future__ import annotations
@@ -18,11 +21,20 @@ COMPARE_PREFIX = "compare"
 
 @dataclass(frozen=True, slots=True)
 class Paths:
-    """Entity paths of one mission under ``prefix`` (no leading or trailing slash)."""
+    """Entity paths of one mission under ``prefix`` (no leading or trailing slash); of one
+    vehicle of a fleet with ``uav`` (its name, ``uav2``)."""
 
     prefix: str = ""
+    uav: str = ""
 
     def _at(self, path: str) -> str:
+        if self.uav:  # world/route → world/uav2/route
+            head, _, tail = path.partition("/")
+            path = f"{head}/{self.uav}/{tail}" if tail else f"{head}/{self.uav}"
+        return self._shared(path)
+
+    def _shared(self, path: str) -> str:
+        """A path of the whole recording, a fleet's vehicle or not (the target)."""
         return f"{self.prefix}/{path}" if self.prefix else path
 
     @property
@@ -108,7 +120,8 @@ class Paths:
 
     @property
     def target(self) -> str:
-        return self._at("target")
+        """The target picture: one per recording (a fleet's vehicles look for one target)."""
+        return self._shared("target")
 
     def picture(self, tag: str) -> str:
         """An image the mission made (a ``Picture`` output), by its tag."""
@@ -116,7 +129,7 @@ class Paths:
 
     @property
     def target_shapes(self) -> str:
-        return self._at("target/shapes")
+        return self._shared("target/shapes")
 
     @property
     def plots(self) -> str:
@@ -151,6 +164,20 @@ class Paths:
     @property
     def map_vehicle(self) -> str:
         return self._at("map/vehicle")
+
+
+@dataclass(frozen=True, slots=True)
+class FleetVehicle:
+    """One vehicle of a fleet's recording: its MAVLink system id and its home in the fleet's
+    frame (ENU metres around vehicle 1's home), where its own frame is placed."""
+
+    sysid: int
+    home_en_m: tuple[float, float]
+
+    @property
+    def name(self) -> str:
+        """Its part of the entity paths (``uav2``), as its topics' namespace (``/uav2``)."""
+        return f"uav{self.sysid}"
 
 
 def _safe(name: str) -> str:

@@ -17,6 +17,7 @@ from uavtool.recording import CompressedImage, JsonDocument, LogEntry, Recording
 from uavtool.recording.annotations import DETECTIONS
 from uavtool.recording.topics import FRAMES, IMAGE, TARGET, TELEMETRY, VEHICLE_EVENTS, VISION
 from uavtool.view.errors import ViewError, showing
+from uavtool.view.fleet import FleetLogger
 from uavtool.view.logger import MissionLogger
 from uavtool.world import SceneError, scene_from_dict
 
@@ -71,7 +72,9 @@ def log_recorded_flight(path: str | Path, reader: RecordingReader, logger: Missi
     logger.flush()
 
 
-def log_scene(path: str | Path, metadata: dict[str, dict[str, str]], logger: MissionLogger) -> None:
+def log_scene(
+    path: str | Path, metadata: dict[str, dict[str, str]], logger: MissionLogger | FleetLogger
+) -> None:
     """The scene in a recording's ``scene`` metadata, if any, to ``logger``."""
     try:
         data = scene_data(metadata, source=str(path))

@@ -1,8 +1,9 @@
 """Where the entities go: a ``.rrd`` file, the native viewer, or the web viewer.
 
 `open_viewer` makes one Rerun recording stream with its sink and the default blueprint,
-and a `MissionLogger` on it; `view` feeds it a recording (and a second one to compare).
-`uavtool fly --rerun` uses `open_viewer` and calls the logger as the mission runs.
+and a `MissionLogger` on it (with a fleet, a `FleetLogger` too); `view` feeds it a recording
+(and a second one to compare). `uavtool fly --rerun` uses `open_viewer` and calls the logger
+as the mission runs.
 """
 
 from __future__ import annotations
@@ -17,7 +18,8 @@ import subprocess
 import sys
 import time
 import uuid
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from urllib.parse import quote
 
@@ -26,8 +28,10 @@ import rerun as rr
 from uavtool.recording.files import atomic_output
 from uavtool.view.blueprint import default_blueprint
 from uavtool.view.errors import PortInUseError, ViewError
+from uavtool.view.fleet import FleetLogger
+from uavtool.view.fleet_source import fleet_of, log_fleet_recording
 from uavtool.view.logger import LogCounts, MissionLogger
-from uavtool.view.paths import COMPARE_PREFIX
+from uavtool.view.paths import COMPARE_PREFIX, FleetVehicle
 from uavtool.view.source import log_recording
 
 APPLICATION_ID = "uavtool"
@@ -45,7 +49,10 @@ GRPC_PORT = 9876
 
 class Viewer:
     """An open Rerun stream: ``logger`` logs into it; ``url`` is the web viewer's address
-    when serving one. ``close`` flushes and finishes the file or stops the servers."""
+    when serving one. ``close`` flushes and finishes the file or stops the servers.
+
+    For a fleet (``fleet``: its vehicles), ``fleet`` is the `FleetLogger` that logs every
+    vehicle, and ``logger`` is its first vehicle's."""
 
     def __init__(
         self,
@@ -54,10 +61,15 @@ class Viewer:
         batch: int,
         url: str | None,
         server: subprocess.Popen[bytes] | None = None,
+        fleet: Sequence[FleetVehicle] = (),
     ) -> None:
         self.rec = rec
         self.url = url
-        self.logger = MissionLogger(rec, batch=batch)
+        self.fleet = FleetLogger(rec, fleet, batch=batch) if fleet else None
+        if self.fleet is None:
+            self.logger = MissionLogger(rec, batch=batch)
+        else:
+            self.logger = self.fleet.vehicles[fleet[0].sysid]
         self._server = server
 
     def compare_logger(self) -> MissionLogger:
@@ -65,6 +77,8 @@ class Viewer:
         return MissionLogger(self.rec, prefix=COMPARE_PREFIX, batch=self.logger.batch)
 
     def flush(self) -> None:
+        if self.fleet is not None:
+            self.fleet.flush()
         self.logger.flush()
         self.rec.flush()
 
@@ -89,17 +103,19 @@ def open_viewer(
     bind: str = LOCALHOST,
     compare: bool = False,
     batch: int = 10,
+    fleet: Sequence[FleetVehicle] = (),
 ) -> Viewer:
     """A stream to ``save`` (a ``.rrd`` file), to a web viewer on ``web_port`` reading from
     ``grpc_port`` (``web``; None: `WEB_PORT`, `GRPC_PORT`), or to a newly spawned native
-    viewer (neither). ``batch``: telemetry samples per send. Raises `ViewError` if the file
-    cannot be written or the servers cannot start (`PortInUseError`: a port is taken)."""
+    viewer (neither). ``batch``: telemetry samples per send; ``fleet``: the vehicles of a
+    fleet to show (its layout, and `Viewer.fleet`). Raises `ViewError` if the file cannot be
+    written or the servers cannot start (`PortInUseError`: a port is taken)."""
     if web and save is None:
         port, grpc = _web_ports(bind, web_port, grpc_port)
     rec = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4())
     # Our log_time is the recording's receive time, not the time of this conversion.
     rec.set_log_time_enabled(False)
-    blueprint = default_blueprint(compare=compare)
+    blueprint = default_blueprint(compare=compare, fleet=[v.name for v in fleet])
     url = None
     server = None
     try:
@@ -118,7 +134,7 @@ def open_viewer(
             server.kill()
         where = save if save is not None else ("the web viewer" if web else "the native viewer")
         raise ViewError(f"{where}: cannot open: {exc}") from None
-    return Viewer(rec, batch=batch, url=url, server=server)
+    return Viewer(rec, batch=batch, url=url, server=server, fleet=fleet)
 
 
 def _serve_web(bind: str, grpc_port: int, web_port: int) -> subprocess.Popen[bytes]:
@@ -214,11 +230,13 @@ def _check_free(bind: str, port: int, option: str) -> None:
 @dataclass(frozen=True, slots=True)
 class ViewResult:
     """The viewer (still serving with ``web``) and what was logged for the recording and
-    the compared one."""
+    the compared one; for a fleet's recording, ``counts`` adds up its vehicles' and
+    ``vehicle_counts`` gives each one's, by system id."""
 
     viewer: Viewer
     counts: LogCounts
     compare_counts: LogCounts | None
+    vehicle_counts: Mapping[int, LogCounts] = field(default_factory=dict)
 
     @property
     def url(self) -> str | None:
@@ -265,6 +283,12 @@ def _view(
     grpc_port: int | None = None,
     bind: str = LOCALHOST,
 ) -> ViewResult:
+    fleet = fleet_of(path)
+    if compare is not None and (fleet or fleet_of(compare)):
+        raise ViewError(
+            f"--compare with a fleet's recording ({compare if not fleet else path}): not yet; "
+            "view each on its own"
+        )
     viewer = open_viewer(
         save=save,
         web=web,
@@ -273,9 +297,13 @@ def _view(
         bind=bind,
         compare=compare is not None,
         batch=1 << 30,
+        fleet=fleet,
     )
     try:
-        log_recording(path, viewer.logger)
+        if viewer.fleet is not None:
+            log_fleet_recording(path, viewer.fleet)
+        else:
+            log_recording(path, viewer.logger)
         other = None
         if compare is not None:
             compare_logger = viewer.compare_logger()
@@ -287,4 +315,6 @@ def _view(
         raise
     if save is not None:
         viewer.close()
+    if viewer.fleet is not None:
+        return ViewResult(viewer, viewer.fleet.counts, other, viewer.fleet.vehicle_counts)
     return ViewResult(viewer, viewer.logger.counts, other)

@@ -3,7 +3,9 @@
 The mission's own streams (``/mission/observations``, ``/mission/outputs``) drive the
 logger exactly as the live runner does; the frames come from ``/camera/image`` (the k-th
 image is frame k, written just before its ``Photo``), vehicle text from STATUSTEXT, the
-home from HOME_POSITION, and the ground truth from the ``scene`` metadata.
+home from HOME_POSITION, and the ground truth from the ``scene`` metadata. A fleet's
+recording goes through `~uavtool.view.fleet_source.log_fleet_recording` instead, each
+vehicle's topics through `log_entry` as one vehicle's.
 """
 
 from __future__ import annotations
@@ -39,40 +41,45 @@ def log_recording(path: str | Path, logger: MissionLogger) -> None:
             split_topic(t) == (k, OBSERVATIONS) for t in present for k in range(1, 65)
         ):
             raise ViewError(
-                f"{path}: a fleet's recording (its vehicles' topics under /uavN): view shows "
-                "one vehicle's flight so far; open it in Foxglove or Lichtblick, which show "
-                "every vehicle's topics"
+                f"{path}: a fleet's recording (its vehicles' topics under /uavN): one "
+                "MissionLogger shows one vehicle; log_fleet_recording shows every vehicle "
+                "through a FleetLogger, as view does"
             )
         if OBSERVATIONS not in present:
             raise ViewError(f"{path}: no {OBSERVATIONS} topic: not a mission recording")
         reader.require_metadata(("scene", "mission"))  # else the view would lack them quietly
         metadata = dict(reader.metadata)
         _setup(path, reader, metadata, logger)
-        topics = (OBSERVATIONS, OUTPUTS, IMAGE, PICTURES, DETECTIONS, EVENTS, STATUSTEXT)
-        wanted = [t for t in topics if t in present]
+        wanted = [t for t in (*MISSION_TOPICS, STATUSTEXT) if t in present]
         images: deque[bytes] = deque()
         for entry in reader.entries(wanted):
             with showing(path, entry):
-                _log_entry(entry, images, logger)
+                log_entry(entry.topic, entry, images, logger)
     logger.flush()
 
 
-def _log_entry(entry: Entry, images: deque[bytes], logger: MissionLogger) -> None:
+MISSION_TOPICS = (OBSERVATIONS, OUTPUTS, IMAGE, PICTURES, DETECTIONS, EVENTS)
+"""The topics of one vehicle's mission that `log_entry` shows (STATUSTEXT besides)."""
+
+
+def log_entry(topic: str, entry: Entry, images: deque[bytes], logger: MissionLogger) -> None:
+    """Log one message of ``topic`` (as a one-vehicle recording names it) through
+    ``logger``; ``images`` holds the camera frames not yet paired with their ``Photo``."""
     value, t_ns = entry.value, entry.log_time_ns
-    if entry.topic == IMAGE and isinstance(value, CompressedImage):
+    if topic == IMAGE and isinstance(value, CompressedImage):
         images.append(value.data)
-    elif entry.topic == PICTURES and isinstance(value, CompressedImage):
+    elif topic == PICTURES and isinstance(value, CompressedImage):
         logger.picture(value.frame_id, value.data, log_time_ns=t_ns)
-    elif isinstance(value, JsonDocument) and entry.topic == OBSERVATIONS:
+    elif isinstance(value, JsonDocument) and topic == OBSERVATIONS:
         obs = value.payload
         png = images.popleft() if obs.get("type") == "Photo" and images else None
         logger.observation(int(obs.get("step", 0)), obs, png, log_time_ns=t_ns)
-    elif isinstance(value, JsonDocument) and entry.topic == OUTPUTS:
+    elif isinstance(value, JsonDocument) and topic == OUTPUTS:
         out = value.payload
         logger.output(int(out.get("n", 0)), out, log_time_ns=t_ns)
-    elif isinstance(value, JsonDocument) and entry.topic == DETECTIONS:
+    elif isinstance(value, JsonDocument) and topic == DETECTIONS:
         logger.detections(value.payload, log_time_ns=t_ns)
-    elif isinstance(value, JsonDocument) and entry.topic == STATUSTEXT:
+    elif isinstance(value, JsonDocument) and topic == STATUSTEXT:
         msg = value.payload
         logger.statustext(int(msg.get("severity", 6)), str(msg.get("text", "")), log_time_ns=t_ns)
     elif isinstance(value, LogEntry) and value.name == "runner":

@@ -42,15 +42,26 @@ def set_times(rec: rr.RecordingStream, *, vehicle_ns: int | None, log_ns: int | 
         rec.set_time(LOG_TIME, timestamp=np.datetime64(log_ns, "ns"))
 
 
-def log_series_styles(rec: rr.RecordingStream, paths: Paths) -> None:
+def log_series_styles(rec: rr.RecordingStream, paths: Paths, *, shade: int = 0) -> None:
     """Names and colours of the telemetry plots; static. A compared mission's series are
-    paler and say so in the legend, as both are drawn on the same axes."""
+    paler and say so in the legend, as both are drawn on the same axes; so do a fleet's
+    vehicles' (``paths.uav``), each ``shade`` steps paler than the first."""
     for name, (base_rgb, base_legend) in SERIES.items():
         rgb, legend = base_rgb, base_legend
         if paths.prefix:
             rgb = (rgb[0] // 2 + 64, rgb[1] // 2 + 64, rgb[2] // 2 + 64)
             legend = f"{legend} [{paths.prefix}]"
+        if paths.uav:
+            rgb = _paler(rgb, shade)
+            legend = f"{legend} [{paths.uav}]"
         rec.log(paths.telemetry(name), rr.SeriesLines(colors=[rgb], names=[legend]), static=True)
+
+
+def _paler(rgb: tuple[int, int, int], steps: int) -> tuple[int, int, int]:
+    """``rgb`` mixed with white, a fifth more each step (four steps, then round again)."""
+    t = (steps % 4) / 5.0
+    r, g, b = (round(c + (255 - c) * t) for c in rgb)
+    return (r, g, b)
 
 
 @dataclass(frozen=True, slots=True)
@@ -76,9 +87,11 @@ class TelemetryLog:
         *,
         route_chunk: int = 64,
         route_step: int = 8,
+        route_rgb: tuple[int, int, int] | None = None,
     ) -> None:
         self.rec = rec
         self.paths = paths
+        self.route_rgb = route_rgb  # None: the route's own colour
         self.home: GeoPoint | None = None
         self.route_chunk = route_chunk
         self.route_step = route_step
@@ -128,6 +141,7 @@ class TelemetryLog:
             self.rec,
             self.paths.route_chunk(self._chunk_index),
             positions_enu_m=np.asarray(self._chunk, dtype=np.float64),
+            rgb=self.route_rgb,
         )
         self._chunk_new = 0
 
