@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from tests.viewer.shown_image import MAX_ERROR, image_area, shown_error
+from uavtool.recording.fleet import split_topic
 from uavtool.recording.reader import RecordingReader
 from uavtool.recording.topics import IMAGE, TARGET
 from uavtool.recording.values import CompressedImage
@@ -35,11 +36,15 @@ def _pictures(recording: Path) -> tuple[list[np.ndarray], np.ndarray]:
     frames: list[np.ndarray] = []
     target = None
     with RecordingReader(recording) as reader:
-        for entry in reader.entries([IMAGE, TARGET]):
+        # a fleet's frames are its vehicles' (/uavK/camera/image)
+        images = sorted(
+            {c.topic for c in reader.channels.values() if split_topic(c.topic)[1] == IMAGE}
+        )
+        for entry in reader.entries([*images, TARGET]):
             if isinstance(entry.value, CompressedImage):
                 data = np.frombuffer(entry.value.data, np.uint8)
                 rgb = cv2.imdecode(data, cv2.IMREAD_COLOR)[:, :, ::-1]
-                if entry.topic == IMAGE:
+                if entry.topic != TARGET:
                     frames.append(rgb)
                 else:
                     target = rgb

@@ -86,7 +86,8 @@ def info(rec: Path, verify: bool, recover: bool, output: Path | None, as_json: b
     type=_PATH,
     default=None,
     help="Write a Foxglove / Lichtblick layout for the recording (JSON): a 3D view of the "
-    "route, photo poses and model, the camera image, the target, attitude plots and the log.",
+    "route, photo poses and model, the camera image, the target, attitude plots and the log; "
+    "a fleet's: a tab per vehicle (its 3D view, camera and log), a map and plots of them all.",
 )
 @click.option(
     "--model", "model", type=_PATH, default=None, metavar="FILE.glb",
@@ -109,7 +110,8 @@ def export(
 
     The .tlog opens in MAVProxy, MAVExplorer and mavlogdump.py. The layout is imported in
     Foxglove or Lichtblick with Layouts → Import from file; it switches on the 3D topics
-    and aims the 3D view at the flown path.
+    and aims the 3D view at the flown path (a fleet's: each vehicle's in a tab of its own,
+    beside a map of the whole fleet).
 
     \b
     Example:
@@ -146,12 +148,6 @@ def export(
                 f"{folder}"
             )
     if layout is not None:
-        if vehicles:
-            raise InputError(
-                f"{rec}: a fleet's recording: --layout makes layouts for one vehicle only, so "
-                "far; open the file in Foxglove or Lichtblick as it is (each vehicle's topics "
-                "are under /uavN)"
-            )
         from uavtool.recording.foxglove_layout import export_layout
 
         panels = export_layout(rec, layout)["configById"]
