@@ -15,6 +15,7 @@ import pytest
 from uavtool.mission import Telemetry
 from uavtool.mission.codec import decode_observation, encode_observation
 from uavtool.recording import RecordingReader
+from uavtool.recording.fleet import split_topic
 from uavtool.recording.schemas import dumps
 from uavtool.recording.topics import OBSERVATIONS
 from uavtool.runner.record import telemetry_json
@@ -30,7 +31,10 @@ def _general(step: int, t: Telemetry) -> bytes:
 def test_every_golden_sample(path: Path) -> None:
     n = 0
     with RecordingReader(path) as reader:
-        for message in reader.messages([OBSERVATIONS]):
+        # a fleet's observations are its vehicles' (/uavK/mission/observations)
+        topics = {c.topic for c in reader.channels.values()}
+        observations = sorted(t for t in topics if split_topic(t)[1] == OBSERVATIONS)
+        for message in reader.messages(observations):
             data = json.loads(message.data)
             if data["type"] != "Telemetry":
                 continue

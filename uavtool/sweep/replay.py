@@ -87,6 +87,7 @@ def replay_recording(
 ) -> dict[str, Any]:
     """One row: the recording replayed with ``overrides`` (a Dask task; errors are rows).
     ``target_png``: the picture a recording of ``uavtool record`` is matched against."""
+    from uavtool.replay.load import is_fleet  # noqa: PLC0415
     from uavtool.replay.photos import is_recorded_flight  # noqa: PLC0415
 
     wall0 = time.perf_counter()
@@ -94,6 +95,8 @@ def replay_recording(
     try:
         if vision_only and is_recorded_flight(path):
             row |= _photos(Path(path), overrides, target_png)
+        elif is_fleet(path):
+            row |= _replay_fleet(Path(path), overrides, vision_only)
         else:
             row |= _replay(Path(path), overrides, vision_only)
     except Exception as exc:  # a recording that fails is a row
@@ -143,6 +146,48 @@ def _replay(path: Path, overrides: Mapping[str, Any], vision_only: bool) -> dict
             "decision_after_from": "mission" if result.finished else "frames",
         }
     return row | {
+        "status_after": after[0],
+        "matched_poi_after": after[1],
+        "decision_changed": after[1] != before[1],
+    }
+
+
+def _replay_fleet(path: Path, overrides: Mapping[str, Any], vision_only: bool) -> dict[str, Any]:
+    """A fleet's row: every member replayed (:func:`uavtool.replay.fleet.replay_fleet`); the
+    first vehicle that differs or diverges names the row's difference (``uavK: …``), and the
+    decision is the fleet's, its first vehicle's (the leader of ``fleet-search``)."""
+    from uavtool.mission.params import with_overrides  # noqa: PLC0415
+    from uavtool.replay.fleet import replay_fleet  # noqa: PLC0415
+    from uavtool.replay.load import load_fleet  # noqa: PLC0415
+
+    if vision_only:
+        raise InputError(f"{path}: a fleet's recording: --vision-only takes one vehicle's")
+    fleet = load_fleet(path)
+    if fleet.truncated:
+        raise InputError(f"{path}: the recording is truncated; replay needs a whole file")
+    results = replay_fleet(fleet, with_overrides(fleet.params, dict(overrides)))
+    named = [(f"uav{v.sysid}: ", r) for v, r in zip(fleet.vehicles, results, strict=True)]
+    diverged = next(((who, r.divergence) for who, r in named if r.divergence), None)
+    differs = next(((who, r.first_difference) for who, r in named if r.first_difference), None)
+    leader = results[0]
+    before = _outcome([o.data for o in fleet.vehicles[0].outputs])
+    after = _outcome([o.data for o in leader.outputs]) if leader.finished else (None, -1)
+    return {
+        "result": IDENTICAL
+        if all(r.identical for r in results)
+        else DIVERGED
+        if diverged
+        else DIFFERS,
+        "steps": sum(r.steps for r in results),
+        "outputs_recorded": sum(len(v.outputs) for v in fleet.vehicles),
+        "outputs_replayed": sum(len(r.outputs) for r in results),
+        "first_difference_step": differs[1].step if differs else None,
+        "first_difference": differs[0] + differs[1].describe() if differs else None,
+        "diverged_step": diverged[1].step if diverged else None,
+        "diverged_reason": diverged[0] + diverged[1].reason if diverged else None,
+        "decision_after_from": "mission" if leader.finished else None,
+        "status_before": before[0],
+        "matched_poi_before": before[1],
         "status_after": after[0],
         "matched_poi_after": after[1],
         "decision_changed": after[1] != before[1],
