@@ -250,3 +250,7 @@ def _name(hint: object) -> str:
     if isinstance(hint, types.UnionType):
         return str(hint)
     return getattr(hint, "__name__", str(hint))
+
+
+MAX_HOME_M = 10_000.0
+"""How far from the scene's home a fleet's home given by hand (``fly --home E,N``) may lie."""

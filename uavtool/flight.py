@@ -20,6 +20,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
+from uavtool.checks import MAX_HOME_M
 from uavtool.errors import InputError
 from uavtool.plugins import BUILTIN, DEFAULT, MissionRef
 
@@ -272,8 +273,6 @@ def _int(text: str) -> int:
 
 
 MAX_FLEET = 64
-MAX_HOME_M = 10_000.0
-"""How far from the scene's home a fleet's home given by hand may lie."""
 """The most vehicles a recording may say flew (as many as ``uavtool sitl`` serves)."""
 
 

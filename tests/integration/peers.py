@@ -190,3 +190,24 @@ def check_photo_poses(recording: Path, *, at_least: int) -> None:
         shot = photo.image_rgb.astype(np.int16)
         same, flipped = np.abs(shot - again).mean(), np.abs(shot - other).mean()
         assert same < 1.0 and (side or flipped > 5.0 * max(same, 0.2)), (photo.tag, same, flipped)
+
+
+def fly_fleet_search(connects: list[str], tmp_path: Path) -> None:
+    """``uavtool fly --mission fleet-search`` on one ``--connect`` each: it completes with the
+    right building's model, the separation kept, and its recording replays identically."""
+    args = [a for url in connects for a in ("--connect", url)]
+    result = subprocess.run(
+        uavtool("fly", "--mission", "fleet-search", *args, "--timeout", "120",
+                "--output", str(tmp_path / "f.mcap")),
+        capture_output=True, text=True, timeout=2400, check=False,
+    )  # fmt: skip
+    out = result.stdout + result.stderr
+    assert result.returncode == 0, out
+    assert "outcome        completed" in result.stdout, out
+    assert "match          building 'red' (right" in result.stdout, out
+    assert "(kept: 5 m)" in result.stdout, out
+    check = subprocess.run(
+        uavtool("replay", "--check", str(tmp_path / "f.mcap")),
+        capture_output=True, text=True, timeout=600, check=False,
+    )  # fmt: skip
+    assert check.returncode == 0, check.stdout + check.stderr

@@ -14,7 +14,13 @@ from pathlib import Path
 
 import pytest
 
-from tests.integration.peers import ARDUCOPTER, arducopter, check_photo_poses, fly, uavtool
+from tests.integration.peers import (
+    ARDUCOPTER,
+    arducopter,
+    check_photo_poses,
+    fly,
+    fly_fleet_search,
+)
 from uavtool.geo import GeoPoint, enu_from_geo, geo_from_enu
 from uavtool.recording import LocationFix, RecordingReader
 from uavtool.recording.topics import FIX
@@ -114,19 +120,4 @@ def test_three_arducopters_fly_the_fleet_search(tmp_path: Path) -> None:
                     )
                 )
             )
-        connects = [a for p in ports for a in ("--connect", f"tcp:127.0.0.1:{p}")]
-        result = subprocess.run(
-            uavtool("fly", "--mission", "fleet-search", *connects, "--timeout", "120",
-                    "--output", str(tmp_path / "f.mcap")),
-            capture_output=True, text=True, timeout=2400, check=False,
-        )  # fmt: skip
-    out = result.stdout + result.stderr
-    assert result.returncode == 0, out
-    assert "outcome        completed" in result.stdout, out
-    assert "match          building 'red' (right" in result.stdout, out
-    assert "(kept: 5 m)" in result.stdout, out
-    check = subprocess.run(
-        uavtool("replay", "--check", str(tmp_path / "f.mcap")),
-        capture_output=True, text=True, timeout=600, check=False,
-    )  # fmt: skip
-    assert check.returncode == 0, check.stdout + check.stderr
+        fly_fleet_search([f"tcp:127.0.0.1:{p}" for p in ports], tmp_path)

@@ -13,7 +13,15 @@ from pathlib import Path
 
 import pytest
 
-from tests.integration.peers import PX4, PX4_GIMBAL, check_photo_poses, fly, px4, uavtool
+from tests.integration.peers import (
+    PX4,
+    PX4_GIMBAL,
+    check_photo_poses,
+    fly,
+    fly_fleet_search,
+    px4,
+    uavtool,
+)
 from uavtool.geo import GeoPoint, geo_from_enu
 from uavtool.recording import LogEntry, RecordingReader
 from uavtool.recording.topics import TELEMETRY, VEHICLE_EVENTS
@@ -136,19 +144,4 @@ def test_three_px4s_fly_the_fleet_search(tmp_path: Path) -> None:
             home = geo_from_enu(start, 10.0 * i, 0.0, 0.0)
             ports.append(stack.enter_context(px4(folder, params=PX4_GIMBAL, instance=i, home=home)))
         assert ports == [14540, 14541, 14542]
-        connects = [a for p in ports for a in ("--connect", f"udpin:0.0.0.0:{p}")]
-        result = subprocess.run(
-            uavtool("fly", "--mission", "fleet-search", *connects, "--timeout", "120",
-                    "--output", str(tmp_path / "f.mcap")),
-            capture_output=True, text=True, timeout=2400, check=False,
-        )  # fmt: skip
-    out = result.stdout + result.stderr
-    assert result.returncode == 0, out
-    assert "outcome        completed" in result.stdout, out
-    assert "match          building 'red' (right" in result.stdout, out
-    assert "(kept: 5 m)" in result.stdout, out
-    check = subprocess.run(
-        uavtool("replay", "--check", str(tmp_path / "f.mcap")),
-        capture_output=True, text=True, timeout=600, check=False,
-    )  # fmt: skip
-    assert check.returncode == 0, check.stdout + check.stderr
+        fly_fleet_search([f"udpin:0.0.0.0:{p}" for p in ports], tmp_path)

@@ -4,7 +4,6 @@ it."""
 from __future__ import annotations
 
 import dataclasses
-import math
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -12,7 +11,7 @@ from typing import TYPE_CHECKING, NoReturn
 
 import click
 
-from uavtool.checks import NON_NEGATIVE, POSITIVE, Range, coerce
+from uavtool.checks import MAX_HOME_M, NON_NEGATIVE, POSITIVE, Range, coerce
 from uavtool.cli.options import PORT, SEED, Number, Numbers, check_web_ports
 from uavtool.cli.spelling import Command, OldSpelling
 from uavtool.errors import InputError
@@ -35,6 +34,11 @@ EXIT_CODES: dict[str, int] = {
 
 _SECONDS = Range(0.0, 86_400.0, lo_open=True)
 _WIND = Numbers(",", (("SPEED", Range(0.0, 50.0)), ("DIR", Range(-360.0, 360.0))), example="5,270")
+_HOME_M = Numbers(
+    ",",
+    (("E", Range(-MAX_HOME_M, MAX_HOME_M)), ("N", Range(-MAX_HOME_M, MAX_HOME_M))),
+    example="0,20",
+)
 _OUTAGE = Numbers(":", (("START", NON_NEGATIVE), ("DURATION", POSITIVE)), example="60:10")
 # --writer: FlyConfig.record_in_process for each choice
 _WRITERS: dict[str, bool | None] = {"auto": None, "process": False, "thread": True}
@@ -201,6 +205,7 @@ _WRITERS: dict[str, bool | None] = {"auto": None, "process": False, "thread": Tr
 @click.option(
     "--home",
     "homes",
+    type=_HOME_M,
     multiple=True,
     metavar="E,N",
     help="With --vehicles: a vehicle's home, metres east and north of the scene's home; give it "
@@ -232,7 +237,7 @@ def fly(
     scene_origin: str,
     vehicles: int,
     offset_line: str,
-    homes: tuple[str, ...],
+    homes: tuple[tuple[float, float], ...],
     quiet: bool,
 ) -> None:
     """Fly a mission and record everything to one MCAP file: by default the search mission,
@@ -317,7 +322,7 @@ def fly(
     if homes and _given("offset_line"):
         raise InputError("--home and --offset-line both place the vehicles: give one of them")
     if vehicles > 1:
-        _fly_fleet(config, vehicles, offset_line, tuple(map(_parse_home_m, homes)), echo)
+        _fly_fleet(config, vehicles, offset_line, homes, echo)
     summary = fly_mission(
         config,
         progress=lambda text, t: echo(format_progress(text, t)),
@@ -335,29 +340,6 @@ def _given(name: str) -> bool:
     """Whether the option ``name`` was given on the command line (not its default)."""
     source = click.get_current_context().get_parameter_source(name)
     return source is not None and source is not click.core.ParameterSource.DEFAULT
-
-
-def _parse_home_m(text: str) -> tuple[float, float]:
-    """``E,N`` → (east, north) metres; InputError naming the bad value."""
-    parts = text.split(",")
-    try:
-        if len(parts) != 2:
-            raise ValueError
-        east, north = (float(p) for p in parts)
-    except ValueError:
-        raise InputError(
-            f"--home {text!r}: expected E,N, metres east and north of the scene's home, e.g. 0,20"
-        ) from None
-    from uavtool.flight import MAX_HOME_M
-
-    if (
-        not (math.isfinite(east) and math.isfinite(north))
-        or max(abs(east), abs(north)) > MAX_HOME_M
-    ):
-        raise InputError(
-            f"--home {text!r}: expected numbers within {MAX_HOME_M / 1000:g} km of the scene's home"
-        )
-    return east, north
 
 
 def _fly_fleet(

@@ -71,12 +71,7 @@ def update_golden(recording: Path) -> tuple[int, int]:
         return _update_fleet(recording)
     flight = load_flight(recording)
     if is_lockstep(recording):
-        tmp = recording.with_suffix(".mcap.tmp")
-        try:
-            refly(recording, out=tmp, compare=False)
-            tmp.replace(recording)
-        finally:
-            tmp.unlink(missing_ok=True)
+        _fly_again(recording)
         outputs = load_flight(recording).outputs
         digest_path(recording).write_text(digest(outputs))
         return len(flight.outputs), len(outputs)
@@ -107,11 +102,16 @@ def _update_fleet(recording: Path) -> tuple[int, int]:
             "(uavtool fly --vehicles N), which is flown again"
         )
     before = sum(len(v.outputs) for v in load_fleet(recording).vehicles)
+    _fly_again(recording)
+    digest_path(recording).write_text(recorded_digest(recording))
+    return before, sum(len(v.outputs) for v in load_fleet(recording).vehicles)
+
+
+def _fly_again(recording: Path) -> None:
+    """Replace a lockstep ``recording`` whole by a flight of its own configuration again."""
     tmp = recording.with_suffix(".mcap.tmp")
     try:
         refly(recording, out=tmp, compare=False)
         tmp.replace(recording)
     finally:
         tmp.unlink(missing_ok=True)
-    digest_path(recording).write_text(recorded_digest(recording))
-    return before, sum(len(v.outputs) for v in load_fleet(recording).vehicles)
