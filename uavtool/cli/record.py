@@ -90,7 +90,20 @@ before the end that was asked for."""
     help="Stop after this many seconds.",
 )
 @click.option(
-    "--until-landed", is_flag=True, help="Stop once the vehicle has flown, landed and disarmed."
+    "--until-landed",
+    is_flag=True,
+    help="Stop once the vehicle has flown, landed and disarmed (a fleet: every vehicle that "
+    "flew, and none of the others is armed).",
+)
+@click.option(
+    "--vehicles",
+    type=int,
+    default=1,
+    show_default=True,
+    metavar="N",
+    help="Record a fleet on the one link: wait for N vehicles (their heartbeats and positions), "
+    "then record each under /uavK (K: its system id), in its own frame around its own home. "
+    "--camera none or sim (each vehicle's own view).",
 )
 @click.option(
     "--timeout",
@@ -99,7 +112,8 @@ before the end that was asked for."""
     default=30.0,
     show_default=True,
     metavar="SECONDS",
-    help="Give up (exit 2) when no vehicle is heard in this many seconds.",
+    help="Give up (exit 2) when no vehicle (or fewer than --vehicles) is heard in this many "
+    "seconds.",
 )
 def record(
     connect: str,
@@ -113,6 +127,7 @@ def record(
     gimbal_pitch_deg: float,
     duration_s: float | None,
     until_landed: bool,
+    vehicles: int,
     timeout_s: float,
 ) -> None:
     """Record a vehicle someone else flies — a pilot, QGroundControl, MAVProxy, an AUTO
@@ -124,11 +139,15 @@ def record(
     or every --photo-every seconds. Stops on Ctrl-C, --duration or --until-landed; the
     file is always closed whole.
 
+    A fleet on one link (a radio, a router, several vehicles sending to one port):
+    --vehicles N records each of N vehicles under /uavK, the MAVLink frames once.
+
     \b
     Examples:
       mavproxy.py --master tcp:127.0.0.1:5760 --out udp:127.0.0.1:14551
       uavtool record --connect udpin:127.0.0.1:14551 -o flight.mcap --camera opencv:0
       uavtool record --connect tcp:127.0.0.1:5760 -o sim.mcap --camera sim --until-landed
+      uavtool record --connect udpin:127.0.0.1:14550 -o fleet.mcap --vehicles 3 --until-landed
       uavtool replay --vision-only sim.mcap --target target.png -o analysed.mcap
     """
     from uavtool.recorder import RecordConfig
@@ -147,6 +166,7 @@ def record(
         duration_s=duration_s,
         until_landed=until_landed,
         timeout_s=timeout_s,
+        vehicles=vehicles,
     )
     stop = threading.Event()
 
@@ -161,11 +181,17 @@ def record(
     finally:
         for s, handler in previous.items():
             signal.signal(s, handler)
+    fleet = f"{len(summary.vehicles)} vehicles, " if len(summary.vehicles) > 1 else ""
+    each = "".join(
+        f"; vehicle {v.sysid}: {counted(v.telemetry, 'telemetry sample')}, "
+        f"{counted(v.frames, 'frame')}, {counted(v.photos, 'photo')}, {counted(v.events, 'event')}"
+        for v in (summary.vehicles if fleet else ())
+    )
     click.echo(
-        f"wrote {summary.path}: {summary.duration_s:.1f} s ({summary.stop.value}), "
+        f"wrote {summary.path}: {summary.duration_s:.1f} s ({summary.stop.value}), {fleet}"
         f"{summary.messages_in} MAVLink frames in, {summary.messages_out} out, "
         f"{counted(summary.telemetry, 'telemetry sample')}, {counted(summary.frames, 'frame')}, "
-        f"{counted(summary.photos, 'photo')}, {counted(summary.events, 'event')}"
+        f"{counted(summary.photos, 'photo')}, {counted(summary.events, 'event')}{each}"
     )
     if summary.gaps:
         # the file is whole and kept; what it holds is less than was asked for

@@ -18,7 +18,7 @@ from uavtool.geo import GeoPoint, wrap_180
 from uavtool.link.freshness import FreshnessFilter
 from uavtool.link.transport import Transport
 from uavtool.mavlink.dialect import mavlink as M
-from uavtool.mavlink.framing import FrameParser, new_encoder
+from uavtool.mavlink.framing import Frame, FrameParser, new_encoder
 from uavtool.mavlink.packing import pack
 
 GCS_SYSID = 255
@@ -109,10 +109,16 @@ class VehicleLink:
         data = self.transport.recv(timeout_s)
         if not data:
             return []
-        out = []
         frames = self._parser.feed(data)
         if self.tap is not None and frames:
             self.tap("in", [frame.raw for frame in frames], [frame.msg for frame in frames])
+        return self.take(frames)
+
+    def take(self, frames: list[Frame]) -> list[Any]:
+        """The messages of ``frames`` (read and tapped by ``poll``, or by a reader that shares
+        one link among several vehicles) that are from the vehicle and fresh; the state is
+        updated with them."""
+        out = []
         for frame in frames:
             msg = frame.msg
             if self._accept(msg) and self.freshness.fresh(msg):
@@ -123,9 +129,7 @@ class VehicleLink:
     def _accept(self, msg: Any) -> bool:
         sysid = msg.get_srcSystem()
         if self.target_system == 0:
-            if msg.get_type() != "HEARTBEAT" or msg.type in _NOT_VEHICLES:
-                return False
-            if msg.autopilot == M.MAV_AUTOPILOT_INVALID:
+            if not is_vehicle_heartbeat(msg):
                 return False
             self.target_system = sysid
             self.target_component = msg.get_srcComponent()
@@ -220,6 +224,16 @@ class VehicleLink:
             if on_wait is not None:
                 on_wait()
             self.poll(0.05)
+
+
+def is_vehicle_heartbeat(msg: Any) -> bool:
+    """Whether ``msg`` is a vehicle's HEARTBEAT: not a ground station's, a gimbal's or a
+    companion computer's, and from an autopilot (what a link locks onto)."""
+    return bool(
+        msg.get_type() == "HEARTBEAT"
+        and msg.type not in _NOT_VEHICLES
+        and msg.autopilot != M.MAV_AUTOPILOT_INVALID
+    )
 
 
 def gimbal_camera_pose(

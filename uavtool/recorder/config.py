@@ -14,9 +14,11 @@ class Stop(Enum):
     """Ctrl-C (SIGINT) or SIGTERM."""
     DURATION = "duration"
     LANDED = "landed"
-    """The vehicle flew, then landed and disarmed (``until_landed``)."""
+    """The vehicle flew, then landed and disarmed (``until_landed``); of a fleet, every
+    vehicle that flew has (or fell silent), and no other is armed."""
     VEHICLE_LOST = "vehicle lost"
-    """Waiting for a landing (``until_landed``), nothing was heard for ``LOST_S``."""
+    """Waiting for a landing (``until_landed``), nothing was heard for ``LOST_S`` (of a
+    fleet: from every vehicle, or from every one that flew while the others stayed idle)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -48,6 +50,21 @@ class RecordConfig:
     home_wait_s: float = 3.0
     """After the first position, how long to wait for HOME_POSITION before taking the first
     fix as the origin of the local frame."""
+    vehicles: int = 1
+    """How many vehicles the link carries: the recording starts when this many are heard,
+    each with its position; with more than one, vehicle K's topics go under ``/uavK``."""
+
+
+@dataclass(frozen=True, slots=True)
+class VehicleSummary:
+    """What was recorded of one vehicle of a fleet."""
+
+    sysid: int
+    telemetry: int
+    frames: int
+    photos: int
+    events: int
+    gaps: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True, slots=True)
@@ -55,7 +72,7 @@ class RecordSummary:
     path: Path
     stop: Stop
     vehicle: str
-    """``sysid N on LINK``."""
+    """``sysid N on LINK`` (``sysids 1, 2, 3 on LINK`` for a fleet)."""
     duration_s: float
     messages_in: int
     messages_out: int
@@ -68,3 +85,5 @@ class RecordSummary:
     gaps: tuple[str, ...] = ()
     """What the file lacks of what was asked for, one line each: a link silent for the end
     of the recording, a camera that stalled or failed. Empty: whole as asked."""
+    vehicles: tuple[VehicleSummary, ...] = ()
+    """Each vehicle's counts, in system-id order (one for a one-vehicle recording)."""

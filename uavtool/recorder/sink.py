@@ -11,11 +11,8 @@ from uavtool.mission import Telemetry
 from uavtool.mission.codec import encode, encode_observation
 from uavtool.recorder.frames import Frame
 from uavtool.recorder.watch import Event
-from uavtool.recording import (
-    Direction,
-    LogEntry,
-    RecordingWriter,
-)
+from uavtool.recording import Direction, LogEntry
+from uavtool.recording.protocol import MessageWriter
 from uavtool.recording.topics import (
     FRAMES,
     TELEMETRY,
@@ -56,18 +53,14 @@ FRAME_SCHEMA = {
 }
 
 
-class PassiveRecorder:
-    """Writes a flight it does not command into ``writer``, stamped by ``clock_ns``;
-    ``origin`` is the local frame's origin (the vehicle's home) for WGS-84 fixes."""
+class LinkRecorder:
+    """Writes every MAVLink frame crossing a link into ``writer``'s shared ``/mavlink``
+    channels, stamped by ``clock_ns``, and counts them (``counts["in"]``, ``["out"]``)."""
 
-    def __init__(self, writer: RecordingWriter, *, clock_ns: ClockNs, origin: GeoPoint) -> None:
+    def __init__(self, writer: MessageWriter, *, clock_ns: ClockNs) -> None:
         self.writer = writer
         self.clock_ns = clock_ns
-        self.origin = origin
-        self.counts = {"in": 0, "out": 0, "telemetry": 0, "frames": 0, "photos": 0, "events": 0}
-        self.max_pose_dt_ms = 0
-        writer.add_json_topic(TELEMETRY, schema_name="uavtool.Telemetry", schema=TELEMETRY_SCHEMA)
-        writer.add_json_topic(FRAMES, schema_name="uavtool.Frame", schema=FRAME_SCHEMA)
+        self.counts = {"in": 0, "out": 0}
 
     def mavlink(self, direction: str, frame: bytes, decoded: Any = None) -> None:
         """The link's tap: every whole frame, as it crossed the link (and the message the
@@ -79,6 +72,21 @@ class PassiveRecorder:
             log_time_ns=self.clock_ns(),
             decoded=decoded,
         )
+
+
+class PassiveRecorder(LinkRecorder):
+    """Writes a flight it does not command into ``writer``, stamped by ``clock_ns``;
+    ``origin`` is the local frame's origin (the vehicle's home) for WGS-84 fixes. One vehicle
+    of a fleet writes through a `~uavtool.recording.fleet.VehicleWriter`: its topics under
+    ``/uavK``, its MAVLink frames (when it taps them) on the shared channels."""
+
+    def __init__(self, writer: MessageWriter, *, clock_ns: ClockNs, origin: GeoPoint) -> None:
+        super().__init__(writer, clock_ns=clock_ns)
+        self.origin = origin
+        self.counts = {"in": 0, "out": 0, "telemetry": 0, "frames": 0, "photos": 0, "events": 0}
+        self.max_pose_dt_ms = 0
+        writer.add_json_topic(TELEMETRY, schema_name="uavtool.Telemetry", schema=TELEMETRY_SCHEMA)
+        writer.add_json_topic(FRAMES, schema_name="uavtool.Frame", schema=FRAME_SCHEMA)
 
     def telemetry(self, t: Telemetry) -> None:
         now = self.clock_ns()

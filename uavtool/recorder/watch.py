@@ -58,10 +58,15 @@ def frame_ids(raw: bytes) -> tuple[int, int]:
 
 class VehicleWatch:
     """Fed every message of the vehicle (``vehicle``) and every frame of another system
-    (``foreign``); collects events and photo triggers. ``now_s`` is the link's clock."""
+    (``foreign``); collects events and photo triggers. ``now_s`` is the link's clock.
+    ``addressed``: a camera command counts only when addressed to this vehicle (or to all),
+    as on a link that carries a fleet."""
 
-    def __init__(self, target_system: int, target_component: int) -> None:
+    def __init__(
+        self, target_system: int, target_component: int, *, addressed: bool = False
+    ) -> None:
         self.target = (target_system, target_component)
+        self.addressed = addressed
         self.events: list[Event] = []
         self.triggers: list[str] = []
         self.other_gcs: dict[int, float] = {}  # sysid -> when last heard
@@ -111,6 +116,8 @@ class VehicleWatch:
                     self.events.append(Event(LogLevel.INFO, text, "recorder"))
                 self.other_gcs[sysid] = now_s
             elif kind in ("COMMAND_LONG", "COMMAND_INT") and msg.command in _CAMERA_COMMANDS:
+                if self.addressed and msg.target_system not in (0, self.target[0]):
+                    continue  # another vehicle's camera
                 shot = msg.command == M.MAV_CMD_IMAGE_START_CAPTURE or _param5(msg) == 1
                 if shot:
                     name = "IMAGE_START_CAPTURE"

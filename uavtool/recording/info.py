@@ -4,6 +4,7 @@ ended: a mission's outcome (`uavtool fly`) or what stopped a `uavtool record`.""
 from __future__ import annotations
 
 import dataclasses
+import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -149,12 +150,22 @@ def _mission(record: dict[str, str] | None) -> str:
 def _vehicles(
     metadata: list[tuple[str, dict[str, str]]],
 ) -> tuple[tuple[int, dict[str, str]], ...]:
-    """Each vehicle of a fleet with its outcome record (``outcome.uavK``)."""
+    """Each vehicle of a fleet with its outcome record (``outcome.uavK``); of a fleet that
+    `uavtool record` recorded, with what was recorded of it (``record_result.uavK``, or
+    nothing when the recorder was killed first: the vehicles are those ``record`` names)."""
     found: dict[int, dict[str, str]] = {}
     for name, record in metadata:
         head, _, tail = name.partition(".uav")
-        if head == OUTCOME_METADATA and tail.isdigit() and len(tail) <= 3:
+        if head in (OUTCOME_METADATA, RECORD_RESULT_METADATA) and tail.isdigit() and len(tail) <= 3:
             found[int(tail)] = dict(record)
+    named = _last(metadata, RECORD_METADATA) or {}
+    try:
+        sysids = json.loads(named.get("vehicle_sysids", "[]")[:10_000])
+    except ValueError:
+        sysids = []
+    for k in sysids if isinstance(sysids, list) else []:
+        if type(k) is int and 0 < k < 1000:
+            found.setdefault(k, {})
     return tuple(sorted(found.items()))
 
 
@@ -226,6 +237,9 @@ def format_info(info: RecordingInfo) -> str:
         lines.append(f"mission:   {info.mission}")
     lines.append(_ending(info))
     for sysid, record in info.vehicles:
+        if info.from_record and "status" not in record:
+            lines.append(f"vehicle {sysid}: {_recorded(record)} (topics /uav{sysid}/…)")
+            continue
         said = f"{record.get('status', '?')}: {record.get('reason', '?')}"
         frames = record.get("frames")
         lines.append(
@@ -241,6 +255,17 @@ def format_info(info: RecordingInfo) -> str:
         lines.append(f"  {t.topic:<{width}}  {t.count:>8} msgs  {t.rate_hz:9.2f} Hz  {kind}")
     # Names and values come from the file: no escape sequence of theirs reaches the terminal.
     return "\n".join(safe_text(line) for line in lines)
+
+
+def _recorded(record: dict[str, str]) -> str:
+    """What `uavtool record` recorded of one vehicle of a fleet (``record_result.uavK``)."""
+    if not record:
+        return "recorded; no result (the recorder was killed before it could write one)"
+    counts = ("telemetry", "telemetry samples"), ("frames", "frames"), ("photos", "photos")
+    text = ", ".join(f"{record.get(key, '?')} {noun}" for key, noun in counts)
+    text += f", {record.get('events', '?')} events"
+    gaps = record.get("gaps")
+    return f"{text}; incomplete: {gaps}" if gaps else text
 
 
 def _ending(info: RecordingInfo) -> str:
