@@ -123,7 +123,7 @@ class FlightDescription:
             # among them) stay as they were.
             **({"no_gimbal": "true"} if self.no_gimbal else {}),
         }
-        if self.vehicles > 1 or self.offset_line != (90.0, 10.0):  # one vehicle's as it was
+        if self.vehicles > 1 or self.offset_line != (90.0, 10.0) or self.homes_m:  # one: as it was
             records["fleet"] = {
                 "vehicles": str(self.vehicles),
                 "offset_line": json.dumps(list(self.offset_line)),

@@ -28,3 +28,8 @@ def raises(frame: Frame) -> list[Detection]:
     if frame.frame_index == 3:
         raise ValueError("model weights missing")
     return []
+
+
+def vehicles(frame: Frame) -> list[Detection]:
+    """One detection naming the vehicle that took the frame (a fleet's: its system id)."""
+    return [Detection(f"vehicle {frame.vehicle}", 1.0, (0.0, 0.0, 1.0, 1.0))]

@@ -66,6 +66,30 @@ def test_detections_are_written_beside_the_original(tmp_path: Path) -> None:
     assert shown.exit_code == 0 and "7 detections" in shown.output, shown.output
 
 
+def test_a_fleets_detections_go_under_each_vehicle(tmp_path: Path) -> None:
+    """In a fleet's recording each frame is its vehicle's (``Frame.vehicle``, its frame index
+    and pose), and its detections go under that vehicle's topics, stamped like its frame."""
+    fleet = GOLDEN.with_name("fleet-search.mcap")
+    out = tmp_path / "detected.mcap"
+    code, text = _run("replay", str(fleet), "--vision", "tests.plugins.detector:vehicles",
+                      "--output", str(out))  # fmt: skip
+    assert code == 0, text
+    written = _messages(out)
+    with RecordingReader(out) as reader:
+        topics = set(reader.topics())
+        assert "/vision/detections" not in topics
+        for k in (1, 2, 3):
+            images = [e.log_time_ns for e in reader.entries([f"/uav{k}/camera/image"])]
+            found = list(reader.entries([f"/uav{k}/vision/detections"]))
+            marks = [t for topic, t, _ in written if topic == f"/uav{k}/vision/annotations"]
+            assert [e.log_time_ns for e in found] == images == marks
+            labels = {d["label"] for e in found for d in e.value.payload["detections"]}
+            assert labels == {f"vehicle {k}"}
+            indices = [e.value.payload["frame_index"] for e in found]
+            assert indices == list(range(len(images)))  # each vehicle's own numbering
+    assert f"on {summarize(fleet).frame_count} photos" in text, text
+
+
 @pytest.mark.parametrize(
     ("function", "code", "words"),
     [
@@ -103,7 +127,7 @@ def test_a_folder_on_dask_with_a_function_from_the_current_folder(
     )  # fmt: skip
     assert code == 0, text
     n = len(list(golden.glob("*.mcap")))
-    photos = sum(int((summarize(p).outcome or {})["frames"]) for p in golden.glob("*.mcap"))
+    photos = sum(summarize(p).frame_count for p in golden.glob("*.mcap"))  # a fleet's: all
     assert f"recordings     {n} of {n}" in text and f"on {photos} photos" in text, text
     written = sorted(p.name for p in out.glob("*.vision.mcap"))
     assert written == sorted(f"{p.stem}.vision.mcap" for p in golden.glob("*.mcap"))

@@ -43,6 +43,7 @@ OTHER: dict[str, Any] = {
     "no_gimbal": True,
     "vehicles": 3,
     "offset_line": (45.0, 12.5),
+    "homes_m": ((0.0, 0.0), (25.5, -12.0), (-40.0, 30.25)),
     "tool_version": "9.9.9",
 }
 """A value other than the default for every field."""

@@ -123,9 +123,12 @@ def test_a_stop_signal_stops_cleanly_with_its_exit_code(sig: signal.Signals, cod
         stderr=subprocess.PIPE,
         text=True,
     )
-    assert proc.stdout is not None
-    while "Ctrl-C to stop" not in proc.stdout.readline():
-        pass
+    assert proc.stdout is not None and proc.stderr is not None
+    for line in proc.stdout:  # until it serves (not for ever if it ended first)
+        if "Ctrl-C to stop" in line:
+            break
+    else:
+        pytest.fail(f"uavtool sitl ended before serving ({proc.wait()}): {proc.stderr.read()}")
     proc.send_signal(sig)
     out, err = proc.communicate(timeout=30)
     assert proc.returncode == code, err

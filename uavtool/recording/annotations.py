@@ -52,10 +52,14 @@ def copy_with_detections(
     dst: Path,
     found: Sequence[tuple[int, Mapping[str, Any]]],
     record: dict[str, str],
+    *,
+    prefixes: Sequence[str] = (),
 ) -> None:
     """Write ``dst``: every message of ``src`` as it is, and for each (log time, detections)
     in ``found`` (log-time order) an annotation and a JSON message at that time; ``record``
-    becomes the ``vision`` metadata record. ``dst`` appears only once whole."""
+    becomes the ``vision`` metadata record. ``dst`` appears only once whole. A fleet's
+    detections go under each vehicle's topics: ``prefixes`` (``/uav2`` …), one per entry of
+    ``found``."""
     with RecordingReader(src) as reader, atomic_output(dst, inputs=[src]) as tmp:
         try:
             with create_file(tmp) as out:
@@ -64,20 +68,29 @@ def copy_with_detections(
                 pb_schema = writer.register_schema(
                     ImageAnnotations.DESCRIPTOR.full_name, "protobuf", bytes(fds)
                 )
-                annotations = writer.register_channel(ANNOTATIONS, "protobuf", pb_schema)
+                where = list(prefixes) or [""] * len(found)
+                if len(where) != len(found):
+                    raise ValueError("one prefix per entry of found")
+                named = sorted(set(where)) or [""]
+                annotations = {
+                    p: writer.register_channel(p + ANNOTATIONS, "protobuf", pb_schema)
+                    for p in named
+                }
                 json_schema = writer.register_schema(
                     "uavtool.Detections", "jsonschema", json.dumps(DETECTIONS_SCHEMA).encode()
                 )
-                detections = writer.register_channel(DETECTIONS, "json", json_schema)
-                pending = list(found)
+                detections = {
+                    p: writer.register_channel(p + DETECTIONS, "json", json_schema) for p in named
+                }
+                pending = [(t, payload, p) for (t, payload), p in zip(found, where, strict=True)]
 
                 def flush(before_ns: int | None) -> None:
                     while pending and (before_ns is None or pending[0][0] < before_ns):
-                        t, payload = pending.pop(0)
+                        t, payload, p = pending.pop(0)
                         data = _annotations(payload, t)
-                        writer.add_message(annotations, log_time=t, data=data, publish_time=t)
+                        writer.add_message(annotations[p], log_time=t, data=data, publish_time=t)
                         text = json.dumps(payload).encode()
-                        writer.add_message(detections, log_time=t, data=text, publish_time=t)
+                        writer.add_message(detections[p], log_time=t, data=text, publish_time=t)
 
                 for message in reader.messages():
                     flush(message.log_time_ns)

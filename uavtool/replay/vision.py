@@ -31,6 +31,7 @@ from uavtool.recording.annotations import (
     DETECTIONS_SCHEMA,
     copy_with_detections,
 )
+from uavtool.recording.fleet import split_topic, vehicle_prefix
 from uavtool.recording.topics import FRAMES, IMAGE, OBSERVATIONS
 from uavtool.vision.detection import Detection, Frame
 
@@ -74,45 +75,67 @@ def load_function(spec: str) -> VisionFunction:
 
 
 def frames(path: Path) -> Iterator[tuple[Frame, int]]:
-    """Every photo of a recording (``uavtool fly`` or ``uavtool record``) with its log time."""
+    """Every photo of a recording (``uavtool fly`` or ``uavtool record``) with its log time:
+    in a fleet's, each vehicle's (``Frame.vehicle``), in log-time order."""
     with RecordingReader(path) as reader:
         topics = set(reader.topics())
-        source = OBSERVATIONS if OBSERVATIONS in topics else FRAMES if FRAMES in topics else None
-        if source is None or IMAGE not in topics:
-            raise InputError(
-                f"{path}: no photos ({IMAGE} with {OBSERVATIONS} or {FRAMES}): record a flight "
-                "with `uavtool fly` or `uavtool record`"
-            )
-        images: list[bytes] = []
-        for entry in reader.entries([IMAGE, source]):
-            value = entry.value
-            if entry.topic == IMAGE and isinstance(value, CompressedImage):
-                images.append(value.data)
-            elif isinstance(value, JsonDocument) and value.payload.get("type") == "Photo":
-                data = dict(value.payload)
-                index = data.get("frame_index")
-                if type(index) is not int or not 0 <= index < len(images):
-                    raise InputError(f"{path}: photo frame {index!r:.20} has no image before it")
-                image = png_decode(images[index], where=f"{path}: frame {index}")
-                photo = decode_observation(data, image)
-                assert isinstance(photo, Photo)
-                frame = Frame(
-                    photo.frame_index,
-                    photo.tag,
-                    photo.time_boot_ms,
-                    photo.pose,
-                    photo.intrinsics,
-                    image,
+        vehicles = sorted({k for k, rest in map(split_topic, topics) if k and rest == IMAGE})
+        if not vehicles:
+            yield from _photos(reader, path, topics, 0)
+            return
+        each = [list(_photos(reader, path, topics, k)) for k in vehicles]
+    yield from sorted(
+        (photo for photos in each for photo in photos), key=lambda p: (p[1], p[0].vehicle)
+    )
+
+
+def _photos(
+    reader: RecordingReader, path: Path, topics: set[str], vehicle: int
+) -> Iterator[tuple[Frame, int]]:
+    """The photos of one vehicle (``vehicle`` 0: the only one, topics without a prefix)."""
+    prefix = vehicle_prefix(vehicle) if vehicle else ""
+    image_topic = prefix + IMAGE
+    source = next((prefix + t for t in (OBSERVATIONS, FRAMES) if prefix + t in topics), None)
+    if source is None or image_topic not in topics:
+        raise InputError(
+            f"{path}: no photos ({image_topic} with {prefix + OBSERVATIONS} or "
+            f"{prefix + FRAMES}): record a flight with `uavtool fly` or `uavtool record`"
+        )
+    images: list[bytes] = []
+    for entry in reader.entries([image_topic, source]):
+        value = entry.value
+        if entry.topic == image_topic and isinstance(value, CompressedImage):
+            images.append(value.data)
+        elif isinstance(value, JsonDocument) and value.payload.get("type") == "Photo":
+            data = dict(value.payload)
+            index = data.get("frame_index")
+            if type(index) is not int or not 0 <= index < len(images):
+                raise InputError(
+                    f"{path}: {prefix}photo frame {index!r:.20} has no image before it"
                 )
-                yield frame, entry.log_time_ns
+            image = png_decode(images[index], where=f"{path}: {prefix}frame {index}")
+            photo = decode_observation(data, image)
+            assert isinstance(photo, Photo)
+            frame = Frame(
+                photo.frame_index,
+                photo.tag,
+                photo.time_boot_ms,
+                photo.pose,
+                photo.intrinsics,
+                image,
+                vehicle,
+            )
+            yield frame, entry.log_time_ns
 
 
 def run_vision(path: Path, out: Path, spec: str, function: VisionFunction) -> VisionRun:
     """Call ``function`` on every photo of ``path`` and write ``out``: ``path``'s messages and
     the detections. ``out`` appears only when whole; nothing is written if the function fails."""
     found: list[tuple[int, dict[str, Any]]] = []
+    prefixes: list[str] = []
     count = 0
     for frame, t_ns in frames(path):
+        prefixes.append(vehicle_prefix(frame.vehicle) if frame.vehicle else "")
         detections = _call(function, frame, spec)
         count += len(detections)
         found.append(
@@ -128,7 +151,8 @@ def run_vision(path: Path, out: Path, spec: str, function: VisionFunction) -> Vi
                 },
             )
         )
-    copy_with_detections(path, out, found, {"function": spec, "source": path.name})
+    record = {"function": spec, "source": path.name}
+    copy_with_detections(path, out, found, record, prefixes=prefixes if any(prefixes) else ())
     return VisionRun(len(found), count, out)
 
 

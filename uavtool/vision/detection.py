@@ -14,7 +14,8 @@ from uavtool.camera import CameraPose, Intrinsics
 @dataclass(frozen=True, slots=True)
 class Frame:
     """One recorded photo. ``image_rgb`` : (H, W, 3) uint8; ``pose`` in ENU metres around
-    the vehicle's home; ``frame_index`` numbers the recording's photos from 0."""
+    the vehicle's home; ``frame_index`` numbers the recording's (in a fleet's, the vehicle's)
+    photos from 0."""
 
     frame_index: int
     tag: str
@@ -22,6 +23,9 @@ class Frame:
     pose: CameraPose
     intrinsics: Intrinsics
     image_rgb: npt.NDArray[np.uint8]
+    vehicle: int = 0
+    """In a fleet's recording, the system id of the vehicle that took it (``frame_index`` and
+    ``pose`` are that vehicle's); 0 in one vehicle's."""
 
 
 @dataclass(frozen=True, slots=True)
