@@ -207,6 +207,40 @@ def test_info_lists_the_vehicles_and_the_tools_take_the_file(
     assert set(SYSIDS) <= set(senders)
 
 
+def test_view_shows_every_vehicle_at_its_home(
+    recorded_fleet: RecordedFleet, tmp_path: Path
+) -> None:
+    """`view --save` puts each vehicle's route and camera frames under world/uavK, that frame
+    placed at its home (``crew.homes_en_m``), as a fleet that `fly` flies is shown."""
+    from tests.view.rrd import read_rrd
+
+    out = tmp_path / "fleet.rrd"
+    result = CliRunner().invoke(cli, ["view", str(recorded_fleet.path), "--save", str(out)])
+    assert result.exit_code == 0, result.output
+    assert result.output.startswith(f"wrote {out}: 3 vehicles, "), result.output
+    data, _ = read_rrd(out)
+    with RecordingReader(recorded_fleet.path) as reader:
+        homes = json.loads(dict(reader.metadata)["crew"]["homes_en_m"])
+    per_vehicle = _read(recorded_fleet.path)
+    for k in SYSIDS:
+        ((placed,),) = data.column(f"world/uav{k}", "Transform3D:translation")
+        assert placed == pytest.approx([*homes[k - 1], 0.0], abs=1e-3)
+        route: list[list[float]] = []
+        for chunk in sorted(data.entities(f"world/uav{k}/route/")):
+            strip = data.last(chunk)["LineStrips3D:strips"][0]
+            route += strip[1:] if route else strip
+        world = np.asarray(route) + np.asarray(placed)
+        telemetry = [t["pos_enu_m"] for t in per_vehicle[k]["telemetry"] if t["time_boot_ms"] > 0]
+        expected = np.asarray(telemetry) + np.asarray([*homes[k - 1], 0.0])
+        np.testing.assert_allclose(world, expected, rtol=0.0, atol=1e-3)
+        frames = len(per_vehicle[k]["frames"])
+        assert frames >= 2
+        assert len(data.column(f"world/uav{k}/camera/image", "EncodedImage:blob")) == frames
+        assert f"map/uav{k}/vehicle" in data.entities()
+        assert data.column(f"log/uav{k}/vehicle", "TextLog:text")  # its events
+    assert not data.entities("world/route/") and "world/vehicle" not in data.entities()
+
+
 def test_fewer_vehicles_than_asked_for_is_one_line_exit_2_and_no_file(tmp_path: Path) -> None:
     out = tmp_path / "two.mcap"
     with shared_port_fleet(2) as shared:

@@ -72,8 +72,8 @@ def view(
     """Show RECORDING (an MCAP file from `uavtool fly`) in Rerun: the scene, the route with
     the photo positions, each frame with its vectors, points of interest, scores,
     telemetry, the built model next to the true building, and the text log. A fleet's
-    recording (`fly --vehicles N`) shows every vehicle so, in one world, each route where it
-    was flown, with a camera view per vehicle.
+    recording (`fly --vehicles N` or `record --vehicles N`) shows every vehicle so, in one
+    world, each route where it was flown, with a camera view per vehicle.
 
     \b
     Examples:

@@ -4,7 +4,8 @@ Vehicle K's topics (``/uavK/mission/observations``, ``/uavK/camera/image`` …) 
 `MissionLogger` as a one-vehicle recording's go to the one logger; the shared MAVLink channels
 (STATUSTEXT, HOME_POSITION) to the vehicle whose system id sent them; the target picture and
 the fleet's outcome (``outcome`` metadata) to the fleet. Each vehicle's home in the fleet's
-frame comes from the ``crew`` metadata.
+frame comes from the ``crew`` metadata. A fleet recorded by ``uavtool record --vehicles N``
+(no mission) goes through `~uavtool.view.recorded.log_recorded_fleet`, in the same layout.
 """
 
 from __future__ import annotations
@@ -19,22 +20,13 @@ from uavtool.errors import InputError
 from uavtool.flight import mission_of
 from uavtool.geo import GeoPoint
 from uavtool.recording import CompressedImage, Entry, JsonDocument, RecordingReader
-from uavtool.recording.fleet import CREW_METADATA, split_topic, vehicle_prefix
+from uavtool.recording.fleet import CREW_METADATA, vehicle_prefix
 from uavtool.recording.topics import OBSERVATIONS, TARGET
 from uavtool.view.errors import ViewError, showing
 from uavtool.view.fleet import FleetLogger
 from uavtool.view.paths import FleetVehicle
-from uavtool.view.recorded import log_scene
-from uavtool.view.source import HOME_POSITION, MISSION_TOPICS, STATUSTEXT, log_entry
-
-_MAX_VEHICLES = 64  # as many as a recording may say flew (`uavtool sitl --vehicles`)
-
-
-def fleet_sysids(topics: set[str]) -> list[int]:
-    """The system ids of the vehicles whose mission ``topics`` holds under ``/uavK``, in
-    order; none for a one-vehicle recording."""
-    found = {k for k, sub in map(split_topic, topics) if k is not None and sub == OBSERVATIONS}
-    return sorted(k for k in found if k <= _MAX_VEHICLES)
+from uavtool.view.recorded import log_recorded_fleet, log_scene
+from uavtool.view.source import HOME_POSITION, MISSION_TOPICS, STATUSTEXT, fleet_sysids, log_entry
 
 
 def fleet_of(path: str | Path) -> tuple[FleetVehicle, ...]:
@@ -59,9 +51,14 @@ def fleet_of(path: str | Path) -> tuple[FleetVehicle, ...]:
 
 def log_fleet_recording(path: str | Path, fleet: FleetLogger) -> None:
     """Log everything the fleet's recording ``path`` holds through ``fleet`` (made for the
-    vehicles `fleet_of` found in it). Raises `ViewError` if it holds no fleet's mission."""
+    vehicles `fleet_of` found in it): a fleet's mission, or a fleet ``uavtool record``
+    recorded. Raises `ViewError` if it holds neither."""
     with RecordingReader(path) as reader:
         present = set(reader.topics())
+        missions = any(vehicle_prefix(k) + OBSERVATIONS in present for k in fleet.vehicles)
+        if not missions and fleet_sysids(present):  # from `record --vehicles N`: no mission
+            log_recorded_fleet(path, reader, fleet)
+            return
         reader.require_metadata(("scene", "mission"))  # else the view would lack them quietly
         metadata = dict(reader.metadata)
         _setup(path, reader, metadata, fleet)

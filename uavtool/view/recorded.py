@@ -1,7 +1,9 @@
 """Feed a recording of ``uavtool record`` (no mission) into a `MissionLogger`: the route and
 telemetry from ``/vehicle/telemetry``, each camera frame from ``/camera/frames`` with its
 image, the events, and — after ``replay --vision-only -o`` — each photo's shapes and match
-from ``/vision/results`` drawn over it, with the target picture."""
+from ``/vision/results`` drawn over it, with the target picture. A fleet's (``record
+--vehicles N``) goes into a `FleetLogger`: each vehicle's topics under ``/uavK`` through its
+own logger, as one vehicle's go through the one."""
 
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ from uavtool.flight import scene_data
 from uavtool.geo import GeoPoint
 from uavtool.recording import CompressedImage, JsonDocument, LogEntry, RecordingReader
 from uavtool.recording.annotations import DETECTIONS
+from uavtool.recording.fleet import vehicle_prefix
 from uavtool.recording.topics import FRAMES, IMAGE, TARGET, TELEMETRY, VEHICLE_EVENTS, VISION
 from uavtool.view.errors import ViewError, showing
 from uavtool.view.fleet import FleetLogger
@@ -29,13 +32,53 @@ def is_recorded_flight(topics: set[str]) -> bool:
 
 
 def log_recorded_flight(path: str | Path, reader: RecordingReader, logger: MissionLogger) -> None:
-    """Log what ``reader`` (a recording of ``uavtool record``) holds through ``logger``."""
+    """Log what ``reader`` (a recording of ``uavtool record``, one vehicle) holds through
+    ``logger``."""
     metadata = dict(reader.metadata)
+    log_scene(path, metadata, logger)
+    origin = metadata.get("record", {}).get("origin")
+    if origin:
+        logger.home(_geo(path, origin, "origin"))
+    params = _params(path, metadata)
+    if params is not None:
+        logger.params(params)
+    log_recorded_vehicle(path, reader, logger)
+    logger.flush()
+
+
+def log_recorded_fleet(path: str | Path, reader: RecordingReader, fleet: FleetLogger) -> None:
+    """Log what ``reader`` (a fleet's recording of ``uavtool record --vehicles N``) holds
+    through ``fleet`` (made for its vehicles): the scene and the target once, each vehicle's
+    topics under ``/uavK`` through its own logger, its home from the ``record`` metadata."""
+    metadata = dict(reader.metadata)
+    log_scene(path, metadata, fleet)
+    params = _params(path, metadata)
+    if params is not None:
+        fleet.params(params)
+    if TARGET in set(reader.topics()):
+        for entry in reader.entries([TARGET]):
+            if isinstance(entry.value, CompressedImage):
+                fleet.target(entry.value.data)
+            break
+    origins = _origins(path, metadata.get("record", {}))
+    for k, logger in fleet.vehicles.items():
+        if k in origins:
+            logger.home(origins[k])
+        log_recorded_vehicle(path, reader, logger, prefix=vehicle_prefix(k))
+    fleet.flush()
+
+
+def log_recorded_vehicle(
+    path: str | Path, reader: RecordingReader, logger: MissionLogger, *, prefix: str = ""
+) -> None:
+    """Log one vehicle's topics of a recording of ``uavtool record`` (under ``prefix``, a
+    fleet's ``/uavK``) through ``logger``: its target picture and ``replay --vision-only``
+    results if any, then its telemetry, frames, detections and events in order."""
     present = set(reader.topics())
-    _setup(path, metadata, logger)
+    mine = {prefix + t: t for t in (TARGET, VISION) if prefix + t in present}
     results: dict[int, list[dict[str, Any]]] = defaultdict(list)
     first = True
-    for entry in reader.entries([t for t in (TARGET, VISION) if t in present]):
+    for entry in reader.entries(list(mine)):
         with showing(path, entry):
             value = entry.value
             if isinstance(value, CompressedImage) and first:
@@ -48,18 +91,19 @@ def log_recorded_flight(path: str | Path, reader: RecordingReader, logger: Missi
                     logger.output(0, out)  # the target's shapes
                 else:
                     results[frame].append(out)
-    wanted = [t for t in (TELEMETRY, FRAMES, IMAGE, DETECTIONS, VEHICLE_EVENTS) if t in present]
+    topics = (TELEMETRY, FRAMES, IMAGE, DETECTIONS, VEHICLE_EVENTS)
+    mine = {prefix + t: t for t in topics if prefix + t in present}
     images: deque[bytes] = deque()
-    for entry in reader.entries(wanted):
+    for entry in reader.entries(list(mine)):
         with showing(path, entry):
-            value, t_ns = entry.value, entry.log_time_ns
+            value, t_ns, topic = entry.value, entry.log_time_ns, mine[entry.topic]
             if isinstance(value, CompressedImage):
                 images.append(value.data)
-            elif isinstance(value, JsonDocument) and entry.topic == TELEMETRY:
+            elif isinstance(value, JsonDocument) and topic == TELEMETRY:
                 logger.observation(0, value.payload, log_time_ns=t_ns)
-            elif isinstance(value, JsonDocument) and entry.topic == DETECTIONS:
+            elif isinstance(value, JsonDocument) and topic == DETECTIONS:
                 logger.detections(value.payload, log_time_ns=t_ns)  # replay --vision's
-            elif isinstance(value, JsonDocument) and entry.topic == FRAMES:
+            elif isinstance(value, JsonDocument) and topic == FRAMES:
                 record = dict(value.payload)
                 logger.observation(
                     0, record, images.popleft() if images else None, log_time_ns=t_ns
@@ -69,7 +113,6 @@ def log_recorded_flight(path: str | Path, reader: RecordingReader, logger: Missi
             elif isinstance(value, LogEntry):
                 level = _LEVEL_NAMES.get(int(value.level), "info")
                 logger.note(level, value.message, source=value.name or "vehicle", log_time_ns=t_ns)
-    logger.flush()
 
 
 def log_scene(
@@ -84,18 +127,39 @@ def log_scene(
         raise ViewError(f"{path}: scene metadata unreadable: {exc}") from None
 
 
-def _setup(path: str | Path, metadata: dict[str, dict[str, str]], logger: MissionLogger) -> None:
-    log_scene(path, metadata, logger)
-    origin = metadata.get("record", {}).get("origin")
-    if origin:
-        try:
-            lat, lon, alt = (float(v) for v in json.loads(origin))
-        except (ValueError, TypeError):
-            raise ViewError(f"{path}: metadata 'record': origin {origin!r} unreadable") from None
-        logger.home(GeoPoint(lat, lon, alt))
+def _geo(path: str | Path, text: str, name: str) -> GeoPoint:
+    """A ``record`` metadata's ``[lat, lon, alt]`` (``name``: which, for the error)."""
+    try:
+        lat, lon, alt = (float(v) for v in json.loads(text))
+    except (ValueError, TypeError):
+        raise ViewError(f"{path}: metadata 'record': {name} {text!r} unreadable") from None
+    return GeoPoint(lat, lon, alt)
+
+
+def _origins(path: str | Path, record: dict[str, str]) -> dict[int, GeoPoint]:
+    """A fleet's origins (its vehicles' homes) by system id, from ``record``'s
+    ``vehicle_sysids`` and ``origins``; none if it names none."""
+    sysids, origins = record.get("vehicle_sysids"), record.get("origins")
+    if not sysids or not origins:
+        return {}
+    try:
+        ks = [int(k) for k in json.loads(sysids)]
+        points = [GeoPoint(*(float(c) for c in o)) for o in json.loads(origins)]
+    except (ValueError, TypeError):
+        raise ViewError(
+            f"{path}: metadata 'record': vehicle_sysids or origins unreadable"
+        ) from None
+    if len(ks) != len(points):
+        raise ViewError(f"{path}: metadata 'record': {len(points)} origins for {len(ks)} vehicles")
+    return dict(zip(ks, points, strict=True))
+
+
+def _params(path: str | Path, metadata: dict[str, dict[str, str]]) -> Any:
+    """The parameters ``replay --vision-only`` ran with, if any."""
     params = metadata.get("vision_only", {}).get("params")
-    if params:
-        try:
-            logger.params(json.loads(params))
-        except ValueError:
-            raise ViewError(f"{path}: metadata 'vision_only': params are not JSON") from None
+    if not params:
+        return None
+    try:
+        return json.loads(params)
+    except ValueError:
+        raise ViewError(f"{path}: metadata 'vision_only': params are not JSON") from None

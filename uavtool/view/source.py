@@ -5,7 +5,8 @@ logger exactly as the live runner does; the frames come from ``/camera/image`` (
 image is frame k, written just before its ``Photo``), vehicle text from STATUSTEXT, the
 home from HOME_POSITION, and the ground truth from the ``scene`` metadata. A fleet's
 recording goes through `~uavtool.view.fleet_source.log_fleet_recording` instead, each
-vehicle's topics through `log_entry` as one vehicle's.
+vehicle's topics through `log_entry` as one vehicle's (a recorded fleet's through
+`~uavtool.view.recorded.log_recorded_vehicle`).
 """
 
 from __future__ import annotations
@@ -30,16 +31,16 @@ _LEVEL_NAMES = {1: "debug", 2: "info", 3: "warning", 4: "error", 5: "error"}
 
 
 def log_recording(path: str | Path, logger: MissionLogger) -> None:
-    """Log everything ``path`` holds through ``logger``. Raises `NotMcapError` if it is not
-    a recording, `ViewError` if it holds no mission."""
+    """Log everything ``path`` holds through ``logger``: a mission's recording, or one
+    vehicle's of ``uavtool record``. Raises `NotMcapError` if it is not a recording,
+    `ViewError` if it holds neither, or is a fleet's (``fly`` or ``record --vehicles N``:
+    `~uavtool.view.fleet_source.log_fleet_recording` shows those)."""
     with RecordingReader(path) as reader:
         present = set(reader.topics())
         if OBSERVATIONS not in present and is_recorded_flight(present):
             log_recorded_flight(path, reader, logger)  # from `uavtool record`: no mission
             return
-        if OBSERVATIONS not in present and any(
-            split_topic(t) == (k, OBSERVATIONS) for t in present for k in range(1, 65)
-        ):
+        if OBSERVATIONS not in present and fleet_sysids(present):
             raise ViewError(
                 f"{path}: a fleet's recording (its vehicles' topics under /uavN): one "
                 "MissionLogger shows one vehicle; log_fleet_recording shows every vehicle "
@@ -56,6 +57,21 @@ def log_recording(path: str | Path, logger: MissionLogger) -> None:
             with showing(path, entry):
                 log_entry(entry.topic, entry, images, logger)
     logger.flush()
+
+
+_MAX_VEHICLES = 64  # as many as a recording may say flew (`uavtool sitl --vehicles`)
+
+
+def fleet_sysids(topics: set[str]) -> list[int]:
+    """The system ids of the vehicles whose mission (or, from ``record --vehicles N``,
+    telemetry or frames) ``topics`` holds under ``/uavK``, in order; none for a one-vehicle
+    recording."""
+    found = {
+        k
+        for k, sub in map(split_topic, topics)
+        if k is not None and (sub == OBSERVATIONS or is_recorded_flight({sub}))
+    }
+    return sorted(k for k in found if k <= _MAX_VEHICLES)
 
 
 MISSION_TOPICS = (OBSERVATIONS, OUTPUTS, IMAGE, PICTURES, DETECTIONS, EVENTS)
