@@ -6,6 +6,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import socket
 import time
@@ -15,6 +16,8 @@ from typing import Any, Protocol
 from uavtool.errors import LinkError
 
 _UDP_MAX = 65535
+UDP_RECEIVE_BYTES = 4 << 20
+"""The receive buffer a UDP link asks for (the default, ~200 KiB, is ~2 s of a fleet)."""
 _DEFAULT_BAUD = 57600
 
 
@@ -87,6 +90,10 @@ class UdpTransport:
         self.name = f"{'udpin' if listen else 'udpout'}:{host}:{port}"
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.peer: tuple[str, int] | None = None
+        # Room for seconds of a fleet's streams: a reader held up (a busy machine) loses no
+        # datagram the kernel could have kept (Linux caps it at net.core.rmem_max).
+        with contextlib.suppress(OSError):
+            self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, UDP_RECEIVE_BYTES)
         try:
             if listen:
                 self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
