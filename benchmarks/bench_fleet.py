@@ -10,8 +10,8 @@ model was built and until the last vehicle landed, the fleet's closest approach;
 - the fleet's time to the model over one vehicle's (median and mean of the scenes where both
   built it; the issue's goal: <= 0.45), and the same for the whole flight (to the last
   landing);
-- right / wrong matches and crashes of each, and separation breaches of the fleet (goal: the
-  same or better right rate, 0 wrong, 0 crashes, 0 breaches);
+- right / wrong matches, crashes and the models' IoU of each, and separation breaches of the
+  fleet (goal: the same or better right rate, 0 wrong, 0 crashes, 0 breaches);
 - lockstep wall time per vehicle-second of each, and their ratio (goal: <= 1.2: a fleet of
   N costs N vehicles' simulation and rendering, so per vehicle-second of *each* vehicle).
 
@@ -93,6 +93,8 @@ def main() -> None:
             "fleet_model_s": fleet_model[0] if fleet_model else None,
             "fleet_s": fleet.vehicle_time_s,
             "fleet_wall_per_s": fleet_wall / max(fleet.vehicle_time_s * args.vehicles, 1e-9),
+            "one_iou": e1.model_iou,
+            "fleet_iou": ef.model_iou if ef else None,
             "closest_m": fleet.closest_approach_m,
             "separation_m": fleet.separation_m,
         }
@@ -154,6 +156,16 @@ def _report(rows: list[dict[str, object]], vehicles: int) -> None:
         f"{sum(1 for r in rows if r['fleet_model_s'] is not None)}; crashed: one "
         f"{count('one', Status.CRASHED)}, fleet {count('fleet', Status.CRASHED)}"
     )
+    ious = [
+        (r["one_iou"], r["fleet_iou"]) for r in rows if None not in (r["one_iou"], r["fleet_iou"])
+    ]
+    if ious:
+        one_iou = statistics.median(a for a, _ in ious)  # type: ignore[type-var]
+        fleet_iou = statistics.median(b for _, b in ious)  # type: ignore[type-var]
+        print(
+            f"model IoU with the true building, median over {len(ious)} scenes where both "
+            f"built it: one {one_iou:.3f}, fleet {fleet_iou:.3f}"
+        )
     breaches = sum(1 for r in rows if r["closest_m"] < r["separation_m"])  # type: ignore[operator]
     closest = min(r["closest_m"] for r in rows)  # type: ignore[type-var]
     print(f"separation breaches: {breaches} (closest approach of all: {closest:.2f} m)")

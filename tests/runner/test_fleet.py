@@ -16,6 +16,8 @@ from uavtool.examples.fleet_survey import FleetSurveyMission, FleetSurveyParams
 from uavtool.flight import FlightDescription
 from uavtool.mission import Level, Status
 from uavtool.mission.fleet import FleetParams
+from uavtool.mission.fleet_search import FleetSearchParams
+from uavtool.mission.params import with_overrides
 from uavtool.recording import RecordingReader, summarize
 from uavtool.replay import load_flight
 from uavtool.replay.fleet import replay_fleet
@@ -24,6 +26,7 @@ from uavtool.replay.refly import refly
 from uavtool.runner.fleet import FleetSummary, fly_fleet
 from uavtool.runner.fly import FlyConfig, fly
 from uavtool.testing import assert_reflies_identically, assert_replays_identically
+from uavtool.world.hard import HardOptions, generate_hard_scene
 
 
 def _config(path: Path | None, **kw: object) -> FlyConfig:
@@ -136,6 +139,26 @@ def test_homes_given_one_by_one_are_where_the_vehicles_fly_from(tmp_path: Path) 
     assert description.homes_m == homes
     again = refly(out)
     assert again.identical, again.first_difference
+
+
+def test_a_viewpoint_where_another_vehicle_stands_is_planned_again() -> None:
+    """Scene 61085 of the fleet benchmark: the modeller's right viewpoint, as one vehicle
+    plans it, lies within the separation of the leader's home, where the leader has landed;
+    the airspace would never grant it (the modeller waited out ``claim_wait_s`` and aborted,
+    no model). The side photos are planned again around the other vehicles' homes."""
+    scene = generate_hard_scene(
+        seed=61085, options=HardOptions(spread_m=75.0, min_buildings=6, max_buildings=9)
+    )
+    params = with_overrides(FleetSearchParams(), {"mission.search_radius_m": 80.0})
+    said: list[tuple[int, str]] = []
+    s = fly_fleet(
+        FlyConfig(scene=scene, params=params, no_record=True, seed=61085, offset_line=None,
+                  mission="fleet-search", vehicles=3),
+        progress=lambda sysid, text, _t: said.append((sysid, text)),
+    )  # fmt: skip
+    assert s.status is Status.COMPLETED and "model built" in s.reason, s.reason
+    assert (3, "a side viewpoint lies where another vehicle stands: planned again") in said
+    assert s.closest_approach_m >= 5.0
 
 
 def test_homes_closer_than_the_claims_take_off_one_after_another() -> None:

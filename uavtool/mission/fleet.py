@@ -19,6 +19,7 @@ the first vehicle's home (:attr:`FleetMember.home_en_m` is the difference).
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any, ClassVar, Self
@@ -229,61 +230,65 @@ class FleetMember(FlightMission):
         """A move inside claimed airspace. At or above this member's layer: the straight way
         there, claimed, flown, then only the point arrived at held. Below it: the way's
         airspace from the layer down to the lowest point of the way, held until the member is
-        back at its layer (a move inside it needs no other claim)."""
+        back at its layer (a move inside it needs no other claim). The way is drawn from
+        where the vehicle is when it is granted, not when it was first asked for: a vehicle
+        called off mid-move flies on to its last target while it waits."""
         last = self.last
         assert last is not None, "move() needs telemetry: take off first"
         layer = self.layer_m()
         if last.landed and not last.armed:  # it landed to wait (land()): up first
             yield from self.take_off(layer)
-            last = self.last
-            assert last is not None
-        here = last.pos_enu_m
         x, y, z = pos_enu_m
         tol = self.flight.arrive_radius_m
         airspace = self.crew.airspace
         below = z < layer - tol
-        if here[2] >= layer - tol and not below:
-            lane = Claim((here[0], here[1]), (x, y), tol, min(here[2], z), max(here[2], z), what)
-            yield from self.claim(lane, what)
-        else:
+
+        def way() -> Claim | None:
+            """The airspace from here to there; None when what it holds covers both."""
+            assert self.last is not None
+            here = self.last.pos_enu_m
+            at = (here[0], here[1])
+            if here[2] >= layer - tol and not below:
+                return Claim(at, (x, y), tol, min(here[2], z), max(here[2], z), what)
             held = airspace.held[self.index]
-            inside = held.covers((here[0], here[1]), here[2], 0.0) and held.covers((x, y), z, 0.0)
-            if not inside:
-                top = max(layer, here[2], z)
-                column = Claim((here[0], here[1]), (x, y), tol, min(here[2], z), top, what)
-                yield from self.claim(column, what)
+            if held.covers(at, here[2], 0.0) and held.covers((x, y), z, 0.0):
+                return None
+            return Claim(at, (x, y), tol, min(here[2], z), max(layer, here[2], z), what)
+
+        yield from self.claim(way, what)
         yield from super().move(pos_enu_m, heading_deg, what)
         if not below:
             airspace.shrink(self.index, (x, y), z, what)
         else:  # only the way back up to its layer is still needed
             airspace.narrow(self.index, Claim.column((x, y), tol, z, max(layer, z), what))
 
-    def claim(self, claim: Claim, what: str) -> Wait[None]:
-        """Wait (hovering where it is) until the airspace grants ``claim``; ABORTED after
-        ``claim_wait_s``."""
+    def claim(self, claim: Claim | Callable[[], Claim | None], what: str) -> Wait[None]:
+        """Wait (hovering where it is, or flying on to its last target) until the airspace
+        grants ``claim`` (or the claim ``claim()`` makes each time it asks, from where the
+        vehicle then is; None: nothing to ask for); ABORTED after ``claim_wait_s``."""
         airspace = self.crew.airspace
-        if airspace.request(self.index, claim):
+        make = claim if callable(claim) else lambda: claim
+
+        def granted(_t: Telemetry | None = None) -> bool:
+            wanted = make()
+            return wanted is None or airspace.request(self.index, wanted)
+
+        if granted():
             return
-        other = airspace.blocker(self.index, claim)
-        self.event(Level.INFO, f"{what}: waiting for vehicle {_sysid(other)} to clear the way")
+        self.event(
+            Level.INFO, f"{what}: waiting for vehicle {self._blocker(make)} to clear the way"
+        )
         wait_s = self.crew.fleet.claim_wait_s
-        granted = yield from self.wait_until(lambda _t: airspace.request(self.index, claim), wait_s)
-        if not granted:
-            other = airspace.blocker(self.index, claim)
+        if not (yield from self.wait_until(granted, wait_s)):
             raise self.end(
                 Status.ABORTED,
-                f"{what}: vehicle {_sysid(other)} held the way for {wait_s:g} s",
+                f"{what}: vehicle {self._blocker(make)} held the way for {wait_s:g} s",
             )
 
-    def _landed_for_good(self, claim: Claim) -> bool:
-        """Whether what blocks ``claim`` is a member that has landed and ended: it will not
-        move again, so waiting is pointless."""
-        other = self.crew.airspace.blocker(self.index, claim)
-        return (
-            other is not None
-            and self.crew.airspace.held[other].parked
-            and (self.crew.members[other].done)
-        )
+    def _blocker(self, make: Callable[[], Claim | None]) -> str:
+        wanted = make()
+        other = None if wanted is None else self.crew.airspace.blocker(self.index, wanted)
+        return _sysid(other)
 
     def go_home(self) -> Wait[None]:
         """Back over home at this member's layer, then claim the column down for the landing

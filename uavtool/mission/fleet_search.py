@@ -202,6 +202,20 @@ class FleetSearchMission(FleetMember, SearchMission):
                 crew.modeller = helper
         crew.decided = True
 
+    def standing_vehicles(self) -> list[tuple[tuple[tuple[float, float], ...], float]]:
+        """The other members' homes, where each stands before it flies and lands when it is
+        done: around each, a square as high as the separation and this member's margin (a
+        parked vehicle keeps none) and that much wider than a claim, so the model's photos
+        are planned again where the airspace would never grant a viewpoint."""
+        fleet = self.crew.fleet
+        high = fleet.separation_m + fleet.margin_m  # a parked vehicle keeps no margin
+        r = high + self.flight.arrive_radius_m  # a claim's own width
+        return [
+            (((e - r, n - r), (e + r, n - r), (e + r, n + r), (e - r, n + r)), high)
+            for i, (e, n) in enumerate(self.crew.homes_en_m)
+            if i != self.index
+        ]
+
     def model_target(self, found: Found, seen: Survey, transit_m: float) -> Wait[None]:
         crew = self.crew
         h = crew.modeller

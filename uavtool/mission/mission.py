@@ -138,6 +138,12 @@ class SearchMission(FlightMission):
 
         return (yield from measure_from_another_altitude(self, k, poi, look, shape))
 
+    def standing_vehicles(self) -> list[tuple[tuple[tuple[float, float], ...], float]]:
+        """Where other vehicles stand, or will land, as obstacles the model's viewpoints keep
+        clear of (each a footprint and a height, as a building's): none for one vehicle (a
+        fleet's member: the others' homes)."""
+        return []
+
     def model_target(self, found: Found, seen: Survey, transit_m: float) -> Wait[None]:
         """Photograph the target from three sides and build its model (a fleet's leader
         hands this to the vehicle at the target)."""

@@ -177,6 +177,16 @@ def photograph_and_model(
     )
     rect = min_area_rect(footprint)
     front, right = plan_viewpoints(rect, obstacles, top_photo.intrinsics, vp_params, heights, apart)
+    standing = m.standing_vehicles()
+    if _among(standing, (front, right)):
+        # a viewpoint where another vehicle stands (a fleet's, landed at its home): the
+        # airspace would never grant it; planned again with them as obstacles
+        m.event(Level.INFO, "a side viewpoint lies where another vehicle stands: planned again")
+        obstacles = obstacles + [f for f, _ in standing]
+        heights = heights + [h for _, h in standing]
+        front, right = plan_viewpoints(
+            rect, obstacles, top_photo.intrinsics, vp_params, heights, apart
+        )
     far = farther(vp_params, top_photo.intrinsics)
     failed = sum(isinstance(v, ViewpointFailure) for v in (front, right))
     if far is not None and failed:
@@ -316,3 +326,19 @@ def _diagonal(
 def _below(photo: Photo) -> float:
     """Just below the camera: the highest plane a nadir photo's pixels can be put on."""
     return photo.pose.pos_enu_m[2] - 0.5
+
+
+def _among(
+    standing: list[tuple[tuple[tuple[float, float], ...], float]],
+    viewpoints: tuple[Viewpoint | ViewpointFailure, ...],
+) -> bool:
+    """Whether a planned viewpoint lies inside the footprint of a standing vehicle (a square),
+    below its height."""
+    for footprint, height_m in standing:
+        (e0, n0), (e1, n1) = footprint[0], footprint[2]  # the square's opposite corners
+        for vp in viewpoints:
+            if isinstance(vp, Viewpoint):
+                e, n, up = vp.pos_enu_m
+                if e0 <= e <= e1 and n0 <= n <= n1 and up < height_m:
+                    return True
+    return False
