@@ -16,16 +16,14 @@ from collections import deque
 from pathlib import Path
 from typing import Any
 
-from uavtool.errors import InputError
-from uavtool.flight import mission_of
 from uavtool.geo import GeoPoint
-from uavtool.recording import CompressedImage, Entry, JsonDocument, RecordingReader
+from uavtool.recording import Entry, JsonDocument, RecordingReader
 from uavtool.recording.fleet import CREW_METADATA, vehicle_prefix
-from uavtool.recording.topics import OBSERVATIONS, TARGET
+from uavtool.recording.topics import OBSERVATIONS
 from uavtool.view.errors import ViewError, showing
 from uavtool.view.fleet import FleetLogger
 from uavtool.view.paths import FleetVehicle
-from uavtool.view.recorded import log_recorded_fleet, log_scene
+from uavtool.view.recorded import log_flight_setup, log_recorded_fleet
 from uavtool.view.source import HOME_POSITION, MISSION_TOPICS, STATUSTEXT, fleet_sysids, log_entry
 
 
@@ -97,18 +95,7 @@ def _setup(
     metadata: dict[str, dict[str, str]],
     fleet: FleetLogger,
 ) -> None:
-    log_scene(path, metadata, fleet)
-    try:
-        _, params = mission_of(metadata, source=str(path))
-    except InputError as exc:
-        raise ViewError(str(exc)) from None
-    fleet.params(params)
-    topics = set(reader.topics())
-    if TARGET in topics:
-        for entry in reader.entries([TARGET]):
-            if isinstance(entry.value, CompressedImage):
-                fleet.target(entry.value.data)
-            break
+    topics = log_flight_setup(path, reader, metadata, fleet)
     if HOME_POSITION in topics:
         homeless = set(fleet.vehicles)
         for entry in reader.entries([HOME_POSITION]):

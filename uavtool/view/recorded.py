@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from uavtool.errors import InputError
-from uavtool.flight import scene_data
+from uavtool.flight import mission_of, scene_data
 from uavtool.geo import GeoPoint
 from uavtool.recording import CompressedImage, JsonDocument, LogEntry, RecordingReader
 from uavtool.recording.annotations import DETECTIONS
@@ -125,6 +125,29 @@ def log_scene(
             logger.scene(scene_from_dict(data, source=f"{path}: scene metadata"))
     except (InputError, SceneError) as exc:
         raise ViewError(f"{path}: scene metadata unreadable: {exc}") from None
+
+
+def log_flight_setup(
+    path: str | Path,
+    reader: RecordingReader,
+    metadata: dict[str, dict[str, str]],
+    logger: MissionLogger | FleetLogger,
+) -> set[str]:
+    """What a flight's view starts with, one vehicle's or a fleet's: the scene, the
+    mission's parameters and the target picture; returns the recording's topics."""
+    log_scene(path, metadata, logger)
+    try:
+        _, params = mission_of(metadata, source=str(path))
+    except InputError as exc:
+        raise ViewError(str(exc)) from None
+    logger.params(params)
+    topics = set(reader.topics())
+    if TARGET in topics:
+        for entry in reader.entries([TARGET]):
+            if isinstance(entry.value, CompressedImage):
+                logger.target(entry.value.data)
+            break
+    return topics
 
 
 def _geo(path: str | Path, text: str, name: str) -> GeoPoint:

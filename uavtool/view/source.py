@@ -14,16 +14,14 @@ from __future__ import annotations
 from collections import deque
 from pathlib import Path
 
-from uavtool.errors import InputError
-from uavtool.flight import mission_of
 from uavtool.geo import GeoPoint
 from uavtool.recording import CompressedImage, Entry, JsonDocument, LogEntry, RecordingReader
 from uavtool.recording.annotations import DETECTIONS
 from uavtool.recording.fleet import split_topic
-from uavtool.recording.topics import EVENTS, IMAGE, OBSERVATIONS, OUTPUTS, PICTURES, TARGET
+from uavtool.recording.topics import EVENTS, IMAGE, OBSERVATIONS, OUTPUTS, PICTURES
 from uavtool.view.errors import ViewError, showing
 from uavtool.view.logger import MissionLogger
-from uavtool.view.recorded import is_recorded_flight, log_recorded_flight, log_scene
+from uavtool.view.recorded import is_recorded_flight, log_flight_setup, log_recorded_flight
 
 STATUSTEXT = "/mavlink/in/STATUSTEXT"
 HOME_POSITION = "/mavlink/in/HOME_POSITION"
@@ -111,18 +109,7 @@ def _setup(
     metadata: dict[str, dict[str, str]],
     logger: MissionLogger,
 ) -> None:
-    log_scene(path, metadata, logger)
-    try:
-        _, params = mission_of(metadata, source=str(path))
-    except InputError as exc:
-        raise ViewError(str(exc)) from None
-    logger.params(params)
-    topics = set(reader.topics())
-    if TARGET in topics:
-        for entry in reader.entries([TARGET]):
-            if isinstance(entry.value, CompressedImage):
-                logger.target(entry.value.data)
-            break
+    topics = log_flight_setup(path, reader, metadata, logger)
     if HOME_POSITION in topics:
         for entry in reader.entries([HOME_POSITION]):
             if isinstance(entry.value, JsonDocument):
