@@ -17,7 +17,8 @@ from uavtool.errors import LinkError
 
 _UDP_MAX = 65535
 UDP_RECEIVE_BYTES = 4 << 20
-"""The receive buffer a UDP link asks for (the default, ~200 KiB, is ~2 s of a fleet)."""
+"""The receive buffer a recorder's UDP link asks for (the default, ~200 KiB, is ~2 s of a
+fleet's streams)."""
 _DEFAULT_BAUD = 57600
 
 
@@ -86,14 +87,15 @@ class TcpTransport:
 class UdpTransport:
     """``udpin`` binds and answers whoever spoke last; ``udpout`` sends to a fixed address."""
 
-    def __init__(self, host: str, port: int, *, listen: bool) -> None:
+    def __init__(
+        self, host: str, port: int, *, listen: bool, receive_bytes: int | None = None
+    ) -> None:
         self.name = f"{'udpin' if listen else 'udpout'}:{host}:{port}"
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.peer: tuple[str, int] | None = None
-        # Room for seconds of a fleet's streams: a reader held up (a busy machine) loses no
-        # datagram the kernel could have kept (Linux caps it at net.core.rmem_max).
-        with contextlib.suppress(OSError):
-            self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, UDP_RECEIVE_BYTES)
+        if receive_bytes is not None:  # a recorder's: see open_transport's keep_all
+            with contextlib.suppress(OSError):
+                self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, receive_bytes)
         try:
             if listen:
                 self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
@@ -158,11 +160,18 @@ class SerialTransport:
 
 
 def open_transport(
-    text: str, *, timeout_s: float = 10.0, waiting: Callable[[str], None] | None = None
+    text: str,
+    *,
+    timeout_s: float = 10.0,
+    waiting: Callable[[str], None] | None = None,
+    keep_all: bool = False,
 ) -> Transport:
     """Open a connection string; raises LinkError naming what is wrong. A TCP vehicle that
     refuses is retried for ``timeout_s`` (it may still be starting); ``waiting`` hears that
-    at the first refusal."""
+    at the first refusal. ``keep_all`` (a recorder's link): a UDP socket keeps seconds of
+    datagrams (`UDP_RECEIVE_BYTES`, capped by the kernel's net.core.rmem_max) for a reader
+    held up on a busy machine, where a flight's link keeps the kernel's default: what a
+    flight reads late is stale, and its lag stays short."""
     kind, _, rest = text.partition(":")
     if text.startswith("/dev/") or kind in ("serial", "com") or kind.upper().startswith("COM"):
         device, baud = _serial_parts(text)
@@ -182,6 +191,8 @@ def open_transport(
         raise LinkError(f"connection {text!r}: expected {kind}:HOST:PORT with a port 1-65535")
     if kind == "tcp":
         return TcpTransport(host, port, connect_timeout_s=timeout_s, waiting=waiting)
+    if keep_all:
+        return UdpTransport(host, port, listen=kind != "udpout", receive_bytes=UDP_RECEIVE_BYTES)
     return opener(host, port)
 
 

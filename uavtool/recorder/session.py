@@ -94,7 +94,7 @@ def _record(
                 )
                 stack.callback(camera.close)
                 cameras.append(camera)
-        transport = open_transport(config.connect, timeout_s=config.timeout_s)
+        transport = open_transport(config.connect, timeout_s=config.timeout_s, keep_all=True)
         stack.callback(transport.close)
         tap = LinkTap()
         source: VehicleSource
