@@ -85,7 +85,10 @@ class VehicleLink:
         tap: Tap | None = None,
         clock: Clock = time.monotonic,
         announce: bool = True,
+        encoder: Any = None,
     ) -> None:
+        """``encoder``: the pymavlink encoder (its sequence) to send with, shared by links that
+        send on one transport (`uavtool.recorder.fleet.FleetLink`); None: one of its own."""
         self.transport = transport
         self.clock = clock
         self.name = transport.name
@@ -94,7 +97,9 @@ class VehicleLink:
         self.freshness = FreshnessFilter()
         self._parser = FrameParser()
         self._gimbal_seen: dict[bytes, tuple[float, float]] = {}  # see _gimbal_angles_of
-        self._mav = new_encoder(sysid=GCS_SYSID, compid=GCS_COMPID)
+        self._mav = (
+            encoder if encoder is not None else new_encoder(sysid=GCS_SYSID, compid=GCS_COMPID)
+        )
         self.target_system = 0
         self.target_component = 0
         self.state = VehicleState()

@@ -107,10 +107,15 @@ class UdpTransport:
             raise LinkError(f"{self.name}: {_why(exc)}") from None
 
     def send(self, data: bytes) -> None:
-        if self.peer is None:
-            return  # udpin: nobody has spoken yet
+        self.send_to(data, self.peer)
+
+    def send_to(self, data: bytes, peer: tuple[str, int] | None) -> None:
+        """Send to ``peer`` (on ``udpin``, one of those that spoke: several vehicles on one
+        port); None: nobody has spoken yet, nothing is sent."""
+        if peer is None:
+            return
         try:
-            self.sock.sendto(data, self.peer)
+            self.sock.sendto(data, peer)
         except OSError as exc:
             if exc.errno not in (errno.ECONNREFUSED, errno.ENOBUFS):
                 raise LinkError(f"{self.name}: send failed: {_why(exc)}") from None

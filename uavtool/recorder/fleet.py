@@ -9,9 +9,9 @@ from collections.abc import Callable
 from typing import Any
 
 from uavtool.link import Transport, VehicleLink
-from uavtool.link.client import Tap, is_vehicle_heartbeat
+from uavtool.link.client import GCS_COMPID, GCS_SYSID, Tap, is_vehicle_heartbeat
 from uavtool.link.transport import UdpTransport
-from uavtool.mavlink.framing import Frame, FrameParser
+from uavtool.mavlink.framing import Frame, FrameParser, new_encoder
 
 
 class FleetLink:
@@ -42,7 +42,8 @@ class FleetLink:
         self._beyond: set[int] = set()
         self._answers = isinstance(transport, UdpTransport) and transport.name.startswith("udpin")
         self._peers: dict[int, Any] = {}  # sysid -> the address it last spoke from (udpin)
-        self._encoder: Any = None
+        # one sequence for every frame we send on this link, whichever vehicle it is for
+        self._encoder = new_encoder(sysid=GCS_SYSID, compid=GCS_COMPID)
 
     @property
     def links(self) -> list[VehicleLink]:
@@ -82,9 +83,10 @@ class FleetLink:
 
     def send_for(self, sysid: int, data: bytes) -> None:
         peer = self._peers.get(sysid)
-        if peer is not None:
-            self.transport.peer = peer  # type: ignore[attr-defined]  # udpin: UdpTransport
-        self.transport.send(data)
+        if peer is not None and isinstance(self.transport, UdpTransport):
+            self.transport.send_to(data, peer)
+        else:
+            self.transport.send(data)
 
     def _new_vehicle(self, msg: Any) -> bool:
         sysid = msg.get_srcSystem()
@@ -96,11 +98,9 @@ class FleetLink:
                 if self.ignored is not None:
                     self.ignored(sysid)
             return False
-        link = VehicleLink(_Outbox(self, sysid), tap=self.tap, announce=False)
-        # one sequence for every frame we send on this link, whichever vehicle it is for
-        if self._encoder is None:
-            self._encoder = link._mav
-        link._mav = self._encoder
+        link = VehicleLink(
+            _Outbox(self, sysid), tap=self.tap, announce=False, encoder=self._encoder
+        )
         self.vehicles[sysid] = link
         return True
 
