@@ -118,6 +118,26 @@ class Recorded:
     """Frames the vehicle received from the recorder's link (0: passive)."""
 
 
+def start_record(args: list[str]) -> tuple[subprocess.Popen[str], str]:
+    """``uavtool record ARGS`` in a process of its own, once it says it is recording, and
+    what it said until then (kill it when done)."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "uavtool", "record", *args],
+        cwd=REPO,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert proc.stderr is not None
+    said = []
+    while "recording to" not in (line := proc.stderr.readline()):
+        if not line:
+            proc.kill()
+            raise AssertionError(f"record exited early: {said} {proc.communicate()}")
+        said.append(line)
+    return proc, "".join(said)
+
+
 def record_auto_flight(path: Path) -> Recorded:
     """``uavtool record --camera sim --scene paper --until-landed`` (passive, on UDP) while a
     scripted ground station flies the AUTO mission over TCP: ~10 s of wall time."""
@@ -130,17 +150,8 @@ def record_auto_flight(path: Path) -> Recorded:
             *("--connect", f"udpin:127.0.0.1:{port}", "-o", str(path)),
             *("--camera", "sim", "--scene", "paper", "--rate", "0.5", "--until-landed"),
         ]
-        proc = subprocess.Popen(
-            [sys.executable, "-m", "uavtool", "record", *args],
-            cwd=REPO,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-        )
+        proc, _ = start_record(args)
         try:
-            assert proc.stderr is not None
-            while "recording to" not in (line := proc.stderr.readline()):
-                assert line, f"record exited early: {proc.communicate()}"
             client = Client.tcp(sitl.ports[0])
             client.heartbeat()
             fly_auto_mission(client, scene)

@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
-import sys
 import threading
 from collections import Counter
 from dataclasses import dataclass
@@ -24,7 +22,7 @@ from tests.recorder.fleet_flight import (
     fly_all,
     shared_port_fleet,
 )
-from tests.recorder.flight import REPO, free_udp_port
+from tests.recorder.flight import free_udp_port, start_record
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.cli import cli
 from uavtool.geo import GeoPoint, enu_from_geo
@@ -60,24 +58,13 @@ def recorded_fleet(tmp_path_factory: pytest.TempPathFactory) -> RecordedFleet:
             *("--vehicles", str(len(SYSIDS)), "--until-landed"),
             *("--camera", "sim", "--scene", "paper", "--rate", "1"),
         ]
-        proc = subprocess.Popen(
-            [sys.executable, "-m", "uavtool", "record", *args],
-            cwd=REPO,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-        )
+        proc, said = start_record(args)
         try:
-            assert proc.stderr is not None
-            said = []
-            while "recording to" not in (line := proc.stderr.readline()):
-                assert line, f"record exited early: {said} {proc.communicate()}"
-                said.append(line)
             fly_all(shared.fleet)
             stdout, stderr = proc.communicate(timeout=30)
         finally:
             proc.kill()
-    return RecordedFleet(path, proc.returncode, stdout, "".join(said) + stderr)
+    return RecordedFleet(path, proc.returncode, stdout, said + stderr)
 
 
 def _read(path: Path) -> dict[int, dict[str, list[Any]]]:
