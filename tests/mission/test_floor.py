@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from uavtool.mission import MissionInputs, Params, SearchMission
+from uavtool.mission.unknown import Unknown
 
 
 def _mission() -> SearchMission:
@@ -25,10 +26,15 @@ def test_floor_over_tiers_and_unknown_roofs() -> None:
     assert m.floor_at(-5.0, -5.0) == 0.0  # 7 m from either: nothing to clear
     m.ceiling_m = 117.4
     where = ((20.0, 0.0), (26.0, 0.0), (26.0, 6.0), (20.0, 6.0))
-    m.unknown = {3: (where, 115.0)}  # nothing rules out a roof up to just below the ceiling
+    m.unknown = {3: Unknown(where, 115.0)}  # nothing rules out a roof up to just below the ceiling
     assert m.floor_at(18.0, 3.0) == 117.4  # within the margin of it: the ceiling, no higher
     assert m.floor_at(9.0, 3.0) == 20.0 + margin  # 3 m from the lower tier, 5 m from the top
-    m.unknown = {3: (where, 30.0)}  # the ground seen around it rules out more than 30 m
+    m.unknown = {3: Unknown(where, 30.0)}  # the ground seen around it rules out more than 30 m
     assert m.floor_at(18.0, 3.0) == 30.0 + margin
+    # where it stands for each range of heights: 9 m off, only the lowest reach
+    higher = ((25.0, 0.0), (31.0, 0.0), (31.0, 6.0), (25.0, 6.0))
+    m.unknown = {3: Unknown(where, 30.0, ((where, 12.0), (higher, 30.0)))}
+    assert m.floor_at(17.0, 3.0) == 12.0 + margin
+    assert m.floor_at(33.0, 3.0) == 30.0 + margin
     m.learn_roof(3, where, 8.0)  # a closer look measured it
     assert m.floor_at(18.0, 3.0) == 8.0 + margin

@@ -199,6 +199,28 @@ def test_the_highest_a_roof_of_unknown_height_may_be() -> None:
     assert 40.0 <= upper <= 60.0  # 56 m here: the 2 m planes up to 54 m are left
 
 
+def test_over_any_one_place_only_the_heights_that_put_the_building_there_count() -> None:
+    """The same 40 m tower, seen only from over home (117 m): placed higher, its roof's
+    outline slides toward home, from 45.6 m out (on the ground) to nearly over home (just
+    below the camera). Over any one place only the heights that put the building there
+    count: never less than the true 40 m where it stands, a low one only where a low one
+    would stand, the highest nearest home, none beyond it."""
+    home, _over, shape = _tower_photos()
+    place = unknown_roof(shape, home, 111.0)
+    assert place.upper_m == 111.0
+
+    def top(x: float) -> float | None:
+        return place.top_m(lambda ring: Polygon(ring).distance(Point(x, 0.0)) <= 1.0)
+
+    assert 40.0 <= (top(30.0) or 0.0) <= 60.0  # at 60 m it would stand 22 m out, no nearer
+    assert (top(46.0) or math.inf) <= 20.0  # where only a low one would stand
+    tops = [top(x) for x in (46.0, 40.0, 30.0, 20.0, 10.0, 2.0)]
+    assert all(t is not None for t in tops)
+    assert tops == sorted(tops)  # type: ignore[type-var]
+    assert tops[-1] == 111.0
+    assert top(-5.0) is None  # past home: nowhere
+
+
 def _tower_on_a_wing() -> Scene:
     """A 14 m wing with a 50 m tower rising from it, 45 m east of home."""
     building = {

@@ -248,7 +248,11 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         }
     )
     m.unknown.update(
-        {-1 - j: Unknown(o.footprint, o.upper_m) for j, o in enumerate(obstacles) if not o.measured}
+        {
+            -1 - j: Unknown(o.footprint, o.upper_m, o.bands)
+            for j, o in enumerate(obstacles)
+            if not o.measured
+        }
     )
     return replace(
         seen,

@@ -29,6 +29,7 @@ from uavtool.mission.outputs import (
 )
 from uavtool.mission.params import Params
 from uavtool.mission.peek import Peek, peek
+from uavtool.mission.unknown import Unknown
 from uavtool.nav.geometry import (
     point_in_polygon,
     point_polygon_distance,
@@ -87,10 +88,10 @@ class SearchMission(FlightMission):
         """Photos straight down from the ceiling beyond that ground
         (:func:`uavtool.mission.peek.peek`): where they show no building near a place or a
         way, it is seen free too."""
-        self.unknown: dict[int, tuple[tuple[tuple[float, float], ...], float]] = {}
-        """Where buildings of unknown height may stand, and the highest each roof may be (by
-        the overview shape's index; an obstacle's is negative): a way near one crosses over
-        that by the margin."""
+        self.unknown: dict[int, Unknown] = {}
+        """Where buildings of unknown height may stand, and the highest each roof may be
+        there (by the overview shape's index; an obstacle's is negative): a way near one
+        crosses over that by the margin."""
         self.roofs: tuple[tuple[tuple[tuple[float, float], ...], float], ...] = ()
         """Every measured roof: (footprint, height above home)."""
         self.viewpoints: Viewpoints | None = None
@@ -282,9 +283,10 @@ class SearchMission(FlightMission):
         for footprint, roof_m in self.roofs:
             if point_polygon_distance((x, y), footprint) <= margin_m:
                 need = max(need, roof_m + margin_m + self.params.mission.arrive_radius_m)
-        for footprint, upper_m in self.unknown.values():
-            if point_polygon_distance((x, y), footprint) <= margin_m:
-                need = max(need, self._clear_of(upper_m))
+        for place in self.unknown.values():
+            top = place.top_m(lambda ring: point_polygon_distance((x, y), ring) <= margin_m)
+            if top is not None:
+                need = max(need, self._clear_of(top))
         return need
 
     def learn_roof(
@@ -302,9 +304,12 @@ class SearchMission(FlightMission):
         a = (here[0], here[1])
         return max(
             (
-                self._clear_of(upper_m)
-                for footprint, upper_m in self.unknown.values()
-                if segment_polygon_distance(a, there, footprint) <= margin_m
+                self._clear_of(top)
+                for top in (
+                    place.top_m(lambda ring: segment_polygon_distance(a, there, ring) <= margin_m)
+                    for place in self.unknown.values()
+                )
+                if top is not None
             ),
             default=0.0,
         )

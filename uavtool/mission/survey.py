@@ -75,6 +75,8 @@ class Obstacle:
     footprint: tuple[tuple[float, float], ...]
     upper_m: float
     """The highest its roof may be (``roof_m`` when measured)."""
+    bands: tuple[tuple[tuple[tuple[float, float], ...], float], ...] = ()
+    """Where it stands for each range of heights, when not measured (`Unknown.bands`)."""
 
     @property
     def height_m(self) -> float:

@@ -12,7 +12,7 @@ a building of unknown height too.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -27,12 +27,27 @@ from uavtool.vision import Shape
 from uavtool.vision.params import VectorizeParams
 from uavtool.vision.vectorize import ground_mask, hue_distance_deg, non_ground
 
+Ring = tuple[tuple[float, float], ...]
+
 
 class Unknown(NamedTuple):
     """Where a building of unknown height may stand, and the highest its roof may be."""
 
-    footprint: tuple[tuple[float, float], ...]
+    footprint: Ring
     upper_m: float
+    bands: tuple[tuple[Ring, float], ...] = ()
+    """Where it stands for each range of heights still possible, with that range's top. A
+    building as high as ``h`` stands under its roof's outline at ``h``, and the outline of a
+    roof seen from one camera slides toward that camera's nadir as the roof is placed
+    higher: over any one place only the heights that put the building there count. Empty:
+    anywhere in ``footprint``, up to ``upper_m``."""
+
+    def top_m(self, near: Callable[[Ring], bool]) -> float | None:
+        """The highest this building may stand where ``near`` holds of where it would stand
+        (None: nowhere)."""
+        if not self.bands:
+            return self.upper_m if near(self.footprint) else None
+        return max((top for ring, top in self.bands if near(ring)), default=None)
 
 
 def footprint_at(shape: Shape, photo: Photo, roof_m: float) -> tuple[tuple[float, float], ...]:
@@ -62,7 +77,7 @@ def unknown_place(
     region = region_of(shape, regions)
     if region is None:
         return place
-    if region.cut_by_border:
+    if region.cut_by_border:  # a higher roof may lie beyond the frame, anywhere in it
         return Unknown(place.footprint, tallest_m)
     whole = unknown_roof(
         region, photo, tallest_m, others, hue_tolerance_deg=tol, own_rgb=shape.colour_rgb
@@ -70,6 +85,7 @@ def unknown_place(
     return Unknown(
         tuple(convex_hull([*place.footprint, *whole.footprint])),
         max(place.upper_m, whole.upper_m),
+        place.bands + whole.bands,
     )
 
 
@@ -97,7 +113,7 @@ def region_of(shape: Shape, regions: Sequence[Shape]) -> Shape | None:
 class Known(NamedTuple):
     """A roof of measured height: where it stands (ENU metres), how high, and its colour."""
 
-    footprint: tuple[tuple[float, float], ...]
+    footprint: Ring
     roof_m: float
     colour_rgb: tuple[int, int, int]
 
@@ -188,7 +204,23 @@ def unknown_roof(
         if kept:  # every height ruled out: the photos disagree, keep them all
             feet, heights = [f for f, _ in kept], [h for _, h in kept]
     upper = min(max(heights) + _HEIGHT_STEP_M, tallest_m)
-    return Unknown(tuple(convex_hull([p for f in feet for p in f])), upper)
+    # a roof between two planes lies between their outlines: each plane left stands for the
+    # heights a step either side of it
+    bands = tuple(
+        (
+            tuple(
+                convex_hull(
+                    [
+                        *footprint_at(shape, photo, max(h - step_m, 0.0)),
+                        *footprint_at(shape, photo, min(h + step_m, tallest_m)),
+                    ]
+                )
+            ),
+            min(h + step_m, tallest_m),
+        )
+        for h in heights
+    )
+    return Unknown(tuple(convex_hull([p for f in feet for p in f])), upper, bands)
 
 
 _HEIGHT_STEP_M = 2.0
