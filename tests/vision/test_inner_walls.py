@@ -1,6 +1,7 @@
 """`inner_walls` finds exactly the strips the plain numpy definition does: a pixel inside the
 roof whose colour differs from the roof's by more than twice the tolerance in some channel,
-of the roof's hue, touching no ground (its faster mask must not move a single pixel)."""
+of the roof's paint (its hue and saturation), touching no ground (its faster mask must not
+move a single pixel)."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from uavtool.vision.shapes import Shape
-from uavtool.vision.vectorize import ground_mask, inner_walls, roof_inside
+from uavtool.vision.vectorize import ground_mask, inner_walls, roof_inside, same_paint
 
 GROUND = (128, 128, 128)
 
@@ -27,7 +28,11 @@ def _reference(frame: npt.NDArray[np.uint8], shape: Shape, tolerance_dn: int) ->
         alike = hsv[:, :, 1] < 40
     else:
         d = np.abs(hsv[:, :, 0].astype(np.int16) - int(roof_hsv[0]))
-        alike = (np.minimum(d, 180 - d) <= 8) & (hsv[:, :, 1] >= 40)
+        sat = hsv[:, :, 1].astype(np.int32)
+        spread = (3 * 255 * 15) // np.maximum(hsv[:, :, 2].astype(np.int32), 1)
+        alike = (
+            (np.minimum(d, 180 - d) <= 8) & (sat >= 40) & (np.abs(sat - int(roof_hsv[1])) <= spread)
+        )
     strips = (inside > 0) & other & alike
     ground = ground_mask(frame, tolerance_dn=tolerance_dn)
     near_ground = cv2.dilate(ground, np.ones((5, 5), np.uint8)) > 0
@@ -95,3 +100,21 @@ def test_a_wall_whose_foot_stands_on_the_roof_is_kept_though_its_end_nears_the_g
     kept = inner_walls(frame, shape, nadir_px=(95.0, 50.0))
     assert len(kept) == 1
     assert set(kept[0][:, 0].tolist()) == {60, 61, 62, 63}
+
+
+def test_a_shade_is_its_paint_and_a_paint_of_the_same_hue_is_not() -> None:
+    """Light scales every channel of a face alike, so a wall keeps its roof's hue and
+    saturation, at any shade down to dark, with noise. A pale ground of the roof's hue
+    (pink under a red roof) has the hue and not the saturation: not the roof's paint where
+    it is bright enough for noise not to blur the two (in the dark, a channel's noise moves
+    the saturation by more than they differ)."""
+    rng = np.random.default_rng(3)
+    red = (210, 40, 40)
+    factors = np.repeat(np.linspace(0.3, 1.0, 64)[None, :, None], 16, axis=0)
+    shades = factors * np.array(red, float)
+    noisy = np.clip(shades + rng.normal(0.0, 3.0, shades.shape), 0, 255).astype(np.uint8)
+    assert same_paint(noisy, red).all()
+    pink = (np.linspace(0.8, 1.0, 64)[None, :, None] * np.array((150, 100, 95), float)).repeat(
+        16, axis=0
+    )
+    assert not same_paint(pink.round().astype(np.uint8), red).any()

@@ -41,7 +41,7 @@ def lies_on_ground(
     if not others:
         return False
     region = outline_mask(photo.image_rgb, shape)
-    if shows_walls(photo, region, shape.colour_rgb, least_px=m.params.vectorize.min_edge_px):
+    if shows_walls(photo, shape, shape.colour_rgb, least_px=m.params.vectorize.min_edge_px):
         return False
     least = m.params.vectorize.min_area_px
     if one_colour:
@@ -73,7 +73,7 @@ def measured_flat(
     and shows no walls (`shows_walls`, at least ``least_px`` pixels of them): a lawn, a
     painted area, measured like a roof, is ground."""
     region = outline_mask(photo.image_rgb, shape)
-    if shows_walls(photo, region, shape.colour_rgb, least_px=least_px):
+    if shows_walls(photo, shape, shape.colour_rgb, least_px=least_px):
         return False
     least = least_telling_m(
         region,
@@ -86,14 +86,18 @@ def measured_flat(
 
 
 def shows_walls(
-    photo: Photo, region: CvArray, colour_rgb: tuple[int, int, int], *, least_px: float
+    photo: Photo, shape: Shape, colour_rgb: tuple[int, int, int], *, least_px: float
 ) -> bool:
-    """Whether at least ``least_px`` pixels just around ``region`` (a mask over ``photo``)
-    show another shade of its colour: a building's walls, which perspective shows beside
-    its roof (unless it stands straight below the camera). What lies on the ground has none;
-    a lawn beside a building of its hue seems to, and is not taken for ground."""
+    """Whether at least ``least_px`` pixels just outside ``shape``'s outer outline (in
+    ``photo``) show another shade of its colour: a building's walls, which perspective shows
+    beside its roof (unless it stands straight below the camera). What lies on the ground has
+    none; a lawn beside a building of its hue seems to, and is not taken for ground. Inside
+    its holes stands whatever they hold: a courtyard's walls, or a building standing on a
+    lawn or a ground of its hue, whose walls are its own."""
+    outer = np.zeros(photo.image_rgb.shape[:2], np.uint8)
+    cv2.fillPoly(outer, [np.round(shape.polygon_px).astype(np.int32).reshape(-1, 1, 2)], 255)
     kernel = np.ones((2 * _WALL_BAND_PX + 1, 2 * _WALL_BAND_PX + 1), np.uint8)
-    band = cv2.subtract(cv2.dilate(region, kernel), region)
+    band = cv2.subtract(cv2.dilate(outer, kernel), outer)
     walls = (band > 0) & same_paint(photo.image_rgb, colour_rgb) & (_near(photo, colour_rgb) == 0)
     return int(np.count_nonzero(walls)) >= least_px
 

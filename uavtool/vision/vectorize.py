@@ -409,7 +409,9 @@ def enclosed_openings(
 
 def same_paint(frame_rgb: U8Array, colour_rgb: tuple[int, int, int]) -> npt.NDArray[np.bool_]:
     """Where ``frame_rgb`` shows ``colour_rgb``'s paint in any shade: its hue (within
-    `_WALL_HUE_HALF_DEG`), or grey for a grey. A wall is its roof's colour, shaded."""
+    `_WALL_HUE_HALF_DEG`) and its saturation (within what `_SHADE_NOISE_DN` of noise in each
+    channel makes of it at the pixel's brightness), or grey for a grey. A wall is its roof's
+    colour shaded: one factor on every channel, which keeps both."""
     frame = _check_frame(frame_rgb)
     hsv = cv2.cvtColor(frame, cv2.COLOR_RGB2HSV)
     own = cv2.cvtColor(np.array([[colour_rgb]], np.uint8), cv2.COLOR_RGB2HSV)[0, 0]
@@ -417,8 +419,13 @@ def same_paint(frame_rgb: U8Array, colour_rgb: tuple[int, int, int]) -> npt.NDAr
         grey: npt.NDArray[np.bool_] = hsv[:, :, 1] < _GREY_SATURATION
         return grey
     d = np.abs(hsv[:, :, 0].astype(np.int16) - int(own[0]))
-    alike: npt.NDArray[np.bool_] = (np.minimum(d, 180 - d) <= _WALL_HUE_HALF_DEG) & (
-        hsv[:, :, 1] >= _GREY_SATURATION
+    saturation = hsv[:, :, 1].astype(np.int32)
+    # S = (max - min) / max moves by at most 3 n / V for n of noise in each channel
+    spread = (3 * 255 * _SHADE_NOISE_DN) // np.maximum(hsv[:, :, 2].astype(np.int32), 1)
+    alike: npt.NDArray[np.bool_] = (
+        (np.minimum(d, 180 - d) <= _WALL_HUE_HALF_DEG)
+        & (saturation >= _GREY_SATURATION)
+        & (np.abs(saturation - int(own[1])) <= spread)
     )
     return alike
 
@@ -433,6 +440,9 @@ _GREY_SATURATION = 40
 _WALL_HUE_HALF_DEG = 8
 """How far (OpenCV hue units, 2° each) a wall's hue may lie from its roof's: a wall is the
 roof's colour, shaded."""
+_SHADE_NOISE_DN = 15
+"""How far a shade's channels may lie from its paint's, shaded exactly (`ground_mask`'s
+tolerance): rounding, sensor noise and texture."""
 
 
 def _ring(points: FloatArray) -> CvArray:
