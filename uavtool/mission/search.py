@@ -19,6 +19,7 @@ from uavtool.mission.analysis import (
     aimed_shape,
     judge,
     nadir_shapes,
+    quartile_edge_share,
     roof_between,
     side_shapes,
 )
@@ -233,13 +234,31 @@ def inspect(
                 if look.judgement.candidate >= 0
             ]
             closer = _closer_look(m, looks[-1], before, poi.shape_index)
-        if closer is not None:
-            pos, roof_m = closer
+        elif looks[-1].judgement.too_small:
+            closer = _closer_look(m, looks[-1], [], poi.shape_index, roof_m)
+        step = None if closer is not None or upper is None else _step_down(m, looks[-1], upper)
+        if step is not None:
             m.event(
                 Level.INFO,
-                f"point of interest {k}: score {looks[-1].judgement.score:.3f} just below "
-                f"the threshold; its roof measured {roof_m:.1f} m above home: looking "
-                f"again from closer, at {pos[2]:.1f} m",
+                f"point of interest {k}: drawn too small to judge; its roof not measured (at "
+                f"most {upper:.1f} m above home): looking again from straight above it, at "
+                f"{step[2]:.1f} m",
+            )
+            yield from m.travel(step, None, transit_m, f"point of interest {k}, look {n}")
+            looks.append((yield from _look(m, k, n, step[2], poi.colour_rgb)))
+            continue
+        if closer is not None:
+            pos, roof_m = closer
+            j = looks[-1].judgement
+            why = (
+                "drawn too small to judge"
+                if j.too_small
+                else f"score {j.score:.3f} just below the threshold"
+            )
+            m.event(
+                Level.INFO,
+                f"point of interest {k}: {why}; its roof measured {roof_m:.1f} m above home: "
+                f"looking again from closer, at {pos[2]:.1f} m",
             )
             yield from m.travel(pos, None, transit_m, f"point of interest {k}, look {n}")
             looks.append((yield from _look(m, k, n, pos[2], poi.colour_rgb)))
@@ -546,17 +565,21 @@ def _look(
 
 
 def _closer_look(
-    m: SearchMission, look: _Look, before: list[tuple[Shape, Photo]], index: int
+    m: SearchMission,
+    look: _Look,
+    before: list[tuple[Shape, Photo]],
+    index: int,
+    roof_m: float | None = None,
 ) -> tuple[Vec3, float] | None:
-    """Where to look again from, lower, and the roof height measured, when the look was
-    taken high over a roof of unknown height (assumed the tallest expected) and its
-    candidate has the target's hue and scores just below the threshold, or is drawn too small
-    to judge: the candidate,
-    whole in the look and in an earlier photo of it (``before``: the overview's shape, the
-    earlier looks' candidates; the one furthest in altitude that tells), gives its roof's
-    height, and from it the altitude at which it fills the photo as a look should. None
-    when that is not clearly lower (by half ``recheck_climb_m``) or the height cannot be
-    told."""
+    """Where to look again from, lower, and the roof height, when the look's candidate has
+    the target's hue and is drawn too small to judge, or (a roof of unknown height, looked
+    at from over the tallest it may be) scores just below the threshold. The roof is
+    ``roof_m`` when measured; else the candidate, whole in the look and in an earlier photo
+    of it (``before``: the overview's shape, the earlier looks' candidates; the one
+    furthest in altitude that tells), gives its height. The altitude is where the candidate
+    fills the photo as a look should or, drawn too small, where it is drawn as large as
+    judging it needs (`_resolving_altitude_m`). None when that is not clearly lower (by
+    half ``recheck_climb_m``) or the height cannot be told."""
     p = m.params.mission
     j, photo = look.judgement, look.photo
     if j.matched or j.candidate < 0 or not j.same_hue or _other_outline(j):
@@ -565,24 +588,84 @@ def _closer_look(
         return None  # a score from too far says nothing: only from closer
     shape = look.shapes[j.candidate]
     alt = photo.pose.pos_enu_m[2]
-    heights = (
-        roof_between(seen, earlier, shape, photo)
-        for seen, earlier in sorted(before, key=lambda b: -abs(b[1].pose.pos_enu_m[2] - alt))
-    )
-    roof = next((h for h in heights if h is not None), None)
-    if roof is None or roof > p.assumed_roof_m:
-        return None
+    roof = roof_m
+    if roof is None:
+        heights = (
+            roof_between(seen, earlier, shape, photo)
+            for seen, earlier in sorted(before, key=lambda b: -abs(b[1].pose.pos_enu_m[2] - alt))
+        )
+        roof = next((h for h in heights if h is not None), None)
+        if roof is None or roof > p.assumed_roof_m:
+            return None
     k = photo.intrinsics
-    ring = ground_polygon(shape.polygon_px, photo.pose, k, plane_z_m=min(roof, look.alt_m - 1))
-    m.learn_roof(index, ring, roof)  # measured: a look may now descend near it
+    plane = min(roof, look.alt_m - 1)
+    ring = ground_polygon(shape.polygon_px, photo.pose, k, plane_z_m=plane)
+    if roof_m is None:
+        m.learn_roof(index, ring, roof)  # measured: a look may now descend near it
     extent = math.dist(*_farthest_pair(ring))
     fit = fit_altitude_m(roof_m=roof, extent_m=extent, intrinsics=k, fill=p.look_fill)
+    if j.too_small:
+        fit = min(fit, _resolving_altitude_m(m, shape, alt, roof, extent, k))
     lower = max(fit, roof + p.min_above_roof_m)
+    u, v = shape.centroid_px
+    x, y = ground_point(u, v, photo.pose, k, plane_z_m=plane)
+    lower = max(lower, m.floor_at(x, y))
     if lower > look.alt_m - p.recheck_climb_m / 2.0:
         return None
-    u, v = shape.centroid_px
-    x, y = ground_point(u, v, photo.pose, k, plane_z_m=min(roof, look.alt_m - 1))
-    return (x, y, max(lower, m.floor_at(x, y))), roof
+    return (x, y, lower), roof
+
+
+def _step_down(m: SearchMission, look: _Look, upper_m: float) -> Vec3 | None:
+    """Where to look again from when the look's candidate, of the target's hue, is drawn
+    too small to judge and its roof's height is not known, only the highest it may be
+    (``upper_m``): over where it stands were it that high, as low as keeps it whole in the
+    photo (filling at most ``mission.top_fill`` of it) whatever its height, and no lower
+    than the floor there. Its size in the two photos then tells its height, and the new
+    photo draws it larger. None when that is not clearly lower (by half
+    ``recheck_climb_m``)."""
+    p = m.params.mission
+    j, photo = look.judgement, look.photo
+    if j.matched or j.candidate < 0 or not j.same_hue or not j.too_small:
+        return None
+    shape = look.shapes[j.candidate]
+    if shape.cut_by_border:
+        return None
+    k = photo.intrinsics
+    alt = photo.pose.pos_enu_m[2]
+    top = min(upper_m, alt - 1.0)
+    span_px = math.dist(*_farthest_pair(tuple(map(tuple, shape.polygon_px))))
+    # drawn largest, were its roof as high as it may be: span_px (alt - top) / (z - top)
+    z = top + (alt - top) * span_px / (p.top_fill * min(k.width_px, k.height_px))
+    try:
+        x, y = ground_point(*shape.centroid_px, photo.pose, k, plane_z_m=top)
+        low = ground_point(*shape.centroid_px, photo.pose, k, plane_z_m=0.0)
+    except NavError:
+        return None
+    z = max(z, top + p.min_above_roof_m, m.floor_at(x, y), m.floor_at(*low))
+    if z > alt - p.recheck_climb_m / 2.0:
+        return None
+    return (x, y, z)
+
+
+def _resolving_altitude_m(
+    m: SearchMission, shape: Shape, alt_m: float, roof_m: float, extent_m: float, k: Intrinsics
+) -> float:
+    """The altitude at which ``shape`` (drawn too small to judge from ``alt_m``, its roof at
+    ``roof_m``) is drawn as large as the target picture draws the target: then its outline
+    leaves out nothing the target picture shows (`hides_detail`), and the target's edges are
+    edges at its size (`quartile_edge_share`). Never closer than where it fills
+    ``mission.top_fill`` of the photo."""
+    p = m.params
+    need_px = max(
+        math.sqrt(max(m.target.area_px, 0.0)),
+        p.vectorize.min_edge_px / max(quartile_edge_share(m.target), 1e-9),
+    )
+    drawn_px = math.sqrt(max(shape.area_px, 1.0))
+    resolving = roof_m + (alt_m - roof_m) * drawn_px / need_px
+    tightest = fit_altitude_m(
+        roof_m=roof_m, extent_m=extent_m, intrinsics=k, fill=p.mission.top_fill
+    )
+    return max(resolving, tightest)
 
 
 def _other_outline(j: Judgement) -> bool:
