@@ -13,7 +13,7 @@ import pytest
 from uavtool.camera import CameraPose, Intrinsics, project
 from uavtool.nav.parallax import on_ground, plane_homography
 from uavtool.world import Block, Building, load_scene, render
-from uavtool.world.ground import GroundArea
+from uavtool.world.ground import GroundArea, GroundTexture, TextureKind
 
 K = Intrinsics.from_hfov(width_px=640, height_px=480)
 LOW = CameraPose((0.0, 0.0, 45.0), 0.0, -90.0)
@@ -75,6 +75,54 @@ def test_a_height_the_other_photo_cannot_show_is_not_ruled_out() -> None:
     alone (a 15 m tower whose roof it does not show once was)."""
     low, high = _photos((-22.0, 4.0), (30.0, 20.0), 6.0, LOW)
     assert _ground(_region(_at(-22.0, 4.0), 0.0), low, high, LOW) is None
+
+
+TEAL = (39, 115, 114)
+
+
+def _field(texture: GroundTexture | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A teal ground as wide as the frame, with towers 12-30 m tall standing on it near
+    home, photographed from LOW and HIGH; and the ground's pixels in HIGH's photo."""
+    towers = tuple(
+        Building(f"t{i}", colour, (Block(_at(x, y), 0.0, top),))
+        for i, (x, y, top, colour) in enumerate(
+            [
+                (-14.0, 6.0, 30.0, (200, 60, 60)),
+                (8.0, 10.0, 22.0, (60, 60, 200)),
+                (-6.0, -16.0, 12.0, (220, 200, 40)),
+                (12.0, -8.0, 26.0, (150, 60, 190)),
+            ]
+        )
+    )
+    scene = dataclasses.replace(
+        load_scene("paper"),
+        buildings=towers,
+        target="t0",
+        ground_rgb=TEAL,
+        ground_texture=texture,
+    )
+    low, high = render(scene, LOW, K), render(scene, HIGH, K)
+    near = np.all(np.abs(high.astype(np.int16) - TEAL) <= 30, axis=2)
+    return low, high, near.astype(np.uint8) * 255
+
+
+def _field_ground(texture: GroundTexture | None) -> bool | None:
+    low, high, region = _field(texture)
+    return on_ground(region, TEAL, high, HIGH, low, LOW, K, top_m=44.0, least_px=60.0)
+
+
+def test_a_textured_ground_as_wide_as_the_frame_is_ground_by_its_grain() -> None:
+    """A ground of a colour fills the frame: it has no edge of its own to line up, and the
+    towers standing on it, each at its own height, weigh more on the average misfit than
+    the ground's height does. Its grain lines up at the ground only: that tells."""
+    grain = GroundTexture(TextureKind.NOISE, 10.0, 2.0, 11)
+    assert _field_ground(grain) is True
+
+
+def test_a_ground_as_wide_as_the_frame_without_grain_is_not_called_ground() -> None:
+    """The same field in one flat colour: nothing in it lines up at one height rather than
+    another (the towers only misalign it), so no answer is ground."""
+    assert _field_ground(None) is not True
 
 
 def test_the_ground_plane_maps_a_ground_point_to_itself() -> None:

@@ -36,6 +36,10 @@ STOREY_M = 3.0
 """The lowest a building stands: one storey. A region the photos can tell from a plane this
 high (or lower) only is on the ground if it fits the ground best; where they cannot tell
 even that, it may be a building."""
+GRAIN_RATIO = 0.5
+"""How much less a textured surface's pixels must differ lined up than misaligned, at the
+median, for its grain to tell its height. Lined up, two photos differ by their noise n;
+misaligned, by the grain g as well: sqrt(n² + g²). Half: a grain of at least sqrt(3) n."""
 _NEAR_DN = 30
 """How far (per channel) the other photo's pixel may be from the region's colour: flat
 shading is one colour per face, and a ground texture or sensor noise a few levels."""
@@ -85,10 +89,11 @@ def on_ground(
     ones = np.full(other.shape[:2], 255, np.uint8)
     shift = np.array([[1.0, 0.0, -x0], [0.0, 1.0, -y0], [0.0, 0.0, 1.0]])
 
-    def misfit(z: float) -> float | None:
-        """How far, on average, the other photo carried as the plane z is from this one
-        over the region's pixels (of those it shows at all): a flat surface's edges, and
-        the grain of a textured ground, line up only at their own height."""
+    def misfit(z: float) -> tuple[float, float] | None:
+        """How far the other photo carried as the plane z is from this one over the
+        region's pixels (of those it shows at all), on average and at the median: a flat
+        surface's edges, and the grain of a textured ground, line up only at their own
+        height."""
         try:
             hom = shift @ plane_homography(other_pose, pose, intrinsics, z)
         except NavError:
@@ -99,18 +104,27 @@ def on_ground(
         shown = cv2.countNonZero(seen)
         if shown < least_px:
             return None  # the other photo shows too little of it
-        differ = cv2.absdiff(here, carried).astype(np.float64).sum(axis=2)
-        return float(differ[seen > 0].sum()) / shown
+        differ = cv2.absdiff(here, carried).astype(np.float64).sum(axis=2)[seen > 0]
+        return float(differ.sum()) / shown, float(np.median(differ))
 
     ground = misfit(0.0)
     if ground is None:
         return None
     # every height it may stand at must be tried: one the other photo cannot show it at
     # (carried out of its frame) might be the one that fits
-    fits = [misfit(z) for z in HEIGHTS_M if least <= z <= top_m]
+    heights = [z for z in HEIGHTS_M if least <= z <= top_m]
+    fits = [misfit(z) for z in heights]
     if not fits or any(f is None for f in fits):
         return None
-    return ground < min(f for f in fits if f is not None)
+    tried = [(z, f) for z, f in zip(heights, fits, strict=True) if f is not None]
+    if ground[0] < min(f[0] for _, f in tried):
+        return True
+    # A region as wide as the frame has little edge, and what stands on it (buildings,
+    # each drawn at its own height) weighs on the average: its grain tells, at the median,
+    # when lined up it differs less than half as much as carried as any building's height
+    # (a storey and up) would misalign it: a grain standing out of the noise.
+    storeys = [f[1] for z, f in tried if z >= STOREY_M]
+    return bool(storeys) and ground[1] < GRAIN_RATIO * min(storeys)
 
 
 def _near(image: npt.NDArray[np.uint8], rgb: tuple[int, int, int]) -> CvArray:
