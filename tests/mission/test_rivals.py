@@ -238,3 +238,34 @@ def test_the_top_photo_ends_a_match_that_it_shows_to_be_another_building(
     assert ended.value.status is Status.NO_MATCH
     assert why in ended.value.reason and "top photo, closer" in ended.value.reason
     assert mission.matched_poi == -1
+
+
+def test_a_small_target_of_unknown_height_is_looked_at_from_straight_above_it() -> None:
+    """World scene 50001 (every world knob on): the small L target is a roof of unknown
+    height, seen from 111 m over the tallest it may be, 18 px across: too small to judge.
+    Straight above it nothing else stands, so the next look descends over it, as low as
+    keeps it whole whatever its height, and matches; the mirror decoy and the near shape
+    (an arm shorter) are not taken for it."""
+    events: list[str] = []
+    summary = fly_scene(
+        FlyConfig(scene=str(DATA / "world-50001.yaml"), no_record=True),
+        progress=lambda e, _t: events.append(e),
+    )
+    assert any("looking again from straight above it" in e for e in events), events
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == summary.evaluation.target_building == "b00"
+
+
+def test_a_textured_ground_of_a_colour_does_not_hold_every_look_up() -> None:
+    """World scene 50042: a teal ground with a grain fills the frame. Taken for a building of
+    unknown height, it stood everywhere up to just below the camera, and every look stayed
+    over 74 m: the target, drawn too small, was never judged. Its grain lines up at the
+    ground only: it is ground, the looks descend, and the target is found."""
+    events: list[str] = []
+    summary = fly_scene(
+        FlyConfig(scene=str(DATA / "world-50042.yaml"), no_record=True),
+        progress=lambda e, _t: events.append(e),
+    )
+    assert any("lie on the ground" in e for e in events), events
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == summary.evaluation.target_building == "b07"

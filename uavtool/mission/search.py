@@ -236,13 +236,16 @@ def inspect(
             closer = _closer_look(m, looks[-1], before, poi.shape_index)
         elif looks[-1].judgement.too_small:
             closer = _closer_look(m, looks[-1], [], poi.shape_index, roof_m)
-        step = None if closer is not None or upper is None else _step_down(m, looks[-1], upper)
-        if step is not None:
+        still = None if poi.roof_measured else m.unknown.get(poi.shape_index)
+        step = None
+        if closer is None and still is not None:
+            step = _step_down(m, looks[-1], still.upper_m)
+        if step is not None and still is not None:
             m.event(
                 Level.INFO,
                 f"point of interest {k}: drawn too small to judge; its roof not measured (at "
-                f"most {upper:.1f} m above home): looking again from straight above it, at "
-                f"{step[2]:.1f} m",
+                f"most {still.upper_m:.1f} m above home): looking again from straight above "
+                f"it, at {step[2]:.1f} m",
             )
             yield from m.travel(step, None, transit_m, f"point of interest {k}, look {n}")
             looks.append((yield from _look(m, k, n, step[2], poi.colour_rgb)))
@@ -529,6 +532,7 @@ def _look(
     """Look ``n`` at point of interest ``k`` (a building of colour ``aimed_rgb``): a nadir
     photo, judged and reported."""
     photo = yield from m.photo(f"poi-{k}" if n == 1 else f"poi-{k}-{n}", -90.0)
+    m.place_again(photo)
     shapes = photo_shapes(m, photo)
     j = judge(
         m.params,

@@ -110,6 +110,16 @@ def region_of(shape: Shape, regions: Sequence[Shape]) -> Shape | None:
     return best if area > 0 and 2 * best_n >= area else None
 
 
+@dataclass(frozen=True, slots=True)
+class Placing:
+    """How a photo taken after the survey places the buildings of unknown height again: its
+    evidence of free space (`evidence`, with the roofs measured by then), and, per building
+    (by the mission's key), where it may stand given more evidence."""
+
+    evidence_of: Callable[[Photo], Evidence]
+    again: dict[int, Callable[[Sequence[Evidence]], Unknown]]
+
+
 class Known(NamedTuple):
     """A roof of measured height: where it stands (ENU metres), how high, and its colour."""
 

@@ -121,6 +121,15 @@ def segments_intersect(a: Point, b: Point, c: Point, d: Point) -> bool:
     )
 
 
+def polygons_overlap(a: Sequence[Point], b: Sequence[Point]) -> bool:
+    """Whether two polygons' closed areas share any point."""
+    if len(a) < 3 or len(b) < 3:
+        return False
+    if any(segments_intersect(p, q, r, t) for p, q in _edges(a) for r, t in _edges(b)):
+        return True
+    return point_in_polygon(a[0], b) or point_in_polygon(b[0], a)
+
+
 def _in_triangle(p: Point, tri: Sequence[Point]) -> bool:
     c1, c2, c3 = cross(tri[0], tri[1], p), cross(tri[1], tri[2], p), cross(tri[2], tri[0], p)
     return (c1 >= 0.0 and c2 >= 0.0 and c3 >= 0.0) or (c1 <= 0.0 and c2 <= 0.0 and c3 <= 0.0)
