@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from uavtool.camera import CameraPose, Intrinsics, project
@@ -63,3 +65,17 @@ def test_a_tower_merged_with_one_behind_it_is_cut_back_to_where_it_stands() -> N
     (cut,) = _in_line((merged, beside), rect, photo, 30.0, clip=True)
     assert not cut.cut_by_border and cut_edges((cut,), K) == set()
     assert cut.polygon_px[:, 1].min() > v0 - 0.11 * max(u1 - u0, v1 - v0) - 1.0
+
+
+def test_a_viewpoint_a_look_down_shows_blocked_is_planned_again_around_what_it_showed() -> None:
+    """World scene 50095: the right viewpoint lies beyond the ground the overview saw, and
+    the look down from the ceiling shows a building 2.9 m from it. The side is planned
+    again around what that photo showed, from elsewhere, and the model is built."""
+    events: list[str] = []
+    data = Path(__file__).parent / "data" / "world-50095.yaml"
+    summary = fly(
+        FlyConfig(scene=str(data), no_record=True), progress=lambda e, _t: events.append(e)
+    )
+    assert any("planned again around the" in e for e in events), events
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == summary.evaluation.target_building

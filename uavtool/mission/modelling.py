@@ -31,6 +31,7 @@ from uavtool.nav import (
     plan_viewpoints,
     top_viewpoint,
 )
+from uavtool.nav.geometry import polygons_overlap
 from uavtool.nav.heights import fit_altitude_m
 from uavtool.nav.viewpoints import farther, for_building
 from uavtool.vision import Shape
@@ -214,15 +215,37 @@ def photograph_and_model(
     )
     views: dict[str, View] = {}
     taken: dict[str, Viewpoint] = {}
-    for vp in (front, right):
-        if isinstance(vp, ViewpointFailure):
-            m.event(Level.WARNING, f"{vp.name} viewpoint impossible: {vp.reason}")
-            continue
-        if vp.fallback:
-            m.event(Level.INFO, f"{vp.name} viewpoint: {vp.fallback}")
-        got = yield from side_view(m, sides, vp, obj.colour_rgb)
-        if got is not None:
-            views[vp.name], taken[vp.name] = got
+    planned = {"front": front, "right": right}
+    for name in ("front", "right"):
+        for _ in range(p.max_looks):
+            vp = planned[name]
+            if isinstance(vp, ViewpointFailure):
+                m.event(Level.WARNING, f"{vp.name} viewpoint impossible: {vp.reason}")
+                break
+            if vp.fallback:
+                m.event(Level.INFO, f"{vp.name} viewpoint: {vp.fallback}")
+            got = yield from side_view(m, sides, vp, obj.colour_rgb)
+            if got is not None:
+                views[name], taken[name] = got
+                break
+            # the look down from the ceiling showed a building near it: planned again
+            # around what it showed (the right photo still apart from the front's heading)
+            below = _seen_below(m, sides)
+            if not below:
+                break
+            sides.obstacles += below
+            sides.cautious += below
+            if sides.heights:
+                sides.heights += [math.inf] * len(below)
+            again = plan_viewpoints(
+                rect, sides.obstacles, top_photo.intrinsics, sides.params, sides.heights, apart
+            )
+            planned = {"front": taken.get("front", again[0]), "right": again[1]}
+            m.event(
+                Level.INFO,
+                f"{name} viewpoint: planned again around the {len(below)} building(s) the look "
+                "down showed",
+            )
 
     missing = [name for name in ("front", "right") if name not in views]
     if missing:
@@ -266,6 +289,20 @@ def photograph_and_model(
         Level.INFO,
         f"model built: height {model.height_m:.2f} m, volume {model.volume_m3:.1f} m³",
     )
+
+
+def _seen_below(m: SearchMission, sides: SidePlan) -> list[tuple[tuple[float, float], ...]]:
+    """What the last look down from the ceiling showed standing (each region carried to the
+    ground, holding its footprint) that the side photos are not yet planned around; never
+    the target itself."""
+    if not m.peeks:
+        return []
+    target = list(sides.rect.corners())
+    return [
+        ring
+        for ring in m.peeks[-1].buildings
+        if len(ring) >= 3 and not polygons_overlap(ring, target) and ring not in sides.obstacles
+    ]
 
 
 def _side_params(m: SearchMission, roof_m: float) -> ViewpointParams:
