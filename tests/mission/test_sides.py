@@ -68,11 +68,11 @@ def test_a_tower_merged_with_one_behind_it_is_cut_back_to_where_it_stands() -> N
 
 
 def test_a_viewpoint_a_look_down_shows_blocked_is_planned_again_around_what_it_showed() -> None:
-    """World scene 50095: the right viewpoint lies beyond the ground the overview saw, and
-    the look down from the ceiling shows a building 2.9 m from it. The side is planned
+    """World scene 50293: a side viewpoint lies beyond the ground the overview saw, and
+    the look down from the ceiling shows a building 2.4 m from it. The side is planned
     again around what that photo showed, from elsewhere, and the model is built."""
     events: list[str] = []
-    data = Path(__file__).parent / "data" / "world-50095.yaml"
+    data = Path(__file__).parent / "data" / "world-50293.yaml"
     summary = fly(
         FlyConfig(scene=str(data), no_record=True), progress=lambda e, _t: events.append(e)
     )

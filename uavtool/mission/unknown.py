@@ -42,6 +42,20 @@ class Unknown(NamedTuple):
     higher: over any one place only the heights that put the building there count. Empty:
     anywhere in ``footprint``, up to ``upper_m``."""
 
+    def slices(self, count: int) -> list[tuple[Ring, float]]:
+        """Where it stands and how high, in at most ``count`` pieces of its ``bands`` (each
+        the hull of neighbouring heights' places, as high as the highest of them): an
+        obstacle a camera may see over where it stands low. Without bands, ``footprint`` up
+        to ``upper_m``."""
+        if not self.bands:
+            return [(self.footprint, self.upper_m)]
+        size = -(-len(self.bands) // max(count, 1))
+        groups = [self.bands[i : i + size] for i in range(0, len(self.bands), size)]
+        return [
+            (tuple(convex_hull([p for ring, _ in group for p in ring])), max(t for _, t in group))
+            for group in groups
+        ]
+
     def top_m(self, near: Callable[[Ring], bool]) -> float | None:
         """The highest this building may stand where ``near`` holds of where it would stand
         (None: nowhere)."""
