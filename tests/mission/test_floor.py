@@ -3,14 +3,10 @@ safety margin, and no lower than the ceiling near a roof of unknown height."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
 import numpy as np
 
-from uavtool.camera import CameraPose, Intrinsics
 from uavtool.mission import MissionInputs, Params, SearchMission
-from uavtool.mission.observations import Photo
-from uavtool.mission.unknown import Evidence, Placing, Unknown
+from uavtool.mission.unknown import Unknown
 
 
 def _mission() -> SearchMission:
@@ -42,34 +38,3 @@ def test_floor_over_tiers_and_unknown_roofs() -> None:
     assert m.floor_at(33.0, 3.0) == 30.0 + margin
     m.learn_roof(3, where, 8.0)  # a closer look measured it
     assert m.floor_at(18.0, 3.0) == 8.0 + margin
-
-
-def test_a_photo_since_the_survey_places_a_building_of_unknown_height_again() -> None:
-    """A look's photo is evidence of free space: a building of unknown height whose place it
-    sees is placed again with every such photo so far, and may then stand in fewer places;
-    never in more (the photos disagreeing, the placing keeps every height), and a photo that
-    does not see its place is no evidence of it."""
-    m = _mission()
-    margin = m.params.viewpoints.safety_margin_m + m.params.mission.arrive_radius_m
-    where = ((20.0, 0.0), (26.0, 0.0), (26.0, 6.0), (20.0, 6.0))
-    m.unknown = {3: Unknown(where, 60.0, ((where, 60.0),))}
-    calls: list[int] = []
-
-    def again(more: Sequence[Evidence]) -> Unknown:
-        calls.append(len(more))
-        top = 14.0 if len(more) == 1 else 80.0  # the second photo "disagrees"
-        return Unknown(where, top, ((where, top),))
-
-    m.placing = Placing(lambda photo: Evidence(photo, None, ()), {3: again})
-    k = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
-    image = np.zeros((480, 640, 3), np.uint8)
-
-    def photo(x: float, y: float) -> Photo:
-        return Photo(0, 0, "poi-3", 0, CameraPose((x, y, 60.0), 0.0, -90.0), k, image)
-
-    m.place_again(photo(-200.0, 0.0))  # sees nothing of it
-    assert calls == [] and m.floor_at(23.0, 3.0) == 60.0 + margin
-    m.place_again(photo(23.0, 3.0))
-    assert calls == [1] and m.floor_at(23.0, 3.0) == 14.0 + margin
-    m.place_again(photo(20.0, 0.0))
-    assert calls == [1, 2] and m.floor_at(23.0, 3.0) == 14.0 + margin

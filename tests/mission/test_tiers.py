@@ -22,7 +22,6 @@ from uavtool.mission.observations import Photo
 from uavtool.mission.params import Params
 from uavtool.mission.unknown import (
     Known,
-    Unknown,
     evidence,
     region_of,
     unexplained,
@@ -220,22 +219,6 @@ def test_over_any_one_place_only_the_heights_that_put_the_building_there_count()
     assert tops == sorted(tops)  # type: ignore[type-var]
     assert tops[-1] == 111.0
     assert top(-5.0) is None  # past home: nowhere
-
-
-def test_a_building_of_unknown_height_is_planned_around_in_slices_of_its_heights() -> None:
-    """For the side photos, the same tower (seen from over home only) is a few obstacles,
-    each where a range of its heights puts it, as high as that range: every place a height
-    puts it is in the slice as high as that height at least; and a building known nowhere
-    better is one obstacle, as high as it may be anywhere."""
-    home, _over, shape = _tower_photos()
-    place = unknown_roof(shape, home, 111.0)
-    slices = place.slices(6)
-    assert 1 < len(slices) <= 6
-    for ring, top in place.bands:
-        assert any(t >= top and Polygon(r).buffer(1e-6).contains(Polygon(ring)) for r, t in slices)
-    assert max(t for _, t in slices) == place.upper_m
-    bare = Unknown(place.footprint, 111.0)
-    assert bare.slices(6) == [(place.footprint, 111.0)]
 
 
 def _tower_on_a_wing() -> Scene:

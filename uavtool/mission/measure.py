@@ -16,7 +16,6 @@ believed: as an obstacle, too tall is safe and too low is not.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import replace
 from functools import partial
 from typing import TYPE_CHECKING
@@ -37,9 +36,7 @@ from uavtool.mission.survey import (
     same_colour,
 )
 from uavtool.mission.unknown import (
-    Evidence,
     Known,
-    Placing,
     Unknown,
     evidence,
     footprint_at,
@@ -179,10 +176,8 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     views = [evidence(v, known, tolerance_dn=tol) for v in photos]
     hue = m.params.vectorize.hue_tolerance_deg
 
-    def place_of(o: Shape, more: Sequence[Evidence] = ()) -> Unknown:
-        return unknown_place(
-            o, seen.photo, tallest_m, [*views, *more], seen.regions, hue_tolerance_deg=hue
-        )
+    def place_of(o: Shape) -> Unknown:
+        return unknown_place(o, seen.photo, tallest_m, views, seen.regions, hue_tolerance_deg=hue)
 
     # What is not ground and has the target's hue, though the vectorizer kept no roof of it
     # (walls whose roof lies beyond the frame, a darker shade), may be the target: it is a
@@ -258,13 +253,6 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
             for j, o in enumerate(obstacles)
             if not o.measured
         }
-    )
-    # The photos to come are evidence of free space too: with them, each is placed again.
-    again = {i: s for i, s in enumerate(shapes) if i in m.unknown}
-    again.update({-1 - j: o.shape for j, o in enumerate(obstacles) if not o.measured})
-    m.placing = Placing(
-        partial(evidence, known=known, tolerance_dn=tol),
-        {i: partial(place_of, s) for i, s in again.items()},
     )
     return replace(
         seen,

@@ -29,19 +29,16 @@ from uavtool.mission.outputs import (
 )
 from uavtool.mission.params import Params
 from uavtool.mission.peek import Peek, peek
-from uavtool.mission.unknown import Evidence, Placing, Unknown
-from uavtool.nav import NavError, frame_on_plane
+from uavtool.mission.unknown import Unknown
 from uavtool.nav.geometry import (
     point_in_polygon,
     point_polygon_distance,
     point_segment_distance,
-    polygons_overlap,
     segment_polygon_distance,
 )
 from uavtool.vision.vectorize import enclosed_openings
 
 if TYPE_CHECKING:
-    from uavtool.mission.observations import Photo
     from uavtool.mission.outputs import PointOfInterest
     from uavtool.mission.search import Found, Inspector, Look
     from uavtool.mission.survey import Survey
@@ -95,10 +92,6 @@ class SearchMission(FlightMission):
         """Where buildings of unknown height may stand, and the highest each roof may be
         there (by the overview shape's index; an obstacle's is negative): a way near one
         crosses over that by the margin."""
-        self.placing: Placing | None = None
-        """How the photos since the survey narrow where those buildings may stand."""
-        self.since_survey: list[Evidence] = []
-        """The evidence of free space of the nadir photos since the survey."""
         self.roofs: tuple[tuple[tuple[tuple[float, float], ...], float], ...] = ()
         """Every measured roof: (footprint, height above home)."""
         self.viewpoints: Viewpoints | None = None
@@ -295,31 +288,6 @@ class SearchMission(FlightMission):
             if top is not None:
                 need = max(need, self._clear_of(top))
         return need
-
-    def place_again(self, photo: Photo) -> None:
-        """A nadir ``photo`` taken since the survey is evidence of free space too: each
-        building of unknown height whose place it sees is placed again with it, and may then
-        stand in fewer places, never in more."""
-        if self.placing is None or not self.unknown:
-            return
-        try:
-            frame = frame_on_plane(photo.pose, photo.intrinsics)
-        except NavError:
-            return
-        seen = [
-            key
-            for key, place in self.unknown.items()
-            if place.bands  # else anywhere up to the tallest: no photo rules that out
-            and key in self.placing.again
-            and polygons_overlap(place.footprint, frame)
-        ]
-        if not seen:
-            return
-        self.since_survey.append(self.placing.evidence_of(photo))
-        for key in seen:
-            place = self.placing.again[key](self.since_survey)
-            if place.upper_m <= self.unknown[key].upper_m:
-                self.unknown[key] = place
 
     def learn_roof(
         self, index: int, footprint: tuple[tuple[float, float], ...], roof_m: float

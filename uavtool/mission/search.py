@@ -532,7 +532,6 @@ def _look(
     """Look ``n`` at point of interest ``k`` (a building of colour ``aimed_rgb``): a nadir
     photo, judged and reported."""
     photo = yield from m.photo(f"poi-{k}" if n == 1 else f"poi-{k}-{n}", -90.0)
-    m.place_again(photo)
     shapes = photo_shapes(m, photo)
     j = judge(
         m.params,

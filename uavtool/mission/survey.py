@@ -319,10 +319,7 @@ def remeasured_obstacles(
     whole."""
     p = m.params.mission
     own = same_building(m, seen, target)
-    out: list[tuple[tuple[tuple[float, float], ...], float]] = []
-    for j, o in enumerate(seen.obstacles):
-        place = m.unknown.get(-1 - j)
-        out += [(o.footprint, o.height_m)] if place is None else place.slices(UNKNOWN_SLICES)
+    out = [(o.footprint, o.height_m) for o in seen.obstacles]
     for i, shape in enumerate(seen.shapes):
         if i in own:
             continue
@@ -331,17 +328,9 @@ def remeasured_obstacles(
         if not seen.measured[i] and not shape.cut_by_border:
             roof = _measure_against(m, shape, seen.photo, photo, shapes)
             if roof is not None and roof <= p.assumed_roof_m + p.min_above_roof_m:
-                out.append((footprint_at(shape, seen.photo, roof), roof))
-                continue
-        place = m.unknown.get(i)
-        out += [(footprint, height)] if place is None else place.slices(UNKNOWN_SLICES)
+                footprint, height = footprint_at(shape, seen.photo, roof), roof
+        out.append((footprint, height))
     return out
-
-
-UNKNOWN_SLICES = 6
-"""How many pieces a building of unknown height is planned around as: each where a range of
-its heights puts it, as high as that range goes (`Unknown.slices`). More cost every line of
-sight; one is its whole place, as high as it may be anywhere."""
 
 
 def _measure_against(

@@ -42,20 +42,6 @@ class Unknown(NamedTuple):
     higher: over any one place only the heights that put the building there count. Empty:
     anywhere in ``footprint``, up to ``upper_m``."""
 
-    def slices(self, count: int) -> list[tuple[Ring, float]]:
-        """Where it stands and how high, in at most ``count`` pieces of its ``bands`` (each
-        the hull of neighbouring heights' places, as high as the highest of them): an
-        obstacle a camera may see over where it stands low. Without bands, ``footprint`` up
-        to ``upper_m``."""
-        if not self.bands:
-            return [(self.footprint, self.upper_m)]
-        size = -(-len(self.bands) // max(count, 1))
-        groups = [self.bands[i : i + size] for i in range(0, len(self.bands), size)]
-        return [
-            (tuple(convex_hull([p for ring, _ in group for p in ring])), max(t for _, t in group))
-            for group in groups
-        ]
-
     def top_m(self, near: Callable[[Ring], bool]) -> float | None:
         """The highest this building may stand where ``near`` holds of where it would stand
         (None: nowhere)."""
@@ -122,16 +108,6 @@ def region_of(shape: Shape, regions: Sequence[Shape]) -> Shape | None:
         if n > best_n:
             best, best_n = region, n
     return best if area > 0 and 2 * best_n >= area else None
-
-
-@dataclass(frozen=True, slots=True)
-class Placing:
-    """How a photo taken after the survey places the buildings of unknown height again: its
-    evidence of free space (`evidence`, with the roofs measured by then), and, per building
-    (by the mission's key), where it may stand given more evidence."""
-
-    evidence_of: Callable[[Photo], Evidence]
-    again: dict[int, Callable[[Sequence[Evidence]], Unknown]]
 
 
 class Known(NamedTuple):
