@@ -5,6 +5,7 @@ building), each flown on the built-in vehicle by today's mission and by the base
 
     python benchmarks/bench_mission_generalization.py [--quick] [--scenes 200] [--first-seed 1]
         [--baseline COMMIT] [--workers 2] [--variants new,baseline] [--random-home] [--town]
+        [--world]
 
 ``--quick``: two scenes (``--scenes 2``), both variants, every row of the table.
 
@@ -15,6 +16,13 @@ decoys in the target's exact colour that differ by a courtyard or a wing, courty
 report then gets one row per class (scenes holding it: correct / wrong / no match / crashed
 / model built), and the baseline is ``TOWN_BASELINE`` unless ``--baseline`` is given.
 Combines with ``--random-home``.
+
+``--world``: town scenes with every world knob on as well (as `uavtool scene random --hard
+--town --world`: any light, any ground colour, ground areas, a ground texture, near-shape
+decoys of the target's colour, homes anywhere on Earth), with a row per world class too
+(`WORLD_CLASSES`: low sun, a saturated ground, near the date line, far north or south). Only
+today's mission is flown unless ``--variants`` says otherwise: a baseline from before the
+world knobs cannot read such scenes.
 
 The baseline is the code of commit ``BASELINE`` (the mission before roof heights, chosen
 altitudes, the mirror rule and collisions: fixed 45/20 m, a 5 m roof plane), with ``--town``
@@ -79,6 +87,37 @@ BASELINE = "863e7d7"
 TOWN_BASELINE = "675267c"
 SAFETY_MARGIN_M = 4.0
 HOME_COLUMN_M = 1.5  # route points this close to home (horizontally) are take-off/landing
+WORLD_CLASSES = (
+    "sun below 20°",
+    "ground saturated",
+    "ground areas",
+    "ground texture",
+    "near shapes",
+    "home within 10° of ±180°",
+    "home beyond 60° latitude",
+)
+"""The world classes a scene may hold (`world_classes`), each a breakdown row of --world."""
+SATURATED = 0.27
+"""The HSV saturation from which a ground counts as a colour rather than a grey."""
+
+
+def _saturation(rgb: tuple[int, int, int]) -> float:
+    return (max(rgb) - min(rgb)) / max(*rgb, 1)
+
+
+def world_classes(scene: Scene, info: HardSceneInfo) -> tuple[str, ...]:
+    """The :data:`WORLD_CLASSES` ``scene`` holds, in that order."""
+    held = {
+        "sun below 20°": scene.lighting.sun_elevation_deg < 20.0,
+        "ground saturated": _saturation(scene.ground_rgb) >= SATURATED,
+        "ground areas": bool(scene.ground_areas),
+        "ground texture": scene.ground_texture is not None,
+        "near shapes": bool(info.near_shapes),
+        "home within 10° of ±180°": abs(abs(scene.home.lon_deg) - 180.0) <= 10.0,
+        "home beyond 60° latitude": abs(scene.home.lat_deg) > 60.0,
+    }
+    return tuple(c for c in WORLD_CLASSES if held[c])
+
 
 # Flies each (scene file, recording) pair given as JSON on stdin with the code on sys.path;
 # prints one JSON line per flight. Only APIs both versions have.
@@ -166,6 +205,12 @@ def fly_batch(
 
 
 def judge(seed: int, scene: Scene, info: HardSceneInfo, row: dict[str, Any]) -> Result:
+    """One flight's result, judged from its recording against the scene's ground truth."""
+    result = _judge(seed, scene, info, row)
+    return replace(result, classes=result.classes + world_classes(scene, info))
+
+
+def _judge(seed: int, scene: Scene, info: HardSceneInfo, row: dict[str, Any]) -> Result:
     path = Path(row["record"])
     status = str(row["status"])
     empty = Result(
@@ -290,7 +335,10 @@ def summarise(name: str, results: list[Result]) -> dict[str, Any]:
         "tunnel_lost_seeds": [r.seed for r in tunnels if not r.tunnel],
         "statuses": _count(r.status.split(":")[0] for r in results),
         "wrong_kinds": _count(r.wrong_kind for r in wrong),
-        "classes": {c: _by_class([r for r in results if c in r.classes]) for c in TOWN_CLASSES},
+        "classes": {
+            c: _by_class([r for r in results if c in r.classes])
+            for c in TOWN_CLASSES + WORLD_CLASSES
+        },
     }
 
 
@@ -323,14 +371,14 @@ def _pct(k: int, n: int) -> str:
     return f"{k:4d}/{n:<4d} {100.0 * k / n if n else 0.0:5.1f} %"
 
 
-def report_classes(rows: list[dict[str, Any]]) -> None:
-    """One row per town class: the scenes holding it, and per variant how they went."""
+def report_classes(rows: list[dict[str, Any]], classes: tuple[str, ...] = TOWN_CLASSES) -> None:
+    """One row per class: the scenes holding it, and per variant how they went."""
     print(
-        "\n  by town class: scenes holding it; per variant correct / wrong / no match / "
+        "\n  by class: scenes holding it; per variant correct / wrong / no match / "
         "crashed / model built (of correct)"
     )
     print(f"  {'class':<30s}{'scenes':>7s}" + "".join(f"{r['name']:>22s}" for r in rows))
-    for c in TOWN_CLASSES:
+    for c in classes:
         cells = []
         for r in rows:
             k = r["classes"][c]
@@ -338,7 +386,7 @@ def report_classes(rows: list[dict[str, Any]]) -> None:
         n = rows[0]["classes"][c]["n"]
         print(f"  {c:<30s}{n:>7d}" + "".join(f"{cell:>22s}" for cell in cells))
     for r in rows:
-        for c in TOWN_CLASSES:
+        for c in classes:
             bad = {k: v for k, v in r["classes"][c]["seeds"].items() if v}
             if bad:
                 listed = "; ".join(f"{k} {v[:20]}" for k, v in bad.items())
@@ -446,10 +494,30 @@ def main() -> None:
         help="town scenes (HardOptions.town()): a breakdown row per class; baseline "
         f"{TOWN_BASELINE} unless --baseline says otherwise",
     )
-    if parser.parse_known_args()[0].quick:
+    parser.add_argument(
+        "--world",
+        action="store_true",
+        help="town scenes with every world knob on: a breakdown row per town and world class; "
+        "today's mission only unless --variants says otherwise",
+    )
+    known = parser.parse_known_args()[0]
+    if known.quick:
         parser.set_defaults(scenes=2)
+    if known.world:
+        parser.set_defaults(variants="new")
     args = parser.parse_args()
+    args.town = args.town or args.world
     options = HardOptions.town() if args.town else HardOptions()
+    if args.world:
+        options = replace(
+            options,
+            any_light=True,
+            any_ground=True,
+            ground_areas=True,
+            ground_texture=True,
+            near_shapes=True,
+            anywhere=True,
+        )
     if args.random_home:
         options = replace(options, random_home=True)
     if args.baseline is None:
@@ -461,7 +529,7 @@ def main() -> None:
         else list(range(args.first_seed, args.first_seed + args.scenes))
     )
     homes = "; random homes" if args.random_home else ""
-    kind = "town" if args.town else "hard"
+    kind = "world" if args.world else "town" if args.town else "hard"
     base = f" (baseline {args.baseline})" if "baseline" in variants else ""
     print(
         f"{len(seeds)} {kind} scenes, seeds {seeds[0]}..{seeds[-1]}{homes}; "
@@ -508,7 +576,7 @@ def main() -> None:
             summaries.append(summarise(variant, sorted(results, key=lambda r: r.seed)))
     report(summaries)
     if args.town:
-        report_classes(summaries)
+        report_classes(summaries, TOWN_CLASSES + (WORLD_CLASSES if args.world else ()))
 
 
 if __name__ == "__main__":
