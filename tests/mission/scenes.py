@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 from typing import Any
 
 from uavtool.mission import MissionParams, Params
+from uavtool.runner.fly import FlightSummary, FlyConfig, fly
 from uavtool.world import Scene, load_scene, scene_from_dict, scene_to_dict
 
 # Wall colours: hues far from the red target and from each other.
@@ -32,6 +34,19 @@ def on_grey_ground(name: str, target: str, buildings: list[dict[str, Any]]) -> S
             "buildings": buildings,
         }
     )
+
+
+DATA = Path(__file__).parent / "data"
+
+
+def fly_data_scene(name: str) -> tuple[FlightSummary, list[str]]:
+    """Fly ``tests/mission/data/<name>.yaml`` without recording: its summary and events."""
+    events: list[str] = []
+    summary = fly(
+        FlyConfig(scene=str(DATA / f"{name}.yaml"), no_record=True),
+        progress=lambda e, _t: events.append(e),
+    )
+    return summary, events
 
 
 def with_mission(**changes: Any) -> Params:

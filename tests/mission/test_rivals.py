@@ -14,6 +14,7 @@ import pytest
 
 from tests.mission.driver import fly
 from tests.mission.fakes import INTRINSICS
+from tests.mission.scenes import fly_data_scene
 from uavtool.mission import MissionInputs, Params, Photo, SearchMission, Status
 from uavtool.mission.base import MissionEnd
 from uavtool.mission.modelling import still_the_target
@@ -246,11 +247,7 @@ def test_a_small_target_of_unknown_height_is_looked_at_from_straight_above_it() 
     Straight above it nothing else stands, so the next look descends over it, as low as
     keeps it whole whatever its height, and matches; the mirror decoy and the near shape
     (an arm shorter) are not taken for it."""
-    events: list[str] = []
-    summary = fly_scene(
-        FlyConfig(scene=str(DATA / "world-50001.yaml"), no_record=True),
-        progress=lambda e, _t: events.append(e),
-    )
+    summary, events = fly_data_scene("world-50001")
     assert any("looking again from straight above it" in e for e in events), events
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == summary.evaluation.target_building == "b00"
@@ -261,11 +258,7 @@ def test_a_textured_ground_of_a_colour_does_not_hold_every_look_up() -> None:
     unknown height, it stood everywhere up to just below the camera, and every look stayed
     over 74 m: the target, drawn too small, was never judged. Its grain lines up at the
     ground only: it is ground, the looks descend, and the target is found."""
-    events: list[str] = []
-    summary = fly_scene(
-        FlyConfig(scene=str(DATA / "world-50042.yaml"), no_record=True),
-        progress=lambda e, _t: events.append(e),
-    )
+    summary, events = fly_data_scene("world-50042")
     assert any("lie on the ground" in e for e in events), events
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == summary.evaluation.target_building == "b07"

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
+from tests.mission.scenes import fly_data_scene
 from uavtool.camera import CameraPose, Intrinsics, project
 from uavtool.mission import Status
 from uavtool.mission.observations import Photo
@@ -71,11 +70,7 @@ def test_a_viewpoint_a_look_down_shows_blocked_is_planned_again_around_what_it_s
     """World scene 50293: a side viewpoint lies beyond the ground the overview saw, and
     the look down from the ceiling shows a building 2.4 m from it. The side is planned
     again around what that photo showed, from elsewhere, and the model is built."""
-    events: list[str] = []
-    data = Path(__file__).parent / "data" / "world-50293.yaml"
-    summary = fly(
-        FlyConfig(scene=str(data), no_record=True), progress=lambda e, _t: events.append(e)
-    )
+    summary, events = fly_data_scene("world-50293")
     assert any("planned again around the" in e for e in events), events
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == summary.evaluation.target_building
