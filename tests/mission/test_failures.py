@@ -44,6 +44,7 @@ from uavtool.mission import (
     Telemetry,
     Viewpoints,
 )
+from uavtool.mission.base import MissionEnd
 from uavtool.world import Scene
 
 
@@ -255,6 +256,28 @@ def test_pilot_takeover_stops_all_commands(paper: Scene, after: type, pilot_land
         assert texts[-1] == "still flying when the mission stopped watching"
         end_ms = flight.steps[-1].time_ms
         assert end_ms - flight.steps[seen].time_ms == pytest.approx(land_timeout_s * 1000, abs=200)
+
+
+def test_a_mode_the_autopilot_picks_while_parked_on_the_ground_is_no_takeover(
+    paper: Scene,
+) -> None:
+    """A fleet's leader lands mid-mission and waits, disarmed, while another vehicle builds
+    the model. PX4 picks its own mode on the ground after a while (Hold, AUTO.LOITER): nobody
+    took over (a three-PX4 fleet ended "pilot-takeover" so). Armed again, a mode the mission
+    did not ask for is a takeover."""
+    mission = SearchMission(Params(), MissionInputs(target_rgb(paper)))
+    mission._expected_modes = frozenset({"GUIDED", "LAND"})
+    mission._parked = True  # as `land` leaves it
+
+    def seen(armed: bool) -> Telemetry:
+        return Telemetry(
+            330_000, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.0, "AUTO.LOITER", armed, True, 0.0, 0.0, 90
+        )
+
+    mission._check_mode(seen(armed=False))
+    with pytest.raises(MissionEnd) as ended:
+        mission._check_mode(seen(armed=True))
+    assert ended.value.status is Status.TAKEOVER
 
 
 # --- the link goes quiet ---------------------------------------------------------------------

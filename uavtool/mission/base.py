@@ -138,6 +138,7 @@ class FlightMission:
         self._airborne = False  # from take-off until landed: disarming in the air is a crash
         self._left_ground = False  # seen above home's height tolerance since the take-off
         self._landing = False  # RTL or LAND sent: a disarm on the ground at home is the landing
+        self._parked = False  # landed and disarmed mid-mission, until the next take-off
         self._deferred: list[Observation] = []
         self._in_fly = False  # fly() is running: interrupt() may end it
         self._gen = self._run()
@@ -353,8 +354,9 @@ class FlightMission:
 
     def _check_mode(self, t: Telemetry) -> None:
         # Down from the landing the mission asked for, the autopilot picks its own mode on the
-        # ground (PX4 switches to Hold): nobody took over.
-        touched_down = self._landing and t.landed
+        # ground (PX4 switches to Hold, at once or after a while disarmed): nobody took over.
+        # Parked mid-mission (a fleet's leader waiting), likewise while it stays disarmed.
+        touched_down = t.landed and (self._landing or (self._parked and not t.armed))
         if not self._expected_modes or t.mode in self._expected_modes or touched_down:
             self._link_was_lost = False  # the link came back and the vehicle kept its mode
             return
@@ -484,6 +486,7 @@ class FlightMission:
         """GUIDED, arm (retrying while pre-arm checks fail) and climb to ``alt_m``."""
         p = self.flight
         self.event(Level.INFO, "arming in GUIDED")
+        self._parked = False
         yield from self.set_mode("GUIDED")
         start_ms = self.now_ms()
         refused = 0
@@ -529,6 +532,7 @@ class FlightMission:
         if not landed:
             raise MissionEnd(Status.ABORTED, f"landing ({what}): not landed in time")
         self._airborne = self._landing = self._left_ground = False
+        self._parked = True
         self.event(Level.INFO, "landed and disarmed, waiting")
 
     def airborne(self, *, flying: bool = False) -> None:
