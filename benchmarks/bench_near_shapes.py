@@ -215,7 +215,12 @@ def _rectified(shape: Shape, half: int, tilt_deg: float, tilt_axis_deg: float) -
     along = along / (math.cos(tilt) - along * math.sin(tilt) / FOCAL_PX)
     across = across * (1.0 + along * math.sin(tilt) / FOCAL_PX)
     flat = np.stack([along * u - across * v, along * v + across * u], axis=1) + half
-    return Shape.from_rings(colour_rgb=shape.colour_rgb, polygon_px=flat, detail_px=shape.detail_px)
+    return Shape.from_rings(
+        colour_rgb=shape.colour_rgb,
+        polygon_px=flat,
+        detail_px=shape.detail_px,
+        left_out_px=shape.left_out_px,
+    )
 
 
 def _roof(image: np.ndarray) -> Shape | None:

@@ -6,7 +6,12 @@ import numpy as np
 
 from uavtool.vision import Shape, VectorizeParams, vectorize
 from uavtool.vision.io import shapes_from_json, shapes_to_json
-from uavtool.vision.verify import hides_detail, outline_accuracy_px, outline_tolerance
+from uavtool.vision.verify import (
+    detail_differs,
+    hides_detail,
+    outline_accuracy_px,
+    outline_tolerance,
+)
 from uavtool.world.raster import paint_polygon
 
 RED = (210, 40, 40)
@@ -70,6 +75,7 @@ def test_detail_survives_the_shapes_file() -> None:
     shape = _one(SLOTTED)
     (back,) = shapes_from_json(shapes_to_json((shape,), width_px=320, height_px=240))
     assert back.detail_px == shape.detail_px
+    assert back.left_out_px == shape.left_out_px > 0.0
 
 
 def test_a_line_of_wall_into_the_roof_is_no_detail_left_out() -> None:
@@ -113,3 +119,56 @@ def test_a_notch_the_target_picture_would_draw_is_not_judged_from_a_coarser_phot
     assert hides_detail(finer, slotted, min_edge)
     smaller = _one([(100.0, 80.0), (160.0, 80.0), (160.0, 120.0), (100.0, 120.0)])
     assert not hides_detail(smaller, _one(SLOTTED), min_edge)
+
+
+def _turned(
+    ring: list[tuple[float, float]], deg: float, scale: float, size: tuple[int, int]
+) -> list[tuple[float, float]]:
+    """``ring`` turned by ``deg`` and scaled by ``scale`` about its centre, put in the middle
+    of a picture of ``size`` (width, height)."""
+    pts = np.array(ring, dtype=np.float64)
+    centre = pts.mean(axis=0)
+    c, s = np.cos(np.radians(deg)), np.sin(np.radians(deg))
+    turned = (pts - centre) @ np.array([[c, s], [-s, c]]) * scale
+    placed = turned + np.array([size[0] / 2, size[1] / 2])
+    return [(float(x), float(y)) for x, y in placed]
+
+
+def _drawn(ring: list[tuple[float, float]], size: tuple[int, int]) -> Shape:
+    image = np.full((size[1], size[0], 3), 128, np.uint8)
+    paint_polygon(image, np.array(ring, dtype=np.float64), RED)
+    (shape,) = vectorize(image, VectorizeParams())
+    return shape
+
+
+PLAIN = [(60.0, 50.0), (250.0, 50.0), (250.0, 170.0), (60.0, 170.0)]
+
+
+def test_a_feature_one_outline_left_out_and_the_other_lacks_is_another_footprint() -> None:
+    """A 5 px slot lost in the outline of a 190 px rectangle (left out, about its depth)
+    against the plain rectangle, whose outline left out nothing beyond its pixels' staircase:
+    were they one footprint, the plain photo would show the slot too. Either way round, and
+    from a plain photo drawing it half as large again; two photos that both left the slot out
+    are not told apart by it, nor are two plain ones."""
+    slotted, plain = _one(SLOTTED), _one(PLAIN)
+    assert len(slotted.polygon_px) == len(plain.polygon_px) == 4
+    assert slotted.left_out_px > 2.0 and plain.left_out_px <= 1.0
+    assert detail_differs(plain, slotted)
+    assert detail_differs(slotted, plain)
+    larger = _drawn(_turned(PLAIN, 0.0, 1.5, (480, 320)), (480, 320))
+    assert detail_differs(larger, slotted)
+    assert not detail_differs(slotted, _one(SLOTTED))
+    assert not detail_differs(plain, larger)
+
+
+def test_one_plain_footprint_differs_in_no_detail_at_any_turn_or_scale() -> None:
+    """The plain rectangle drawn turned by any angle (7.5° steps) at 0.6-1.6 times the
+    reference's scale, shifted by a fraction of a pixel: each outline's traced border lies
+    within the pixel grid's staircase, so no photo shows a feature another lacks."""
+    reference = _one(PLAIN)
+    for deg in np.arange(0.0, 90.0, 7.5):
+        for scale in (0.6, 1.0, 1.6):
+            ring = [(x + 0.37, y + 0.61) for x, y in _turned(PLAIN, deg, scale, (480, 400))]
+            candidate = _drawn(ring, (480, 400))
+            assert not detail_differs(reference, candidate), (deg, scale, candidate.left_out_px)
+            assert not detail_differs(candidate, reference), (deg, scale)

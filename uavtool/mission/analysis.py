@@ -26,6 +26,7 @@ from uavtool.vision.merge import merge_touching
 from uavtool.vision.model3d import central_shape
 from uavtool.vision.vectorize import ground_mask, hue_distance_deg, inner_walls
 from uavtool.vision.verify import (
+    detail_differs,
     hides_detail,
     outline_accuracy_px,
     outline_gap,
@@ -94,11 +95,16 @@ class Judgement:
     edge (``vectorize.min_edge_px``), or its outline leaves out (``Shape.detail_px``) a
     feature the target picture would draw as an edge. A closer look may judge it; a higher
     one cannot."""
+    detail_differs: bool = False
+    """The outlines lie together, but one photo's outline left out a feature (a notch or a
+    cut corner drawn under the least edge kept) that the other photo would draw and does
+    not (:func:`uavtool.vision.verify.detail_differs`): another footprint."""
 
     @property
     def outline_fits(self) -> bool:
-        """Whether the outline lies on the target's within the photos' accuracy."""
-        return self.outline_gap <= self.outline_tolerance
+        """Whether the outline lies on the target's within the photos' accuracy, and neither
+        left out a feature the other does not show."""
+        return self.outline_gap <= self.outline_tolerance and not self.detail_differs
 
 
 def aimed_shape(
@@ -168,7 +174,7 @@ def judge(
     # keep may be what makes it another building: not judged from here, a closer look may
     if matched and hides_detail(target, centre, params.vectorize.min_edge_px):
         matched, judgeable, too_small = False, False, True
-    outline, tolerance, tiers = 0.0, 0.0, False
+    outline, tolerance, tiers, differs = 0.0, 0.0, False, False
     if matched:
         # the corners agree; the outline must also lie on the target's: a near shape (a
         # trapezoid, a notched corner, an arm shorter) has the target's corners too
@@ -179,7 +185,8 @@ def judge(
             accuracy = outline_accuracy_px(params.vectorize)
             outline = outline_gap(target, centre, matches[candidate])
             tolerance = outline_tolerance(target, centre, accuracy, accuracy)
-            matched = outline <= tolerance
+            differs = detail_differs(target, centre)
+            matched = outline <= tolerance and not differs
     return Judgement(
         scores,
         candidate,
@@ -193,6 +200,7 @@ def judge(
         tolerance,
         tiers,
         too_small,
+        differs,
     )
 
 

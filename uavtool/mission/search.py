@@ -554,11 +554,13 @@ def _look(
     elif j.stepped:
         why = "; parts at several heights: outline not compared"
     elif j.outline_tolerance > 0.0:
-        fits = "within" if j.outline_fits else "beyond"
+        fits = "within" if j.outline_gap <= j.outline_tolerance else "beyond"
         why = (
             f"; outline {j.outline_gap * 100:.1f} % of its size off the target's, {fits} "
             f"the photos' {j.outline_tolerance * 100:.1f} %"
         )
+        if j.detail_differs:
+            why += ", but one photo's outline leaves out a corner the other does not show"
     m.event(
         Level.INFO,
         f"point of interest {k}{'' if n == 1 else f', look {n}'}: "

@@ -55,6 +55,7 @@ def shapes_to_json(shapes: tuple[Shape, ...], *, width_px: int, height_px: int) 
                 "centroid_px": list(s.centroid_px),
                 "cut_by_border": s.cut_by_border,
                 "detail_px": s.detail_px,
+                "left_out_px": s.left_out_px,
             }
             for s in shapes
         ],
@@ -93,6 +94,7 @@ def shapes_from_json(text: str, *, source: str = "<shapes>") -> tuple[Shape, ...
                     centroid,
                     bool(item["cut_by_border"]),
                     _detail(item.get("detail_px", 0.0), f"{where}.detail_px"),
+                    _detail(item.get("left_out_px", 0.0), f"{where}.left_out_px"),
                 )
             )
         except ShapeFileError:

@@ -65,6 +65,7 @@ def merge_touching(
                 cut_by_border=any(shapes[i].cut_by_border for i in idx),
                 # the closing may have drawn the outline anywhere across the slits it closed
                 detail_px=max(half, *(shapes[i].detail_px for i in idx)),
+                left_out_px=max(half, *(shapes[i].left_out_px for i in idx)),
             )
         )
     return tuple(out)
@@ -93,6 +94,7 @@ def _without_strips(shape: Shape, gap_px: float) -> Shape:
         holes_px=holes,
         cut_by_border=shape.cut_by_border,
         detail_px=shape.detail_px,
+        left_out_px=shape.left_out_px,
     )
 
 

@@ -24,12 +24,13 @@ _MAX_MITRE = 3.0
 
 def simplify_rings_detail(
     contours_px: list[npt.NDArray[Any]], p: VectorizeParams
-) -> tuple[list[FloatArray], list[float]]:
+) -> tuple[list[FloatArray], list[float], list[float]]:
     """Each closed pixel border ``(n, 2)`` as a simplified ring ``(m, 2)`` (``m`` may be < 3
-    for a border too small to make a polygon), and how much detail each ring holds at the
-    limit of what it can be trusted with, in pixels: how far its border strays from it
+    for a border too small to make a polygon); how much detail each ring holds at the limit
+    of what it can be trusted with, in pixels: how far its border strays from it
     (:func:`ring_detail`: what the simplification left out), or its longest edge shorter
-    than ``min_edge_px`` when longer (a step kept at the limit), whichever is more."""
+    than ``min_edge_px`` when longer (a step kept at the limit), whichever is more; and the
+    first of those alone (what was left out)."""
     dense = [resample_ring(c.astype(np.float64), p.point_spacing_px) for c in contours_px]
     kept = rdp_rings_indices(dense, p.rdp_epsilon_px)
     if not p.refine_corners:
@@ -45,10 +46,11 @@ def simplify_rings_detail(
             # pixel's half-diagonal of it
             join_tolerance_px=p.rdp_epsilon_px + math.sqrt(0.5),
         )
-    return rings, [
-        max(ring_detail(d, r), longest_stub(r, p.min_edge_px))
-        for d, r in zip(dense, rings, strict=True)
+    left_out = [ring_detail(d, r) for d, r in zip(dense, rings, strict=True)]
+    details = [
+        max(gone, longest_stub(r, p.min_edge_px)) for gone, r in zip(left_out, rings, strict=True)
     ]
+    return rings, details, left_out
 
 
 def longest_stub(ring_px: FloatArray, min_edge_px: float) -> float:

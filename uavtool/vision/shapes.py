@@ -31,6 +31,9 @@ class Shape:
     ``detail_px`` : how far the traced border strays from ``polygon_px`` at most, in pixels:
     what the simplification left out (a step or notch shorter than an edge it keeps); 0
     when the shape was not traced from pixels.
+    ``left_out_px`` : the part of ``detail_px`` the outline left out, as against a step it
+    kept at the limit of what it keeps (an edge shorter than ``min_edge_px``): how far the
+    traced border strays from ``polygon_px`` at most.
     """
 
     colour_rgb: tuple[int, int, int]
@@ -40,6 +43,7 @@ class Shape:
     centroid_px: tuple[float, float]
     cut_by_border: bool
     detail_px: float = 0.0
+    left_out_px: float = 0.0
 
     @classmethod
     def from_rings(
@@ -50,6 +54,7 @@ class Shape:
         holes_px: tuple[FloatArray, ...] = (),
         cut_by_border: bool = False,
         detail_px: float = 0.0,
+        left_out_px: float = 0.0,
     ) -> Shape:
         """A shape whose orientation, area and centroid are computed from its rings."""
         outer = orient(np.asarray(polygon_px, dtype=np.float64), positive=True)
@@ -57,7 +62,7 @@ class Shape:
         rings = (outer, *holes)
         area, cu, cv = _area_moments(rings)
         centroid = (cu / area, cv / area) if area != 0.0 else _vertex_mean(outer)
-        return cls(colour_rgb, outer, holes, area, centroid, cut_by_border, detail_px)
+        return cls(colour_rgb, outer, holes, area, centroid, cut_by_border, detail_px, left_out_px)
 
 
 def signed_area(ring: FloatArray) -> float:

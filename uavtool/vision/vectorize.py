@@ -164,20 +164,24 @@ def _traced(
 ) -> list[tuple[int, _Region, Shape]]:
     """(order, region, shape with its inside colour) for each region whose outline keeps
     three corners once the outlines are simplified together."""
-    rings, details = simplify_rings_detail([c for r in regions for c in (r.outer, *r.holes)], p)
+    contours = [c for r in regions for c in (r.outer, *r.holes)]
+    rings, details, left_outs = simplify_rings_detail(contours, p)
     out: list[tuple[int, _Region, Shape]] = []
     at = 0
     for order, r in enumerate(regions):
         outer, holes = rings[at], rings[at + 1 : at + 1 + len(r.holes)]
-        detail = details[at]
+        detail, left_out = details[at], left_outs[at]
         at += 1 + len(r.holes)
         if len(outer) < 3:
             continue
         shape = _offset_shape(outer, tuple(h for h in holes if len(h) >= 3), r.cut, detail, p)
-        shape = dataclasses.replace(shape, colour_rgb=_inside_colour(frame, r, shape))
+        shape = dataclasses.replace(
+            shape, colour_rgb=_inside_colour(frame, r, shape), left_out_px=left_out
+        )
         if detail > _STAIRCASE_PX:
-            detail_px = _detail_with_walls(frame, r, outer, shape, p)
-            shape = dataclasses.replace(shape, detail_px=detail_px)
+            left_out = _left_out_with_walls(frame, r, outer, shape, p)
+            detail = max(left_out, longest_stub(outer, p.min_edge_px))
+            shape = dataclasses.replace(shape, detail_px=detail, left_out_px=left_out)
         out.append((order, r, shape))
     return out
 
@@ -187,7 +191,7 @@ _STAIRCASE_PX = 1.0
 out worth looking at again."""
 
 
-def _detail_with_walls(
+def _left_out_with_walls(
     frame: U8Array, r: _Region, outer: FloatArray, shape: Shape, p: VectorizeParams
 ) -> float:
     """What ``shape``'s outline (``outer`` before its edge offset) leaves out of its region
@@ -206,8 +210,7 @@ def _detail_with_walls(
     if not contours:
         return 0.0
     border = max(contours, key=cv2.contourArea)[:, 0, :].astype(np.float64)
-    left_out = ring_detail(resample_ring(border, p.point_spacing_px), outer)
-    return max(left_out, longest_stub(outer, p.min_edge_px))
+    return ring_detail(resample_ring(border, p.point_spacing_px), outer)
 
 
 def non_ground(

@@ -29,6 +29,8 @@ from uavtool.vision.params import VectorizeParams
 from uavtool.vision.shapes import FloatArray, Shape
 
 __all__ = [
+    "STAIRCASE_PX",
+    "detail_differs",
     "hides_detail",
     "outline_accuracy_px",
     "outline_fits",
@@ -108,6 +110,40 @@ def hides_detail(reference: Shape, candidate: Shape, reference_min_edge_px: floa
     return LEGS_PER_DETAIL * candidate.detail_px * scale >= reference_min_edge_px * drawn
 
 
+STAIRCASE_PX = 1.0
+"""How far a traced border may stray from a straight edge by the pixel grid alone: the
+staircase of a slanted edge, a pixel at most. What an outline leaves out beyond it is a
+feature of the footprint (a notch, a cut corner, a step) drawn too small to keep as an
+edge."""
+
+
+def detail_differs(reference: Shape, candidate: Shape) -> bool:
+    """Whether one photo's outline left out a feature (``Shape.left_out_px`` beyond the
+    pixel grid's `STAIRCASE_PX`: a notch or a cut corner drawn under the least edge kept)
+    that the other photo, were it of the same footprint, would draw and does not: the other
+    left out nothing (its traced border lies within the staircase of its outline), and the
+    feature, carried to its scale (the ratio of the two shapes' ``sqrt(area)``), would stand
+    beyond its staircase. When both left something out they may have left out the same
+    feature, drawn apart by each photo's perspective (a step between a building's tiers):
+    its size then tells nothing."""
+    scale = math.sqrt(max(reference.area_px, 0.0))
+    drawn = math.sqrt(max(candidate.area_px, 0.0))
+    if not (scale > 0.0 and drawn > 0.0):
+        return False
+    return _missing(candidate.left_out_px, reference.left_out_px, scale / drawn) or _missing(
+        reference.left_out_px, candidate.left_out_px, drawn / scale
+    )
+
+
+def _missing(left_out_px: float, clean_px: float, ratio: float) -> bool:
+    """Whether a feature of ``left_out_px`` (beyond the staircase) is missing from a photo
+    whose outline left out ``clean_px`` (within its staircase), drawn ``ratio`` times as
+    large there."""
+    if clean_px > STAIRCASE_PX:
+        return False
+    return (left_out_px - STAIRCASE_PX) * ratio > clean_px + STAIRCASE_PX
+
+
 def outline_fits(
     reference: Shape,
     candidate: Shape,
@@ -117,11 +153,12 @@ def outline_fits(
 ) -> bool:
     """Whether ``candidate`` (vectorized with ``params``) lies on ``reference`` (vectorized
     with ``reference_params``, by default the same) as closely as one footprint photographed
-    twice can: `outline_gap` within `outline_tolerance`, and nothing left out of it that
-    the reference would show (`hides_detail`)."""
+    twice can: `outline_gap` within `outline_tolerance`, nothing left out of it that
+    the reference would show (`hides_detail`) and no feature one left out that the other
+    does not (`detail_differs`)."""
     p = params if params is not None else VectorizeParams()
     q = reference_params if reference_params is not None else p
-    if hides_detail(reference, candidate, q.min_edge_px):
+    if hides_detail(reference, candidate, q.min_edge_px) or detail_differs(reference, candidate):
         return False
     tolerance = outline_tolerance(
         reference, candidate, outline_accuracy_px(p), outline_accuracy_px(q)
