@@ -65,3 +65,17 @@ def test_a_stepped_tower_beside_home_is_not_measured_at_its_lowest_tier() -> Non
     summary = fly(FlyConfig(scene=str(DATA / "town-11921.yaml"), no_record=True))
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == "b08"
+
+
+def test_a_grey_building_a_lawn_outline_touches_is_still_an_obstacle() -> None:
+    """World scene 48039: a 19.9 m grey building (b07) stands beside a field of another
+    colour. The field's simplified outline reached one pixel into the grey roof, and a
+    region sharing any pixel with a building the vectorizer found was taken for that
+    building; the field then proved ground, and the grey building was in no obstacle at
+    all. The right viewpoint was planned on its roof, 12.5 m up: a crash at 17 m. A region
+    is now a found building's only when most of it lies inside the found outlines; the grey
+    building is an obstacle, and the flight completes clear of it."""
+    summary = fly(FlyConfig(scene=str(DATA / "world-48039.yaml"), no_record=True))
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == "b06"
+    assert summary.clearance_m is not None and summary.clearance_m > 2.0
