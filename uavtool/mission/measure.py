@@ -49,7 +49,7 @@ from uavtool.nav.heights import roof_from_cut_outline
 from uavtool.nav.parallax import STOREY_M
 from uavtool.vision import Shape
 from uavtool.vision.colour import has_hue, hue_distance_deg
-from uavtool.vision.vectorize import non_ground
+from uavtool.vision.vectorize import non_ground, same_paint
 
 if TYPE_CHECKING:
     from uavtool.mission.base import Wait
@@ -279,17 +279,23 @@ def may_be_target(m: SearchMission, region: Shape) -> bool:
 
 def _unclassified(m: SearchMission, seen: Survey) -> list[Shape]:
     """The regions of the higher overview that are not ground (by its colour, nor by
-    parallax: `lies_on_ground`) and are not a building the vectorizer found (a coloured
-    roof and its walls are one region): less than half of the region lies inside the found
-    buildings' outlines. A grey roof beside a lawn, whose simplified outline reaches a pixel
-    into it, is not that lawn (a 20 m grey building was once left out of every obstacle so)."""
+    parallax: `lies_on_ground`) and are not a building the vectorizer found: a region that
+    touches a found roof of its own paint (`same_paint`: a coloured roof and its walls, the
+    roof's colour shaded, are one building), or lies mostly (half or more) inside the found
+    outlines, is that building. A grey roof beside a lawn, whose simplified outline reaches
+    a pixel into it, is not that lawn (a 20 m grey building was once left out of every
+    obstacle so)."""
     k = seen.photo.intrinsics
+    masks = []
+    for s in seen.shapes:
+        mask = np.zeros((k.height_px, k.width_px), np.uint8)
+        cv2.fillPoly(mask, [pixels(s.polygon_px)], 255)
+        for hole in s.holes_px:  # a courtyard is not its building: what stands in it is other
+            cv2.fillPoly(mask, [pixels(hole)], 0)
+        masks.append(mask)
     found = np.zeros((k.height_px, k.width_px), np.uint8)
-    for s in seen.shapes:  # one by one: where two overlap, one call leaves the overlap empty
-        cv2.fillPoly(found, [pixels(s.polygon_px)], 255)
-    for s in seen.shapes:  # a courtyard is not its building: what stands in it is other
-        for hole in s.holes_px:
-            cv2.fillPoly(found, [pixels(hole)], 0)
+    for mask in masks:
+        cv2.bitwise_or(found, mask, dst=found)
     out: list[Shape] = []
     for region in non_ground(seen.photo.image_rgb, m.params.vectorize):
         if region.area_px < m.params.vectorize.min_area_px:
@@ -300,8 +306,16 @@ def _unclassified(m: SearchMission, seen: Survey) -> list[Shape]:
             continue  # a road, a car park: ground of another colour
         own = np.zeros_like(found)
         cv2.fillPoly(own, [pixels(region.polygon_px)], 255)
-        if 2 * cv2.countNonZero(cv2.bitwise_and(own, found)) < cv2.countNonZero(own):
-            out.append(region)
+        if 2 * cv2.countNonZero(cv2.bitwise_and(own, found)) >= cv2.countNonZero(own):
+            continue
+        paint = np.full((3, 3, 3), region.colour_rgb, np.uint8)  # its colour, as a picture
+        if any(
+            bool(same_paint(paint, s.colour_rgb)[1, 1])
+            and cv2.countNonZero(cv2.bitwise_and(own, mask)) > 0
+            for s, mask in zip(seen.shapes, masks, strict=True)
+        ):
+            continue
+        out.append(region)
     return out
 
 
