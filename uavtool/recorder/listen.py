@@ -118,6 +118,14 @@ def wait_vehicles(
                 fix = GeoPoint(p.lat / 1e7, p.lon / 1e7, (p.alt - p.relative_alt) / 1000.0)
                 origins[link.target_system] = fix, "first fix: no HOME_POSITION heard"
         if len(origins) == config.vehicles:
+            # each watch starts from the vehicle's state as last heard: a watch that has not
+            # had a heartbeat yet would take an arming that comes before its first one as
+            # how the vehicle was, and never say "armed"
+            for link in links:
+                seen = tap.watches[link.target_system]
+                heartbeat = link.state.heartbeat
+                if seen.mode_unknown and heartbeat is not None:
+                    seen.vehicle(heartbeat, now)
             return origins
         if stop_now():
             raise KeyboardInterrupt  # before anything was recorded: no file

@@ -130,6 +130,11 @@ class VehicleWatch:
     def gcs_present(self, now_s: float) -> bool:
         return any(now_s - t < OTHER_GCS_S for t in self.other_gcs.values())
 
+    @property
+    def mode_unknown(self) -> bool:
+        """Whether no heartbeat of the vehicle has reached this watch yet."""
+        return self._mode is None
+
     def take_triggers(self) -> list[str]:
         out, self.triggers = self.triggers, []
         return out
