@@ -15,6 +15,12 @@ if TYPE_CHECKING:
 
 FloatArray = npt.NDArray[np.float64]
 
+STAIRCASE_PX = 1.0
+"""How far a traced border may stray from a straight edge by the pixel grid alone: the
+staircase of a slanted edge, a pixel at most. What an outline leaves out beyond it
+(``Shape.left_out_px``) is a feature of the footprint (a notch, a cut corner, a step) drawn
+too small to keep as an edge."""
+
 
 @dataclass(frozen=True, slots=True)
 class Shape:

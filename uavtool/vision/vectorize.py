@@ -29,7 +29,7 @@ from uavtool.vision.outline import (
 )
 from uavtool.vision.params import VectorizeParams
 from uavtool.vision.roof import INSET_PX, far_edge_pixels, roof_value
-from uavtool.vision.shapes import FloatArray, Shape, orient
+from uavtool.vision.shapes import STAIRCASE_PX, FloatArray, Shape, orient
 
 U8Array = npt.NDArray[np.uint8]
 # What OpenCV returns (its stubs type every array loosely).
@@ -178,17 +178,12 @@ def _traced(
         shape = dataclasses.replace(
             shape, colour_rgb=_inside_colour(frame, r, shape), left_out_px=left_out
         )
-        if detail > _STAIRCASE_PX:
+        if detail > STAIRCASE_PX:
             left_out = _left_out_with_walls(frame, r, outer, shape, p)
             detail = max(left_out, longest_stub(outer, p.min_edge_px))
             shape = dataclasses.replace(shape, detail_px=detail, left_out_px=left_out)
         out.append((order, r, shape))
     return out
-
-
-_STAIRCASE_PX = 1.0
-"""A traced border within this of its outline is the pixel grid's staircase: nothing left
-out worth looking at again."""
 
 
 def _left_out_with_walls(

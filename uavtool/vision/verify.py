@@ -26,10 +26,9 @@ import shapely
 
 from uavtool.vision.align import Match
 from uavtool.vision.params import VectorizeParams
-from uavtool.vision.shapes import FloatArray, Shape
+from uavtool.vision.shapes import STAIRCASE_PX, FloatArray, Shape
 
 __all__ = [
-    "STAIRCASE_PX",
     "detail_differs",
     "hides_detail",
     "outline_accuracy_px",
@@ -108,13 +107,6 @@ def hides_detail(reference: Shape, candidate: Shape, reference_min_edge_px: floa
     if drawn >= scale:
         return False
     return LEGS_PER_DETAIL * candidate.detail_px * scale >= reference_min_edge_px * drawn
-
-
-STAIRCASE_PX = 1.0
-"""How far a traced border may stray from a straight edge by the pixel grid alone: the
-staircase of a slanted edge, a pixel at most. What an outline leaves out beyond it is a
-feature of the footprint (a notch, a cut corner, a step) drawn too small to keep as an
-edge."""
 
 
 def detail_differs(reference: Shape, candidate: Shape) -> bool:
