@@ -416,14 +416,19 @@ def same_paint(frame_rgb: U8Array, colour_rgb: tuple[int, int, int]) -> npt.NDAr
     if int(own[1]) < _GREY_SATURATION:
         grey: npt.NDArray[np.bool_] = hsv[:, :, 1] < _GREY_SATURATION
         return grey
-    d = np.abs(hsv[:, :, 0].astype(np.int16) - int(own[0]))
-    saturation = hsv[:, :, 1].astype(np.int32)
+    # Per-pixel tests as look-up tables over the 256 values of one channel: the same
+    # arithmetic, done once per value instead of once per pixel.
+    hue, saturation, value = cv2.split(hsv)
+    d = np.abs(_CHANNEL - int(own[0]))
+    hue_lut = ((np.minimum(d, 180 - d) <= _WALL_HUE_HALF_DEG) * 255).astype(np.uint8)
     # S = (max - min) / max moves by at most 3 n / V for n of noise in each channel
-    spread = (3 * 255 * _SHADE_NOISE_DN) // np.maximum(hsv[:, :, 2].astype(np.int32), 1)
+    spread = (3 * 255 * _SHADE_NOISE_DN) // np.maximum(_CHANNEL, 1)
+    least = np.clip(np.maximum(int(own[1]) - spread, _GREY_SATURATION), 0, 255).astype(np.uint8)
+    most = np.clip(int(own[1]) + spread, 0, 255).astype(np.uint8)
     alike: npt.NDArray[np.bool_] = (
-        (np.minimum(d, 180 - d) <= _WALL_HUE_HALF_DEG)
-        & (saturation >= _GREY_SATURATION)
-        & (np.abs(saturation - int(own[1])) <= spread)
+        (cv2.LUT(hue, hue_lut) > 0)
+        & (saturation >= cv2.LUT(value, least))
+        & (saturation <= cv2.LUT(value, most))
     )
     return alike
 
@@ -433,6 +438,8 @@ def near_colour(frame_rgb: U8Array, rgb: tuple[int, int, int], tolerance_dn: int
     return _near(_check_frame(frame_rgb), rgb, tolerance_dn)
 
 
+_CHANNEL = np.arange(256, dtype=np.int64)
+"""Every value an 8-bit channel takes: the index of a look-up table."""
 _GREY_SATURATION = 40
 """OpenCV saturation (0-255) under which a colour counts as grey (its hue says nothing)."""
 _WALL_HUE_HALF_DEG = 8
