@@ -254,10 +254,21 @@ def _rms_to_edges(
     points: Sequence[tuple[float, float]],
     edges: Sequence[tuple[tuple[float, float], tuple[float, float]]],
 ) -> float:
-    """RMS of each point's distance to the nearest of ``edges``."""
+    """RMS of each point's distance to the nearest of ``edges``: `point_segment_distance`'s
+    arithmetic, step for step, on every pair at once (the same floats), summed in order."""
+    p = np.asarray(points, dtype=np.float64)
+    ends = np.asarray(edges, dtype=np.float64)
+    px, py = p[:, 0:1], p[:, 1:2]
+    ax, ay, bx, by = ends[:, 0, 0], ends[:, 0, 1], ends[:, 1, 0], ends[:, 1, 1]
+    dx, dy = bx - ax, by - ay
+    den = dx * dx + dy * dy
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = ((px - ax) * dx + (py - ay) * dy) / den
+    t = np.where(den == 0.0, 0.0, np.minimum(1.0, np.maximum(0.0, t)))
+    ex, ey = px - (ax + t * dx), py - (ay + t * dy)
+    nearest = np.sqrt(ex * ex + ey * ey).min(axis=1)
     total = 0.0
-    for p in points:
-        d = min(point_segment_distance(p, a, b) for a, b in edges)
+    for d in nearest.tolist():
         total += d * d
     return math.sqrt(total / len(points))
 
