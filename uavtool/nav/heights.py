@@ -24,7 +24,6 @@ import numpy as np
 import numpy.typing as npt
 
 from uavtool.camera import CameraPose, Intrinsics, project
-from uavtool.nav.geometry import point_segment_distance
 
 SIZE_ERROR = 0.01
 """Relative error of a roof's linear size in pixels (its outline's area, square-rooted)."""
@@ -254,8 +253,9 @@ def _rms_to_edges(
     points: Sequence[tuple[float, float]],
     edges: Sequence[tuple[tuple[float, float], tuple[float, float]]],
 ) -> float:
-    """RMS of each point's distance to the nearest of ``edges``: `point_segment_distance`'s
-    arithmetic, step for step, on every pair at once (the same floats), summed in order."""
+    """RMS of each point's distance to the nearest of ``edges``: the arithmetic of
+    `~uavtool.nav.geometry.point_segment_distance`, step for step, on every pair at once
+    (the same floats), summed in order."""
     p = np.asarray(points, dtype=np.float64)
     ends = np.asarray(edges, dtype=np.float64)
     px, py = p[:, 0:1], p[:, 1:2]

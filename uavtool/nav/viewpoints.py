@@ -389,6 +389,15 @@ def _sight_blocked(
     """Whether the straight line from ``eye`` to ``point`` passes through a building of
     ``footprint`` standing ``height_m`` tall (``math.inf``: of unknown height)."""
     (ex, ey, ez), (px, py, pz) = eye, point
+    xs = [x for x, _ in footprint]
+    ys = [y for _, y in footprint]
+    if (
+        max(ex, px) < min(xs)
+        or min(ex, px) > max(xs)
+        or max(ey, py) < min(ys)
+        or min(ey, py) > max(ys)
+    ):
+        return False  # the line's box misses the footprint's: neither end in it, no crossing
     if point_in_polygon((px, py), footprint):
         return False  # the point stands in it (a building touching the target)
     dx, dy = px - ex, py - ey
