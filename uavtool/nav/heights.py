@@ -156,28 +156,26 @@ def roof_from_cut_outline(
     if top_m <= 0.0:
         return None
 
-    cut_edges = [e for ring in (cut_ring_px, *cut_holes_px) for e in _ring_edges(ring)]
-    whole_rings = (whole_ring_px, *whole_holes_px)
-
-    def carried(h_m: float) -> list[list[tuple[float, float]]] | None:
-        rings = [_reprojected(w, whole_pose, cut_pose, k, h_m) for w in whole_rings]
-        return None if any(r is None for r in rings) else [r for r in rings if r is not None]
+    cut_edges = _edge_arrays([np.asarray(r, np.float64) for r in (cut_ring_px, *cut_holes_px)])
+    at_points = np.asarray(samples, np.float64)
+    carry = _Carrier((whole_ring_px, *whole_holes_px), whole_pose, cut_pose, k)
 
     def cut_on_whole(h_m: float) -> float:  # pixels
-        rings = carried(h_m)
+        rings = carry.at(h_m)
         if rings is None:
             return math.inf
-        return _rms_to_edges(samples, [e for ring in rings for e in _ring_edges(ring)])
+        return _rms_to_edge_arrays(at_points, _edge_arrays(rings))
 
     def whole_on_cut_px(h_m: float) -> float:
-        rings = carried(h_m)
+        rings = carry.at(h_m)
         if rings is None:
             return math.inf
-        inside = [p for ring in rings for p in _inner_edge_points(ring, k, border_px)]
-        everywhere = sum(_ring_length(ring) for ring in rings) / 2.0  # points every 2 px
+        listed = [ring.tolist() for ring in rings]
+        inside = [p for ring in listed for p in _inner_edge_points(ring, k, border_px)]
+        everywhere = sum(_ring_length(ring) for ring in listed) / 2.0  # points every 2 px
         if len(inside) < max(3.0, _INSIDE_SHARE * everywhere):
             return math.inf
-        return _rms_to_edges(inside, cut_edges)
+        return _rms_to_edge_arrays(np.asarray(inside, np.float64), cut_edges)
 
     return _fit_height(
         whole_on_cut_px if whole_on_cut else cut_on_whole, top_m, cut_pose.pos_enu_m[2]
@@ -253,23 +251,38 @@ def _rms_to_edges(
     points: Sequence[tuple[float, float]],
     edges: Sequence[tuple[tuple[float, float], tuple[float, float]]],
 ) -> float:
-    """RMS of each point's distance to the nearest of ``edges``: the arithmetic of
-    `~uavtool.nav.geometry.point_segment_distance`, step for step, on every pair at once
-    (the same floats), summed in order."""
-    p = np.asarray(points, dtype=np.float64)
+    """RMS of each point's distance to the nearest of ``edges``."""
     ends = np.asarray(edges, dtype=np.float64)
-    px, py = p[:, 0:1], p[:, 1:2]
-    ax, ay, bx, by = ends[:, 0, 0], ends[:, 0, 1], ends[:, 1, 0], ends[:, 1, 1]
-    dx, dy = bx - ax, by - ay
+    return _rms_to_edge_arrays(np.asarray(points, np.float64), (ends[:, 0], ends[:, 1]))
+
+
+_Edges = tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]
+"""Edges as two (n, 2) arrays: where each starts, where it ends."""
+
+
+def _edge_arrays(rings: Sequence[npt.NDArray[np.float64]]) -> _Edges:
+    """Every edge of closed ``rings`` ((n, 2) arrays of vertices)."""
+    return (
+        np.concatenate(rings),
+        np.concatenate([np.roll(ring, -1, axis=0) for ring in rings]),
+    )
+
+
+def _rms_to_edge_arrays(points: npt.NDArray[np.float64], edges: _Edges) -> float:
+    """RMS of each point's ((n, 2) array) distance to the nearest of ``edges``: the arithmetic
+    of `~uavtool.nav.geometry.point_segment_distance`, step for step, on every pair at once
+    (the same floats), the squares summed in order."""
+    a, b = edges
+    px, py = points[:, 0:1], points[:, 1:2]
+    ax, ay = a[:, 0], a[:, 1]
+    dx, dy = b[:, 0] - ax, b[:, 1] - ay
     den = dx * dx + dy * dy
     with np.errstate(divide="ignore", invalid="ignore"):
         t = ((px - ax) * dx + (py - ay) * dy) / den
     t = np.where(den == 0.0, 0.0, np.minimum(1.0, np.maximum(0.0, t)))
     ex, ey = px - (ax + t * dx), py - (ay + t * dy)
     nearest = np.sqrt(ex * ex + ey * ey).min(axis=1)
-    total = 0.0
-    for d in nearest.tolist():
-        total += d * d
+    total = float(np.add.accumulate(nearest * nearest)[-1])  # in order, as a loop would
     return math.sqrt(total / len(points))
 
 
@@ -332,6 +345,56 @@ def _reprojected(
             )
         )
     return out
+
+
+class _Carrier:
+    """`_reprojected` of several rings onto many planes: each vertex's ray, which the plane
+    does not change, worked out once (as `_reprojected` works it out), then every vertex of
+    a ring carried at once, with `_reprojected`'s arithmetic (the same floats)."""
+
+    def __init__(
+        self,
+        rings: Sequence[Sequence[tuple[float, float]]],
+        pose: CameraPose,
+        other: CameraPose,
+        k: Intrinsics,
+    ) -> None:
+        right, down, forward = pose.axes()
+        self._right, self._down, self._forward = other.axes()
+        self._camera, self._other, self._k = pose.pos_enu_m, other.pos_enu_m, k
+        self._rays: list[npt.NDArray[np.float64]] | None = []
+        for ring in rings:
+            rays = []
+            for u, v in ring:
+                x = (u - k.cx_px) / k.fx_px
+                y = (v - k.cy_px) / k.fy_px
+                d = [right[i] * x + down[i] * y + forward[i] for i in range(3)]
+                if not d[2] < 0.0:
+                    self._rays = None  # a vertex above the horizon: on no plane below
+                    return
+                rays.append(d)
+            self._rays.append(np.asarray(rays, np.float64).reshape(-1, 3))
+
+    def at(self, plane_z_m: float) -> list[npt.NDArray[np.float64]] | None:
+        """Each ring's pixels ((n, 2) arrays) in the other photo, on the plane z =
+        ``plane_z_m``; None if a vertex falls behind the other camera."""
+        if self._rays is None:
+            return None
+        (cx, cy, cz), (ox, oy, oz), k = self._camera, self._other, self._k
+        o_right, o_down, o_forward = self._right, self._down, self._forward
+        out = []
+        for d in self._rays:
+            t = (cz - plane_z_m) / -d[:, 2]
+            p0 = cx + t * d[:, 0] - ox
+            p1 = cy + t * d[:, 1] - oy
+            p2 = plane_z_m - oz
+            depth = p0 * o_forward[0] + p1 * o_forward[1] + p2 * o_forward[2]
+            if not bool(np.all(depth > 0.0)):
+                return None
+            u = k.fx_px * (p0 * o_right[0] + p1 * o_right[1] + p2 * o_right[2]) / depth + k.cx_px
+            v = k.fy_px * (p0 * o_down[0] + p1 * o_down[1] + p2 * o_down[2]) / depth + k.cy_px
+            out.append(np.stack([u, v], axis=1))
+        return out
 
 
 def nadir_px(pose: CameraPose, intrinsics: Intrinsics) -> tuple[float, float]:
