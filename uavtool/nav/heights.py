@@ -320,37 +320,14 @@ def _reprojected(
 ) -> list[tuple[float, float]] | None:
     """``ring_px`` of ``pose``'s photo placed on the plane z = ``plane_z_m`` and seen from
     ``other``: its pixels there (None if a vertex falls behind that camera)."""
-    right, down, forward = pose.axes()
-    o_right, o_down, o_forward = other.axes()
-    cx, cy, cz = pose.pos_enu_m
-    ox, oy, oz = other.pos_enu_m
-    out = []
-    for u, v in ring_px:
-        x = (u - k.cx_px) / k.fx_px
-        y = (v - k.cy_px) / k.fy_px
-        d = [right[i] * x + down[i] * y + forward[i] for i in range(3)]
-        if not d[2] < 0.0:
-            return None
-        t = (cz - plane_z_m) / -d[2]
-        p = (cx + t * d[0] - ox, cy + t * d[1] - oy, plane_z_m - oz)
-        depth = p[0] * o_forward[0] + p[1] * o_forward[1] + p[2] * o_forward[2]
-        if not depth > 0.0:
-            return None
-        out.append(
-            (
-                k.fx_px * (p[0] * o_right[0] + p[1] * o_right[1] + p[2] * o_right[2]) / depth
-                + k.cx_px,
-                k.fy_px * (p[0] * o_down[0] + p[1] * o_down[1] + p[2] * o_down[2]) / depth
-                + k.cy_px,
-            )
-        )
-    return out
+    rings = _Carrier([ring_px], pose, other, k).at(plane_z_m)
+    return None if rings is None else [(u, v) for u, v in rings[0].tolist()]
 
 
 class _Carrier:
-    """`_reprojected` of several rings onto many planes: each vertex's ray, which the plane
-    does not change, worked out once (as `_reprojected` works it out), then every vertex of
-    a ring carried at once, with `_reprojected`'s arithmetic (the same floats)."""
+    """Rings of one photo placed on planes z = h and seen from another camera: each vertex's
+    ray, which the plane does not change, worked out once, then every vertex of a ring
+    carried at once."""
 
     def __init__(
         self,
