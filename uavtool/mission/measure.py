@@ -339,12 +339,15 @@ def measure_roof(
     edges on the cut one's), which finds the outline's height, a stepped tower's lowest
     tier."""
     k = photo.intrinsics
+    limit_px = max(_AGREE * math.sqrt(shape.area_px), 2.0) * (1.0 + shape.cut_by_border)
     best: tuple[float, float] | None = None  # (disagreement px, height)
     for cand in others:
         if not same_colour(m, cand.colour_rgb, shape.colour_rgb):
             continue
         if shape.cut_by_border and cand.cut_by_border:
             continue
+        if _apart_at_any_height(shape, photo, cand, other, below_m, limit_px):
+            continue  # no height found could place both here: not worth a fit
         if not shape.cut_by_border and not cand.cut_by_border:
             roof = roof_between(shape, photo, cand, other)  # None: no one roof explains both
         else:
@@ -370,8 +373,6 @@ def measure_roof(
         if roof is None or not 0.0 <= roof <= below_m:
             continue
         miss = _disagreement_px(shape, photo, cand, other, roof)
-        size_px = math.sqrt(shape.area_px)
-        limit_px = max(_AGREE * size_px, 2.0) * (1.0 + shape.cut_by_border)
         if miss is not None and miss <= limit_px and (best is None or miss < best[0]):
             best = (miss, roof)
     return None if best is None else best[1]
@@ -426,6 +427,35 @@ def measure_on_tour(
             return roof
     tour.append((other, seen_here))
     return None
+
+
+def _apart_at_any_height(
+    shape: Shape, photo: Photo, cand: Shape, other: Photo, top_m: float, limit_px: float
+) -> bool:
+    """Whether `_disagreement_px` exceeds ``limit_px`` at every height in 0..``top_m``, so
+    that no roof height found for the pair could pass it. Each photo's centroid, placed on
+    the plane z = h, moves linearly with h: their distance is least where the gap between
+    two lines is; over the camera's height above the ground, which is at least its height
+    above the plane, it bounds the disagreement from below. False (fit it) when a centroid
+    cannot be placed on both planes."""
+    try:
+        a0 = ground_point(*shape.centroid_px, photo.pose, photo.intrinsics)
+        a1 = ground_point(*shape.centroid_px, photo.pose, photo.intrinsics, plane_z_m=top_m)
+        b0 = ground_point(*cand.centroid_px, other.pose, other.intrinsics)
+        b1 = ground_point(*cand.centroid_px, other.pose, other.intrinsics, plane_z_m=top_m)
+    except NavError:
+        return False
+    gap = (a0[0] - b0[0], a0[1] - b0[1])
+    change = (a1[0] - b1[0] - gap[0], a1[1] - b1[1] - gap[1])
+    square = change[0] * change[0] + change[1] * change[1]
+    s = 0.0 if square == 0.0 else -(gap[0] * change[0] + gap[1] * change[1]) / square
+    s = min(1.0, max(0.0, s))
+    least_m = math.hypot(gap[0] + s * change[0], gap[1] + s * change[1])
+    camera_m = photo.pose.pos_enu_m[2]
+    if not camera_m > 0.0:
+        return False
+    # a hair of room for rounding: at the limit, fit and let `_disagreement_px` judge
+    return least_m * photo.intrinsics.fx_px / camera_m > limit_px * (1.0 + 1e-6) + 1e-6
 
 
 def _disagreement_px(
