@@ -129,13 +129,6 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
             ]
     assumed_m = m.params.mission.assumed_roof_m
     tallest_m = below_camera_m(m, seen.photo)
-    # What the roofs as measured do not explain (a taller part of a building, a neighbour
-    # of a darker shade merged with it in the photo) is not measured: it may be as high as
-    # its region allows.
-    others += unexplained(
-        seen.photo, seen.shapes, roofs, measured, seen.regions, m.params.vectorize
-    )
-    others_m += [None] * (len(others) - len(others_m))
     # What the overviews could not tell from the ground (beyond the lower one, near the
     # point below both), the tour's photos, taken from beside it, may: a lawn, a road.
     ground = frozenset(
@@ -144,6 +137,16 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         if not (measured[i] and roofs[i] > STOREY_M)
         and lies_on_ground(m, s, seen.photo, photos, one_colour=False)
     )
+    for i in ground:
+        roofs[i], measured[i] = 0.0, True
+    # What the roofs as measured do not explain (a taller part of a building, a neighbour
+    # of a darker shade merged with it in the photo) is not measured: it may be as high as
+    # its region allows. Ground explains only itself: a lawn of unknown height explained
+    # its whole region, and a tower beside it was once left out of every obstacle when the
+    # lawn was found to be ground.
+    later = unexplained(seen.photo, seen.shapes, roofs, measured, seen.regions, m.params.vectorize)
+    others += later
+    others_m += _measured_by(m, later, seen.photo, photos, below_m)
     flat = 0
     if photos:
         still: list[tuple[Shape, float | None]] = []
@@ -163,8 +166,6 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
             f"{len(ground) + flat} more region(s) lie on the ground (parallax between the "
             "overview and the photos from above): not buildings",
         )
-    for i in ground:
-        roofs[i], measured[i] = 0.0, True
     # Each photo is evidence of where nothing stands: the ground it sees, and the roofs of
     # known height (measured whole) it sees in their places.
     known = [
@@ -265,6 +266,24 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         obstacles=obstacles,
         roofless=frozenset(range(len(seen.shapes), len(shapes))),
     )
+
+
+def _measured_by(
+    m: SearchMission, regions: list[Shape], photo: Photo, photos: list[Photo], below_m: float
+) -> list[float | None]:
+    """Each of ``regions`` (of nadir ``photo``) measured against the first of ``photos``
+    (nadir, taken already) that shows its roof, as the tour measures obstacles; None where
+    none does."""
+    heights: list[float | None] = [None] * len(regions)
+    for other in photos:
+        if all(h is not None for h in heights):
+            break
+        found = non_ground(other.image_rgb, m.params.vectorize)
+        heights = [
+            h if h is not None else measure_roof(m, r, photo, other, found, below_m=below_m)
+            for r, h in zip(regions, heights, strict=True)
+        ]
+    return heights
 
 
 def may_be_target(m: SearchMission, region: Shape) -> bool:

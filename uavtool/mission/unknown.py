@@ -338,7 +338,7 @@ def unexplained(
         if region is None:
             continue
         cv2.fillPoly(touched, [pixels(region.polygon_px)], 255)
-        if ok and not shape.cut_by_border:
+        if ok and (roof_m <= 0.0 or not shape.cut_by_border):  # ground has no walls
             for ring in _prism_px(shape, photo, roof_m):  # one by one: overlaps stay filled
                 cv2.fillPoly(explained, [ring], 255)
         else:
