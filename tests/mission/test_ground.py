@@ -86,3 +86,20 @@ def test_a_tower_a_lawn_of_unknown_height_explained_stays_an_obstacle_once_it_is
         if roof >= top - 1.0
     ]
     assert max(covered, default=0.0) > 0.9
+
+
+def test_the_ground_beside_a_darker_field_of_its_hue_is_ground() -> None:
+    """World scene 50015: a brown ground with a grain, and a darker brown field beside the
+    road. The ground, a region of its own colour as wide as the frame, lies on the ground
+    by parallax, but the field along its outline looked like its walls (another shade of
+    its colour), and it stayed a building of unknown height under every way: looks flew at
+    116 m and small buildings of the target's colour were never judged. The field's own
+    parallax shows it lies on the ground too: no walls, and the ground is no obstacle."""
+    scene = load_scene(str(Path(__file__).parent / "data" / "world-50015.yaml"))
+    flown = fly(scene)
+    mission = flown.mission
+    assert mission.plan is not None
+    assert all(poi.area_px < 640 * 480 / 2 for poi in mission.plan.pois)
+    # the overview from 117 m covers some 14,000 m²: no place of unknown height is most of it
+    widest = max(shapely.Polygon(place.footprint).area for place in mission.unknown.values())
+    assert widest < 2_000.0

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 import cv2
 import numpy as np
+import numpy.typing as npt
 
 from uavtool.mission.observations import Photo
 from uavtool.nav.parallax import STOREY_M, least_telling_m, on_ground
@@ -21,6 +22,8 @@ if TYPE_CHECKING:
 CvArray = Any
 _WALL_BAND_PX = 3
 """How far around a region its walls are looked for: past its blended edge."""
+_SHADES = 4
+"""How many shades of what looks like walls beside a region are told apart (`_painted`)."""
 _NEAR_DN = 30
 """A region is one colour when all but a shape's worth of its pixels lie this close (per
 channel) to its colour: flat shading and a ground texture (`uavtool.nav.parallax`)."""
@@ -40,29 +43,79 @@ def lies_on_ground(
     touches), only a region of one colour may be: else what it holds besides might stand."""
     if not others:
         return False
-    region = outline_mask(photo.image_rgb, shape)
-    if shows_walls(photo, shape, shape.colour_rgb, least_px=m.params.vectorize.min_edge_px):
-        return False
     least = m.params.vectorize.min_area_px
+    walls = wall_pixels(photo, shape, shape.colour_rgb)
+    if _count(walls) >= m.params.vectorize.min_edge_px and not _painted(
+        walls, photo, others, least, m.params.vectorize.min_edge_px
+    ):
+        return False
+    region = outline_mask(photo.image_rgb, shape)
     if one_colour:
         other_colour = cv2.bitwise_and(region, cv2.bitwise_not(_near(photo, shape.colour_rgb)))
         if cv2.countNonZero(other_colour) >= least:
             return False
+    return _flat(region, shape.colour_rgb, photo, others, least)
+
+
+def _flat(
+    region: CvArray,
+    colour_rgb: tuple[int, int, int],
+    photo: Photo,
+    others: Sequence[Photo],
+    least_px: float,
+) -> bool:
+    """Whether one of ``others`` tells ``region`` (of ``colour_rgb``) lies on the ground."""
     return any(
         on_ground(
             region,
-            shape.colour_rgb,
+            colour_rgb,
             photo.image_rgb,
             photo.pose,
             other.image_rgb,
             other.pose,
             photo.intrinsics,
             top_m=other.pose.pos_enu_m[2] - 1.0,
-            least_px=least,
+            least_px=least_px,
         )
         is True
         for other in others
     )
+
+
+def _painted(
+    walls: npt.NDArray[np.bool_],
+    photo: Photo,
+    others: Sequence[Photo],
+    least_px: float,
+    few_px: float,
+) -> bool:
+    """Whether what looks like walls beside a region (``walls``) is ground of a shade of
+    its colour: a field or a lawn. Shade by shade (the median of what is left), the pixels
+    of that shade joined to them must lie on the ground by parallax, as the region itself
+    must; a real wall, whose top stands off the ground, does not. At most ``_SHADES``
+    shades, until fewer than ``few_px`` are left."""
+    left = walls.copy()
+    for _ in range(_SHADES):
+        if _count(left) < few_px:
+            return True
+        pixels = np.sort(photo.image_rgb[left], axis=0)  # (np.median imports numpy.ma)
+        shade = tuple(int(c) for c in pixels[len(pixels) // 2])
+        near = _near(photo, shade)  # type: ignore[arg-type]
+        _, labels = cv2.connectedComponents(near, connectivity=8)
+        # (np.unique would import numpy.ma: tests/test_imports.py)
+        hits = np.bincount(labels[left & (near > 0)], minlength=int(labels.max()) + 1)
+        hits[0] = 0
+        if not hits.any():
+            return False
+        joined = (hits > 0)[labels]
+        if not _flat(np.where(joined, 255, 0).astype(np.uint8), shade, photo, others, least_px):  # type: ignore[arg-type]
+            return False
+        left &= ~joined
+    return _count(left) < few_px
+
+
+def _count(mask: npt.NDArray[np.bool_]) -> int:
+    return int(np.count_nonzero(mask))
 
 
 def measured_flat(
@@ -94,12 +147,22 @@ def shows_walls(
     none; a lawn beside a building of its hue seems to, and is not taken for ground. Inside
     its holes stands whatever they hold: a courtyard's walls, or a building standing on a
     lawn or a ground of its hue, whose walls are its own."""
+    return _count(wall_pixels(photo, shape, colour_rgb)) >= least_px
+
+
+def wall_pixels(
+    photo: Photo, shape: Shape, colour_rgb: tuple[int, int, int]
+) -> npt.NDArray[np.bool_]:
+    """The pixels just outside ``shape``'s outer outline that show another shade of
+    ``colour_rgb`` (`shows_walls`)."""
     outer = np.zeros(photo.image_rgb.shape[:2], np.uint8)
     cv2.fillPoly(outer, [np.round(shape.polygon_px).astype(np.int32).reshape(-1, 1, 2)], 255)
     kernel = np.ones((2 * _WALL_BAND_PX + 1, 2 * _WALL_BAND_PX + 1), np.uint8)
     band = cv2.subtract(cv2.dilate(outer, kernel), outer)
-    walls = (band > 0) & same_paint(photo.image_rgb, colour_rgb) & (_near(photo, colour_rgb) == 0)
-    return int(np.count_nonzero(walls)) >= least_px
+    walls: npt.NDArray[np.bool_] = (
+        (band > 0) & same_paint(photo.image_rgb, colour_rgb) & (_near(photo, colour_rgb) == 0)
+    )
+    return walls
 
 
 def without_ground(

@@ -245,7 +245,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         {
             i: place_of(s)
             for i, (s, ok) in enumerate(zip(shapes, measured, strict=True))
-            if ok and s.cut_by_border and not at_first[i]
+            if ok and s.cut_by_border and not at_first[i] and i not in ground
         }
     )
     m.unknown.update(

@@ -600,7 +600,10 @@ def _closer_look(
             for seen, earlier in sorted(before, key=lambda b: -abs(b[1].pose.pos_enu_m[2] - alt))
         )
         roof = next((h for h in heights if h is not None), None)
-        if roof is None or roof > p.assumed_roof_m:
+        # a roof no closer look could clear is no height to learn (a mismatched pair); one
+        # taller than the tallest expected is believed (a tower: 25.4 m for a 25 m roof
+        # was once refused, and the target never looked at from closer)
+        if roof is None or roof + p.min_above_roof_m > look.alt_m - p.recheck_climb_m / 2.0:
             return None
     k = photo.intrinsics
     plane = min(roof, look.alt_m - 1)

@@ -105,7 +105,7 @@ def on_ground(
         if shown < least_px:
             return None  # the other photo shows too little of it
         differ = cv2.absdiff(here, carried).astype(np.float64).sum(axis=2)[seen > 0]
-        return float(differ.sum()) / shown, float(np.median(differ))
+        return float(differ.sum()) / shown, _median(differ)
 
     ground = misfit(0.0)
     if ground is None:
@@ -125,6 +125,16 @@ def on_ground(
     # (a storey and up) would misalign it: a grain standing out of the noise.
     storeys = [f[1] for z, f in tried if z >= STOREY_M]
     return bool(storeys) and ground[1] < GRAIN_RATIO * min(storeys)
+
+
+def _median(values: npt.NDArray[np.float64]) -> float:
+    """``np.median`` of a 1-D array, without the import of numpy.ma it makes."""
+    n = len(values)
+    half = n // 2
+    if n % 2:
+        return float(np.partition(values, half)[half])
+    part = np.partition(values, (half - 1, half))
+    return float((part[half - 1] + part[half]) / 2.0)
 
 
 def _near(image: npt.NDArray[np.uint8], rgb: tuple[int, int, int]) -> CvArray:
