@@ -289,6 +289,17 @@ class SearchMission(FlightMission):
                 need = max(need, self._clear_of(top))
         return need
 
+    def floor_along(self, a: tuple[float, float], b: tuple[float, float]) -> float:
+        """The lowest altitude that keeps the safety margin (and the arrival radius) above
+        every roof within the margin of the ground track from ``a`` to ``b``, known or of
+        unknown height (`floor_at` along a line)."""
+        margin_m = self.params.viewpoints.safety_margin_m
+        need = 0.0
+        for footprint, roof_m in self.roofs:
+            if segment_polygon_distance(a, b, footprint) <= margin_m:
+                need = max(need, roof_m + margin_m + self.params.mission.arrive_radius_m)
+        return max(need, self._over_unknown((a[0], a[1], 0.0), b))
+
     def learn_roof(
         self, index: int, footprint: tuple[tuple[float, float], ...], roof_m: float
     ) -> None:
