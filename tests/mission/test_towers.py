@@ -70,3 +70,15 @@ def test_a_courtyard_tower_is_measured_though_one_photo_sees_no_courtyard_floor(
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == "b01"
     assert summary.evaluation.model_iou is not None and summary.evaluation.model_iou > 0.8
+
+
+def test_a_tier_whose_walls_differ_little_from_its_roof_keeps_the_roof_unmeasured() -> None:
+    """World scene 50104: the target is a tower of three tiers (6.6, 12.3 and 16 m) in one
+    green, under much ambient light (0.76): its tiers' walls differ from the roof by 24 DN,
+    under the twice-the-tolerance (30 DN) a look's judgement asks of a wall. The tour then
+    took its outline's height, the lowest tier's 6.6 m, for a flat roof, and after the match
+    the mission descended to 15.4 m over it: into the top tier (a crash, reported as one).
+    Telling whether a roof is flat, any shade beyond the tolerance is a wall."""
+    summary = fly(FlyConfig(scene=str(DATA / "world-50104.yaml"), no_record=True))
+    assert summary.outcome.status is not Status.CRASHED, summary.outcome.reason
+    assert summary.clearance_m is not None and summary.clearance_m > 2.0

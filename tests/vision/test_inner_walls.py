@@ -1,5 +1,6 @@
 """`inner_walls` finds exactly the strips the plain numpy definition does: a pixel inside the
-roof whose colour differs from the roof's by more than twice the tolerance in some channel,
+roof whose colour differs from the roof's by more than twice the tolerance (or the shade
+given) in some channel,
 of the roof's paint (its hue and saturation), touching no ground (its faster mask must not
 move a single pixel)."""
 
@@ -17,11 +18,14 @@ from uavtool.vision.vectorize import ground_mask, inner_walls, roof_inside, same
 GROUND = (128, 128, 128)
 
 
-def _reference(frame: npt.NDArray[np.uint8], shape: Shape, tolerance_dn: int) -> list[np.ndarray]:
+def _reference(
+    frame: npt.NDArray[np.uint8], shape: Shape, tolerance_dn: int, shade_dn: int | None
+) -> list[np.ndarray]:
     """`inner_walls` as first written, with numpy's per-pixel maximum over the channels."""
     inside = roof_inside(frame, shape, inset_px=1, tolerance_dn=tolerance_dn)
     roof = np.array(shape.colour_rgb, np.int16)
-    other = np.abs(frame.astype(np.int16) - roof).max(axis=2) > 2 * tolerance_dn
+    shade = 2 * tolerance_dn if shade_dn is None else shade_dn
+    other = np.abs(frame.astype(np.int16) - roof).max(axis=2) > shade
     hsv = cv2.cvtColor(frame, cv2.COLOR_RGB2HSV)
     roof_hsv = cv2.cvtColor(np.array([[shape.colour_rgb]], np.uint8), cv2.COLOR_RGB2HSV)[0, 0]
     if int(roof_hsv[1]) < 40:
@@ -54,6 +58,7 @@ _channel = st.integers(0, 255)
     shade=st.tuples(_channel, _channel, _channel),
     step=st.integers(-40, 40),
     tolerance_dn=st.sampled_from([0, 1, 7, 15, 20, 60, 130]),
+    shade_dn=st.sampled_from([None, 0, 15, 30, 100]),
     seed=st.integers(0, 2**32 - 1),
 )
 def test_inner_walls_are_those_of_the_numpy_definition(
@@ -61,6 +66,7 @@ def test_inner_walls_are_those_of_the_numpy_definition(
     shade: tuple[int, int, int],
     step: int,
     tolerance_dn: int,
+    shade_dn: int | None,
     seed: int,
 ) -> None:
     frame = np.full((60, 80, 3), GROUND, np.uint8)
@@ -74,8 +80,8 @@ def test_inner_walls_are_those_of_the_numpy_definition(
         colour_rgb=roof,
         polygon_px=np.array([[10.0, 10.0], [69.0, 10.0], [69.0, 49.0], [10.0, 49.0]]),
     )
-    got = inner_walls(frame, shape, tolerance_dn=tolerance_dn)
-    want = _reference(frame, shape, tolerance_dn)
+    got = inner_walls(frame, shape, tolerance_dn=tolerance_dn, shade_dn=shade_dn)
+    want = _reference(frame, shape, tolerance_dn, shade_dn)
     assert len(got) == len(want)
     for a, b in zip(got, want, strict=True):
         assert a.dtype == b.dtype and np.array_equal(a, b)

@@ -281,7 +281,15 @@ def not_flat(
     hole of the roof's outline there (``other_shape``'s courtyards, which show ground
     somewhere), is a courtyard's far wall, going down, not a higher part's: a higher part
     shows from above as its walls on one side and its roof, never as a hole."""
-    walls = inner_walls(photo.image_rgb, shape, nadir_px=nadir_px(photo.pose, photo.intrinsics))
+    # Any shade beyond the colour tolerance counts here: a roof taken for flat is flown
+    # near, and a tier's walls under much ambient light differ little from its roof (24 DN
+    # in world scene 50104, whose 16 m tower was measured at its lowest tier, 6.6 m).
+    walls = inner_walls(
+        photo.image_rgb,
+        shape,
+        nadir_px=nadir_px(photo.pose, photo.intrinsics),
+        shade_dn=_WALL_SHADE_DN,
+    )
     if other is not None and walls:
         ground = ground_mask(other.image_rgb)
         if other_shape is not None and other_shape.holes_px:
@@ -291,6 +299,12 @@ def not_flat(
         walls = [w for w in walls if not _shows_ground(w, photo, other, roof_m, ground)]
     top = higher_part_m(walls, photo.pose, photo.intrinsics, roof_m=roof_m)
     return top is not None and top > roof_m + NOT_FLAT_M
+
+
+_WALL_SHADE_DN = 15
+"""How far (in some channel) a strip inside a roof must lie from the roof's colour to be a
+wall when telling whether the roof is flat: the colour tolerance (`inner_walls`' default
+``tolerance_dn``), without the factor of two the look's judgement keeps."""
 
 
 _GROUND_SHARE = 0.2

@@ -309,9 +309,11 @@ def inner_walls(
     tolerance_dn: int = 15,
     least_px: int = 3,
     nadir_px: tuple[float, float] | None = None,
+    shade_dn: int | None = None,
 ) -> list[npt.NDArray[np.int32]]:
     """The walls seen inside ``shape``'s roof: strips of another shade of its colour (the
-    same hue; grey for a grey roof) that do not stand on the ground. Seen from above, a
+    same hue; grey for a grey roof; in some channel more than ``shade_dn`` from the roof's,
+    by default twice ``tolerance_dn``) that do not stand on the ground. Seen from above, a
     roof's own walls lie outside its outline, and a courtyard's go down to the ground that
     shows between them: a wall inside the outline that stands on this roof is under a higher
     part of the building. Each strip is its ``(n, 2)`` pixels ``(u, v)``, at least
@@ -326,9 +328,10 @@ def inner_walls(
     inside = roof_inside(frame, shape, inset_px=1, tolerance_dn=tolerance_dn)
     # a channel more than 2 * tolerance_dn from the roof's: inRange's exact integer test is
     # ~30x faster than numpy's per-pixel max over three channels
+    shade = 2 * tolerance_dn if shade_dn is None else shade_dn
     other = (
-        cv2.bitwise_not(_near(frame, shape.colour_rgb, 2 * tolerance_dn))
-        if tolerance_dn >= 0
+        cv2.bitwise_not(_near(frame, shape.colour_rgb, shade))
+        if shade >= 0
         else np.ones(frame.shape[:2], np.uint8)
     )
     strips = (inside > 0) & (other > 0) & same_paint(frame, shape.colour_rgb)
