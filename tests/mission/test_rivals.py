@@ -273,3 +273,28 @@ def test_a_closer_look_at_a_rival_across_the_scene_clears_the_roofs_on_the_way()
     summary = fly_scene(FlyConfig(scene=str(DATA / "world-50193.yaml"), no_record=True))
     assert summary.outcome.status is not Status.CRASHED, summary.outcome.reason
     assert summary.clearance_m is not None and summary.clearance_m > 2.0
+
+
+def test_a_stepped_target_scored_low_from_afar_keeps_a_near_shape_from_being_found() -> None:
+    """World scene 50196: the target is a stepped cross (three tiers), low sun, dark light.
+    From 112-117 m it scored 0.543-0.607, its roof of unknown height kept every look that
+    high, and a near shape (one arm 15 % shorter, one tier) scored 0.921 there, its outline
+    not compared (the target picture shows parts at several heights): the near shape was
+    reported found. A building of the target's colour left in doubt now holds any match by
+    score alone."""
+    summary = fly_scene(FlyConfig(scene=str(DATA / "world-50196.yaml"), no_record=True))
+    assert summary.evaluation.matched_building in ("", summary.evaluation.target_building)
+    assert summary.outcome.status is Status.NO_MATCH, summary.outcome.reason
+    assert "from too far to tell" in summary.outcome.reason
+
+
+def test_an_outline_that_may_hold_the_buildings_own_walls_excludes_nothing() -> None:
+    """World scene 50334: the target, a small L, looked at from 20 m over its roof, showed
+    the wall in its inner corner lit 15 DN brighter than its roof, within the vectorizer's
+    shade tolerance: the wall joined the roof's outline, 12.9 % off the target's, and the
+    target was ruled out. A near shape (its aspect changed) then matched within the photos'
+    accuracy and was reported found. An outline that may hold walls rules nothing out."""
+    summary = fly_scene(FlyConfig(scene=str(DATA / "world-50334.yaml"), no_record=True))
+    assert summary.evaluation.matched_building in ("", summary.evaluation.target_building)
+    assert summary.outcome.status is Status.NO_MATCH, summary.outcome.reason
+    assert "may hold its own walls" in summary.outcome.reason

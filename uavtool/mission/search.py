@@ -13,6 +13,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+import cv2
+import numpy as np
+
 from uavtool.camera import Intrinsics
 from uavtool.mission.analysis import (
     Judgement,
@@ -30,7 +33,12 @@ from uavtool.nav import NavError, ground_point, ground_polygon
 from uavtool.nav.geometry import point_polygon_distance
 from uavtool.nav.heights import fit_altitude_m
 from uavtool.vision import Shape
-from uavtool.vision.vectorize import enclosed_openings, hue_distance_deg
+from uavtool.vision.vectorize import (
+    enclosed_openings,
+    hue_distance_deg,
+    outline_mask,
+    same_paint,
+)
 
 if TYPE_CHECKING:
     from uavtool.mission.base import Wait
@@ -121,6 +129,7 @@ def search(
     best_score, best_poi = 0.0, -1
     matches: list[Found] = []  # every building that matched, in turn
     unjudged: list[tuple[int, _Look]] = []  # of the target's hue, never judged
+    doubtful: list[tuple[int, _Look, bool]] = []  # of the target's hue, judged in doubt
     todo = list(order)
     look_at: Inspector = inspector or (
         lambda k, _todo: inspect(m, k, pois, overview, overview_shapes, transit_m)
@@ -136,6 +145,8 @@ def search(
         j = look.judgement
         if not j.judgeable and j.candidate >= 0 and j.same_hue:
             unjudged.append((k, look))
+        elif (doubt := _doubtful(m, looks)) is not None:
+            doubtful.append((k, *doubt))
         if (
             j.matched
             and poi.shape_index in roofless
@@ -183,6 +194,12 @@ def search(
             Status.NO_MATCH, f"no building matched the target (best score {best_score:.3f}{where})"
         )
     _judged_all(m, best, unjudged)
+    # a match by score alone (its outline not compared) leaves any doubt standing; one
+    # whose outline lies on the target's, only a doubt of walls (its rival's outline was
+    # told apart from the target's, but may hold walls)
+    _judged_all(
+        m, best, [(k, look) for k, look, walls in doubtful if walls or not best.outline_compared]
+    )
     best = yield from _settle(m, best, matches)
     m.event(
         Level.INFO,
@@ -279,6 +296,62 @@ def inspect(
     return looks, upper
 
 
+def _doubtful(m: SearchMission, looks: list[_Look]) -> tuple[_Look, bool] | None:
+    """The look that left a point of interest in doubt, if the looks did, and whether the
+    doubt is its walls: a candidate of the target's hue that no look matched, and either
+
+    - scored between ``mission.recheck_min_score`` and the threshold, none of its outlines
+      told apart from the target's (`_other_outline`): the looks asked to see it again,
+      closer or higher, and ran out; a score from afar says little of a building whose
+      parts stand at several heights (False);
+    - or its outline was told apart from the target's only by a look whose outline may
+      hold the building's own walls (`_walls_inside`): a wall lit within the vectorizer's
+      shade tolerance of the roof joins the roof's outline (True)."""
+    threshold = m.params.recognize.threshold
+    least = m.params.mission.recheck_min_score
+    judged = [
+        look
+        for look in looks
+        if look.judgement.candidate >= 0 and look.judgement.same_hue and look.judgement.judgeable
+    ]
+    if any(look.judgement.matched for look in judged):
+        return None
+    apart = [look for look in judged if _other_outline(look.judgement)]
+    if apart:
+        if all(_walls_inside(m, look) for look in apart):
+            return max(apart, key=lambda look: look.judgement.score), True
+        return None  # a near shape, told apart clearly
+    doubts = [look for look in judged if least <= look.judgement.score < threshold]
+    if not doubts:
+        return None
+    return max(doubts, key=lambda look: look.judgement.score), False
+
+
+def _walls_inside(m: SearchMission, look: _Look) -> bool:
+    """Whether the look's candidate outline holds what may be the building's own walls:
+    at least ``vectorize.min_area_px`` pixels inside it (a pixel in from its edge) of its
+    paint (`same_paint`) whose brightness differs from the roof's by more than the roof's
+    own spread (three median deviations, at least 2 DN) but no more than
+    ``vectorize.roof_value_tolerance``, within which the vectorizer takes a shade for roof.
+    A lit wall, seen from close, then moves the outline by its width (world scene 50334:
+    the target's inner corner, 15 DN brighter than its roof, put its outline 12.9 % off)."""
+    shape = look.shapes[look.judgement.candidate]
+    image = look.photo.image_rgb
+    inside = cv2.erode(outline_mask(image, shape), np.ones((3, 3), np.uint8)) > 0
+    value = image.max(axis=2)[inside].astype(np.int16)
+    if value.size == 0:
+        return False
+    roof = max(shape.colour_rgb)
+    spread = np.sort(np.abs(value - roof))[value.size // 2]  # (np.median imports numpy.ma)
+    differ = np.abs(value - roof)
+    shaded = (
+        same_paint(image, shape.colour_rgb)[inside]
+        & (differ > max(3 * int(spread), 2))
+        & (differ <= m.params.vectorize.roof_value_tolerance)
+    )
+    return int(np.count_nonzero(shaded)) >= m.params.vectorize.min_area_px
+
+
 def _judged_all(m: SearchMission, best: Found, unjudged: list[tuple[int, _Look]]) -> None:
     """End the mission NO_MATCH when a building of the target's hue other than ``best``'s
     was never judged (drawn too small to tell its outline, or cut by the border, however
@@ -287,8 +360,16 @@ def _judged_all(m: SearchMission, best: Found, unjudged: list[tuple[int, _Look]]
         shape = look.shapes[look.judgement.candidate]
         if k == best.poi.index or _on_roof(best, look.photo, shape):
             continue
-        too_small = look.judgement.too_small
-        why = "drawn too small to tell its outline" if too_small else "cut by the image border"
+        j = look.judgement
+        why = (
+            "drawn too small to tell its outline"
+            if j.too_small
+            else "cut by the image border"
+            if not j.judgeable
+            else f"its outline, {j.outline_gap * 100:.1f} % off, may hold its own walls"
+            if _other_outline(j)
+            else f"scored {j.score:.3f} from too far to tell, and could not be looked at closer"
+        )
         raise m.end(
             Status.NO_MATCH,
             f"point of interest {best.poi.index} matches the target (score {best.score:.3f}), "
