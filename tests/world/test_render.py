@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from uavtool.camera import CameraPose, Intrinsics, project
 from uavtool.world import Block, Building, Scene, load_scene, render
 from uavtool.world.generator import generate_scene
-from uavtool.world.raster import prepare, project_faces, shade
+from uavtool.world.raster import NEAR_M, prepare, project_faces, shade
 from uavtool.world.reference import render_reference
 from uavtool.world.render import render_packed, rgb_from_packed
 
@@ -136,6 +136,19 @@ POSES = [
 ]
 
 
+def _near_a_building(scene: Scene, pose: CameraPose, reach_m: float) -> bool:
+    """Whether the camera is inside a block or within ``reach_m`` of one."""
+    import shapely
+
+    e, n, u = pose.pos_enu_m
+    return any(
+        blk.base_m - reach_m <= u <= blk.top_m + reach_m
+        and shapely.Polygon(blk.footprint_enu_m).distance(shapely.Point(e, n)) < reach_m
+        for b in scene.buildings
+        for blk in b.blocks
+    )
+
+
 def _inside_a_building(scene: Scene, pose: CameraPose) -> bool:
     import shapely
 
@@ -192,7 +205,9 @@ def test_random_scenes_match_reference(
 ) -> None:
     scene = generate_scene(seed=seed, buildings=6)
     pose = CameraPose((e, n, u), yaw, pitch)
-    assume(not _inside_a_building(scene, pose))
+    # within the near plane of a wall (3 mm from one, seed 4059) the renderer clips what the
+    # reference's rays still see: no pose to compare them at
+    assume(not _near_a_building(scene, pose, NEAR_M))
     _assert_same_but_ties(scene, pose, SMALL)
     # the per-pixel depth-test path (used when the order has a cycle) agrees exactly
     fast = render(scene, pose, SMALL)
