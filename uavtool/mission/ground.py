@@ -99,8 +99,9 @@ def _painted(
         if _count(left) < few_px:
             return True
         pixels = np.sort(photo.image_rgb[left], axis=0)  # (np.median imports numpy.ma)
-        shade = tuple(int(c) for c in pixels[len(pixels) // 2])
-        near = _near(photo, shade)  # type: ignore[arg-type]
+        r, g, b = (int(c) for c in pixels[len(pixels) // 2])
+        shade = (r, g, b)
+        near = _near(photo, shade)
         _, labels = cv2.connectedComponents(near, connectivity=8)
         # (np.unique would import numpy.ma: tests/test_imports.py)
         hits = np.bincount(labels[left & (near > 0)], minlength=int(labels.max()) + 1)
@@ -108,7 +109,7 @@ def _painted(
         if not hits.any():
             return False
         joined = (hits > 0)[labels]
-        if not _flat(np.where(joined, 255, 0).astype(np.uint8), shade, photo, others, least_px):  # type: ignore[arg-type]
+        if not _flat(np.where(joined, 255, 0).astype(np.uint8), shade, photo, others, least_px):
             return False
         left &= ~joined
     return _count(left) < few_px

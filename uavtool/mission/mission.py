@@ -32,7 +32,6 @@ from uavtool.mission.peek import Peek, peek
 from uavtool.mission.unknown import Unknown
 from uavtool.nav.geometry import (
     point_in_polygon,
-    point_polygon_distance,
     point_segment_distance,
     segment_polygon_distance,
 )
@@ -278,16 +277,7 @@ class SearchMission(FlightMission):
         radius) above every roof within the margin of it, and above the highest a roof of
         unknown height there may be. (A look aimed at one tier of a stepped tower must not
         descend onto another.)"""
-        margin_m = self.params.viewpoints.safety_margin_m
-        need = 0.0
-        for footprint, roof_m in self.roofs:
-            if point_polygon_distance((x, y), footprint) <= margin_m:
-                need = max(need, roof_m + margin_m + self.params.mission.arrive_radius_m)
-        for place in self.unknown.values():
-            top = place.top_m(lambda ring: point_polygon_distance((x, y), ring) <= margin_m)
-            if top is not None:
-                need = max(need, self._clear_of(top))
-        return need
+        return self.floor_along((x, y), (x, y))
 
     def floor_along(self, a: tuple[float, float], b: tuple[float, float]) -> float:
         """The lowest altitude that keeps the safety margin (and the arrival radius) above

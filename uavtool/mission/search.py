@@ -341,12 +341,12 @@ def _walls_inside(m: SearchMission, look: _Look) -> bool:
     value = image.max(axis=2)[inside].astype(np.int16)
     if value.size == 0:
         return False
-    roof = max(shape.colour_rgb)
-    spread = np.sort(np.abs(value - roof))[value.size // 2]  # (np.median imports numpy.ma)
-    differ = np.abs(value - roof)
+    differ = np.abs(value - max(shape.colour_rgb))
+    half = differ.size // 2
+    spread = int(np.partition(differ, half)[half])  # the median (np.median imports numpy.ma)
     shaded = (
         same_paint(image, shape.colour_rgb)[inside]
-        & (differ > max(3 * int(spread), 2))
+        & (differ > max(3 * spread, 2))
         & (differ <= m.params.vectorize.roof_value_tolerance)
     )
     return int(np.count_nonzero(shaded)) >= m.params.vectorize.min_area_px
@@ -360,22 +360,24 @@ def _judged_all(m: SearchMission, best: Found, unjudged: list[tuple[int, _Look]]
         shape = look.shapes[look.judgement.candidate]
         if k == best.poi.index or _on_roof(best, look.photo, shape):
             continue
-        j = look.judgement
-        why = (
-            "drawn too small to tell its outline"
-            if j.too_small
-            else "cut by the image border"
-            if not j.judgeable
-            else f"its outline, {j.outline_gap * 100:.1f} % off, may hold its own walls"
-            if _other_outline(j)
-            else f"scored {j.score:.3f} from too far to tell, and could not be looked at closer"
-        )
+        why = _why_unjudged(look.judgement)
         raise m.end(
             Status.NO_MATCH,
             f"point of interest {best.poi.index} matches the target (score {best.score:.3f}), "
             f"but {k}, of the target's colour, could not be judged ({why}): which is the "
             "target is not known",
         )
+
+
+def _why_unjudged(j: Judgement) -> str:
+    """Why a look left its candidate unjudged (`_judged_all`)."""
+    if j.too_small:
+        return "drawn too small to tell its outline"
+    if not j.judgeable:
+        return "cut by the image border"
+    if _other_outline(j):
+        return f"its outline, {j.outline_gap * 100:.1f} % off, may hold its own walls"
+    return f"scored {j.score:.3f} from too far to tell, and could not be looked at closer"
 
 
 def _found(poi: PointOfInterest, look: _Look, roof_m: float | None) -> Found:
@@ -783,7 +785,7 @@ def _shift(m: SearchMission, pos: Vec3, what: str) -> Wait[None]:
     x, y, z = pos
     # the whole way, not only where it ends: a closer look at a rival may lie across the
     # scene (world 50193: 64 m at 16.6 m, through a 22.5 m roof the mission had measured)
-    need = max(m.floor_at(x, y), m.floor_along((here[0], here[1]), (x, y)))
+    need = m.floor_along((here[0], here[1]), (x, y))
     z = max(z, need)
     if need > here[2]:
         yield from m.move((here[0], here[1], z), None, f"{what}: up to {z:.1f} m")

@@ -326,7 +326,7 @@ def inner_walls(
     tier's edge, has the lower roof at its foot."""
     frame = _check_frame(frame_rgb)
     inside = roof_inside(frame, shape, inset_px=1, tolerance_dn=tolerance_dn)
-    # a channel more than 2 * tolerance_dn from the roof's: inRange's exact integer test is
+    # a channel more than ``shade`` from the roof's: inRange's exact integer test is
     # ~30x faster than numpy's per-pixel max over three channels
     shade = 2 * tolerance_dn if shade_dn is None else shade_dn
     other = (
