@@ -173,14 +173,19 @@ def session(tmp_path: Path) -> Iterator[MavProxy]:
 
 
 _EXIT_RACE = re.compile(r"AttributeError: 'NoneType' object has no attribute '\w+'")
+_EXCEPTION = re.compile(r"[\w.]+(Error|Exception|Exit|Interrupt)\b")
+"""The last line of a whole traceback: the exception's type."""
 
 
 def _without_exit_race(lines: list[str]) -> list[str]:
     """``lines`` less MAVProxy's own race at exit, seen on a loaded machine: once it unloads
     its modules on EOF, its main loop thread may still run and find the global state already
     gone (``Exception in thread main_loop:`` … ``AttributeError: 'NoneType' object has no
-    attribute 'input_queue'``, every frame in MAVProxy or threading). Any other traceback,
-    or this one before exit, stays a warning."""
+    attribute 'input_queue'``, every frame in MAVProxy or threading). The interpreter may
+    end while that daemon thread prints, cutting the traceback short, down to its first
+    line alone: a cut traceback at the very end of the output counts too when the frames it
+    shows are MAVProxy's or threading's. Any other traceback, or this one before exit,
+    stays a warning."""
     try:
         exiting = next(i for i, line in enumerate(lines) if line.startswith("Unloading module"))
     except StopIteration:
@@ -192,9 +197,11 @@ def _without_exit_race(lines: list[str]) -> list[str]:
     if start is None:
         return lines
     end = next((i for i in range(start, len(lines)) if _EXIT_RACE.fullmatch(lines[i])), None)
-    if end is None:
-        return lines
-    frames = [line for line in lines[start:end] if line.startswith("File ")]
+    if end is None:  # cut short, if the process ended while the thread printed
+        if any(_EXCEPTION.match(line) for line in lines[start + 1 :]):
+            return lines  # a whole traceback, of another exception
+        end = len(lines) - 1
+    frames = [line for line in lines[start : end + 1] if line.startswith("File ")]
     if not all("/MAVProxy/" in f or "/threading.py" in f for f in frames):
         return lines
     return lines[:start] + lines[end + 1 :]
@@ -278,3 +285,30 @@ def test_connect_params_guided_arm_takeoff_land_without_warnings(
     ]
     assert not severe, severe
     assert (tmp_path / "mav.parm").read_text().count("\n") >= len(PARAM_SPECS)
+
+
+_EXITING = ["DISARMED", "Unloading module link"]
+_HEADER = ["Exception in thread main_loop:", "Traceback (most recent call last):"]
+
+
+@pytest.mark.parametrize(
+    ("tail", "forgiven"),
+    [
+        (_HEADER[:1], True),  # the interpreter ended right after the thread's first line
+        ([*_HEADER, 'File "/v/MAVProxy/mavproxy.py", line 9, in main_loop'], True),
+        (
+            [
+                *_HEADER,
+                'File "/v/MAVProxy/mavproxy.py", line 9',
+                "x",
+                "AttributeError: 'NoneType' object has no attribute 'input_queue'",
+            ],
+            True,
+        ),
+        ([*_HEADER, 'File "/v/uavtool/x.py", line 9'], False),  # cut, but not MAVProxy's
+        ([*_HEADER, 'File "/v/MAVProxy/mavproxy.py", line 9', "x", "KeyError: 3"], False),
+    ],
+)
+def test_only_mavproxys_own_exit_race_is_forgiven(tail: list[str], forgiven: bool) -> None:
+    kept = _without_exit_race([*_EXITING, *tail])
+    assert kept == (_EXITING if forgiven else [*_EXITING, *tail])
