@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -12,18 +14,26 @@ import shapely  # type: ignore[import-untyped]
 
 from tests.mission import scenes
 from tests.mission.driver import Flight, Flown, fly
-from uavtool.camera import CameraPose, Intrinsics
+from uavtool.camera import CameraPose, Intrinsics, project
 from uavtool.errors import InputError
 from uavtool.images import png_decode
 from uavtool.mission import GoTo, Params, Photo, Plan, Recognition, Shapes, Status
-from uavtool.mission.analysis import aimed_shape, judge, nadir_shapes, target_shapes
+from uavtool.mission.analysis import (
+    aimed_shape,
+    judge,
+    nadir_shapes,
+    same_roof_aside,
+    target_shapes,
+)
 from uavtool.mission.params import with_overrides
-from uavtool.runner.fly import target_picture
+from uavtool.runner.fly import FlyConfig, target_picture
+from uavtool.runner.fly import fly as fly_scene
 from uavtool.vision import Shape
 from uavtool.world import Scene, building_footprint, render
 from uavtool.world.hard import generate_hard_scene_with_info
 
 K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
+DATA = Path(__file__).parent / "data"
 
 
 def _looks(flight: Flight, poi: int) -> list[tuple[Photo, Recognition]]:
@@ -240,7 +250,6 @@ def test_a_look_judges_the_building_it_was_aimed_at() -> None:
 def test_a_look_again_names_why(score: float, mirror: float, reason: str) -> None:
     """A candidate that scores over the threshold but fails the mirror rule is looked at
     again for that reason, not as one scoring just below the threshold."""
-    from types import SimpleNamespace
 
     from uavtool.mission.analysis import Judgement
     from uavtool.mission.search import _Look, _look_again
@@ -283,3 +292,71 @@ def test_a_candidate_drawn_too_small_to_tell_the_targets_corners_is_not_judged(
         assert j.matched
     else:
         assert not j.matched
+
+
+def test_a_tower_drawn_too_small_with_its_roof_unknown_is_looked_at_from_aside() -> None:
+    """World scene 50010, flown on the built-in vehicle: six towers of 54-56 m and the
+    target among them, an L-shaped tower (b01, 56.4 m). The overview cut its roof, so its
+    height was unknown (up to 111 m), and its look from the ceiling, 61 m over its roof,
+    drew it too small to judge: no lower look was clear of what may stand there, and it
+    was never judged (no match). A look from aside at the same altitude draws one roof
+    alike whatever its height; the one shape of its size on the stretch its centroid may
+    shift along is the tower (another tower lies nearer the centre of that photo). Drawn as
+    small, it is not judged there, but the two photos measure its roof, and a look from
+    closer matches it. (The fake vehicle's photos draw it just large enough at once.)"""
+    texts: list[str] = []
+    summary = fly_scene(
+        FlyConfig(scene=str(DATA / "world-50010.yaml"), no_record=True),
+        progress=lambda text, _t: texts.append(text),
+    )
+    assert any("m aside, at 117" in t for t in texts), texts
+    measured = [t for t in texts if "drawn too small to judge; its roof measured 56." in t]
+    assert measured, texts  # 56.4 m
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == "b01"
+
+
+def _roof_px(corners_en: list[tuple[float, float]], roof_m: float, photo: Photo) -> Shape:
+    ring = project(np.array([[x, y, roof_m] for x, y in corners_en]), photo.pose, K)[:, :2]
+    return Shape.from_rings(colour_rgb=(200, 40, 40), polygon_px=ring)
+
+
+def _square(cx: float, cy: float, half: float = 3.0) -> list[tuple[float, float]]:
+    return [
+        (cx - half, cy - half),
+        (cx + half, cy - half),
+        (cx + half, cy + half),
+        (cx - half, cy + half),
+    ]
+
+
+def _nadir(x_m: float, alt_m: float) -> Photo:
+    pose = CameraPose((x_m, 0.0, alt_m), 0.0, -90.0)
+    return Photo(0, 0, "poi-0", 0, pose, K, np.zeros((K.height_px, K.width_px, 3), np.uint8))
+
+
+def test_a_roof_of_unknown_height_is_the_one_shape_of_its_size_where_parallax_puts_it() -> None:
+    """Two nadir photos from one altitude, 8 m apart: a 6 m roof 40 m high is the shape of
+    its size on the stretch its centroid may land on for heights 0 to 90 m, not the
+    roof of the same size nearer the centre; a second one as large on that stretch makes
+    it unknown, and so does a roof drawn larger there."""
+    first, aside = _nadir(0.0, 100.0), _nadir(8.0, 100.0)
+    roof = _roof_px(_square(2.0, 1.0), 40.0, first)
+    seen = _roof_px(_square(2.0, 1.0), 40.0, aside)
+    central = _roof_px(_square(8.0, -6.0), 40.0, aside)
+
+    def off_centre(shape: Shape) -> float:
+        return math.hypot(shape.centroid_px[0] - K.cx_px, shape.centroid_px[1] - K.cy_px)
+
+    def find(*shapes: Shape) -> int | None:
+        return same_roof_aside(roof, first, shapes, aside, 90.0, 1.5)
+
+    assert off_centre(central) < off_centre(seen)
+    assert find(central, seen) == 1
+    along = seen.centroid_px[0] - _roof_px(_square(2.0, 1.0), 0.0, aside).centroid_px[0]
+    twin = Shape.from_rings(
+        colour_rgb=seen.colour_rgb, polygon_px=np.add(seen.polygon_px, (along / 2, 0))
+    )
+    assert find(central, seen, twin) is None  # as large, on the stretch too: which is it?
+    wider = _roof_px(_square(2.0, 1.0, half=3.6), 40.0, aside)
+    assert find(central, wider) is None

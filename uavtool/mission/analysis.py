@@ -14,7 +14,8 @@ from uavtool.camera import Intrinsics, project
 from uavtool.mission.errors import MissionInputError
 from uavtool.mission.observations import Photo, U8Array
 from uavtool.mission.params import Params
-from uavtool.nav import NavError, frame_corners_px, frame_on_plane
+from uavtool.nav import NavError, frame_corners_px, frame_on_plane, ground_point
+from uavtool.nav.geometry import point_segment_distance
 from uavtool.nav.heights import (
     higher_part_m,
     nadir_px,
@@ -141,13 +142,17 @@ def judge(
     aimed_rgb: tuple[int, int, int] | None = None,
     *,
     target_stepped: bool = False,
+    chosen: int | None = None,
 ) -> Judgement:
     """The photo's shapes against the target; the candidate is :func:`aimed_shape`'s (the
     photo was aimed at a building of ``aimed_rgb``, None when not known). A syntactic match
     must also lie on the target's outline (`uavtool.vision.verify`), unless the target
     picture shows parts at several heights (``target_stepped``): each photo's perspective
-    then draws them apart by its own distance."""
-    centre = aimed_shape(params, shapes, intrinsics, aimed_rgb)
+    then draws them apart by its own distance. ``chosen``: the candidate is that shape
+    (found otherwise, `same_roof_aside`), not the one the photo is centred on."""
+    centre = (
+        shapes[chosen] if chosen is not None else aimed_shape(params, shapes, intrinsics, aimed_rgb)
+    )
     candidate = next((i for i, s in enumerate(shapes) if s is centre), -1)
     if centre is None or candidate < 0:
         return Judgement((), -1, 0.0, False)
@@ -219,6 +224,48 @@ def quartile_edge_share(shape: Shape) -> float:
     if not edges:
         return 0.0
     return edges[(len(edges) - 1) // 4] / math.sqrt(max(shape.area_px, 1.0))
+
+
+def same_roof_aside(
+    shape: Shape,
+    photo: Photo,
+    shapes: tuple[Shape, ...],
+    aside: Photo,
+    upper_m: float,
+    outline_px: float,
+) -> int | None:
+    """Which of ``shapes`` (nadir photo ``aside``, taken at ``photo``'s altitude) is the
+    roof ``shape`` of ``photo``, whose height is not known but at most ``upper_m``; None
+    unless exactly one may be. Seen from one altitude a flat roof is drawn alike whatever
+    its height: one whole outline of the same size (within ``outline_px`` all round: how far
+    a simplified outline may lie from the roof's edge), and its centroid where ``shape``'s
+    lands for a height between 0 and ``upper_m`` (within ``outline_px`` of that stretch).
+    The shape nearest the centre may be another."""
+    if shape.cut_by_border:
+        return None
+    k = photo.intrinsics
+    u, v = shape.centroid_px
+    top = min(upper_m, photo.pose.pos_enu_m[2] - 1.0)
+    try:
+        ends = [ground_point(u, v, photo.pose, k, plane_z_m=z) for z in (0.0, top)]
+    except NavError:
+        return None
+    (a, b) = (
+        tuple(px[:2])
+        for px in project(
+            np.array([[x, y, z] for (x, y), z in zip(ends, (0.0, top), strict=True)]), aside.pose, k
+        )
+    )
+    ring = np.asarray(shape.polygon_px, np.float64)
+    perimeter = float(np.hypot(*np.diff(np.vstack([ring, ring[:1]]), axis=0).T).sum())
+    alike = [
+        i
+        for i, s in enumerate(shapes)
+        if not s.cut_by_border
+        and abs(s.area_px - shape.area_px) <= perimeter * outline_px
+        and point_segment_distance(s.centroid_px, a, b) <= outline_px
+    ]
+    return alike[0] if len(alike) == 1 else None
 
 
 def placed_roof(a: Shape, photo_a: Photo, b: Shape, photo_b: Photo) -> float | None:

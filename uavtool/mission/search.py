@@ -8,9 +8,10 @@ shrink (on ``paper``, over headings and ±0.5 m: 65 % of photos from 20 m match,
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import cv2
@@ -18,12 +19,14 @@ import numpy as np
 
 from uavtool.camera import Intrinsics
 from uavtool.mission.analysis import (
+    ONE_ROOF_PX,
     Judgement,
     aimed_shape,
     judge,
     nadir_shapes,
     quartile_edge_share,
     roof_between,
+    same_roof_aside,
     side_shapes,
 )
 from uavtool.mission.observations import Photo
@@ -242,6 +245,7 @@ def inspect(
     m.visited.append(k)
     looks = [(yield from _look(m, k, 1, alt, poi.colour_rgb))]
     roof_m = poi.roof_m
+    sided = False  # a look from beside the first, to measure a roof by parallax, taken
     for n in range(2, p.max_looks + 1):
         closer = None
         if not poi.roof_measured:
@@ -257,6 +261,24 @@ def inspect(
         step = None
         if closer is None and still is not None:
             step = _step_down(m, looks[-1], still.upper_m)
+        aside = None
+        if closer is None and step is None and still is not None and not sided:
+            aside = _side_step(m, looks[-1])
+        if aside is not None and still is not None:
+            sided = True
+            off = math.dist(aside[:2], looks[-1].photo.pose.pos_enu_m[:2])
+            m.event(
+                Level.INFO,
+                f"point of interest {k}: drawn too small to judge; its roof not measured (at "
+                f"most {still.upper_m:.1f} m above home) and no lower look is clear: looking "
+                f"again from {off:.1f} m aside, at {aside[2]:.1f} m, to measure it",
+            )
+            yield from _shift(m, aside, f"point of interest {k}, look {n}")
+            same = functools.partial(
+                _same_aside, looks[-1], still.upper_m, m.params.vectorize.rdp_epsilon_px
+            )
+            looks.append((yield from _look(m, k, n, aside[2], poi.colour_rgb, same)))
+            continue
         if step is not None and still is not None:
             m.event(
                 Level.INFO,
@@ -610,12 +632,28 @@ def measure_from_another_altitude(
 
 
 def _look(
-    m: SearchMission, k: int, n: int, alt_m: float, aimed_rgb: tuple[int, int, int]
+    m: SearchMission,
+    k: int,
+    n: int,
+    alt_m: float,
+    aimed_rgb: tuple[int, int, int],
+    find: Callable[[tuple[Shape, ...], Photo], int | None] | None = None,
 ) -> Wait[_Look]:
     """Look ``n`` at point of interest ``k`` (a building of colour ``aimed_rgb``): a nadir
-    photo, judged and reported."""
+    photo, judged and reported. ``find``: a look to measure the roof of a building drawn too
+    small to judge (`_side_step`), which shape is that building (None: not told apart). Drawn
+    as small again, it is not judged here (a borderline outline may pass from one photo and
+    not from the other), only measured."""
     photo = yield from m.photo(f"poi-{k}" if n == 1 else f"poi-{k}-{n}", -90.0)
     shapes = photo_shapes(m, photo)
+    if find is not None and (chosen := find(shapes, photo)) is None:
+        j = Judgement((), -1, 0.0, False)
+        m.emit(Recognition(photo.frame_index, k, (), -1, 0.0, False, 0.0))
+        m.event(
+            Level.INFO,
+            f"point of interest {k}, look {n}: the building not told apart from others here",
+        )
+        return _Look(photo, shapes, j, alt_m)
     j = judge(
         m.params,
         m.target,
@@ -623,12 +661,17 @@ def _look(
         photo.intrinsics,
         aimed_rgb,
         target_stepped=m.target_stepped,
+        chosen=None if find is None else chosen,
     )
+    if find is not None:  # as small as the look that could not judge it: to measure only
+        j = replace(j, matched=False, judgeable=False, too_small=True)
     m.emit(
         Recognition(photo.frame_index, k, j.scores, j.candidate, j.score, j.matched, j.mirror_score)
     )
     why = ""
-    if j.too_small:
+    if find is not None:
+        why = "; from aside to measure its roof, drawn as small: not judged"
+    elif j.too_small:
         why = "; drawn too small here to tell the target's outline, not judged"
     elif not j.judgeable:
         why = "; outline cut by the image border, not judged"
@@ -736,6 +779,45 @@ def _step_down(m: SearchMission, look: _Look, upper_m: float) -> Vec3 | None:
     if z > alt - p.recheck_climb_m / 2.0:
         return None
     return (x, y, z)
+
+
+def _side_step(m: SearchMission, look: _Look) -> Vec3 | None:
+    """Where to look again from when the look's candidate, of the target's hue, is drawn
+    too small to judge, its roof's height is unknown and no lower look is clear of what may
+    stand there (`_step_down`): at the look's altitude, a baseline aside along the photo's
+    long side, toward the candidate, so that the two photos measure its roof by parallax
+    (`roof_between`, then `_closer_look`). A roof ``D`` below the camera shifts by
+    ``f b / D`` pixels between them and outlines are placed within ``ONE_ROOF_PX``: the
+    baseline ``b`` keeps the height's error within half ``mission.min_above_roof_m`` even
+    for a roof on the ground, the farthest it may be. A roof so high that it slides out of
+    the second photo is not measured (another shape there does not explain both outlines
+    at one height). None when the look's candidate does not ask for it."""
+    p = m.params.mission
+    j, photo = look.judgement, look.photo
+    if j.matched or j.candidate < 0 or not j.same_hue or not j.too_small:
+        return None
+    k = photo.intrinsics
+    x0, y0, alt = photo.pose.pos_enu_m
+    baseline = alt * alt * ONE_ROOF_PX / (k.fx_px * p.min_above_roof_m / 2.0)
+    toward = 1.0 if look.shapes[j.candidate].centroid_px[0] >= k.cx_px else -1.0
+    try:
+        a = ground_point(k.cx_px, k.cy_px, photo.pose, k, plane_z_m=0.0)
+        b = ground_point(k.cx_px + toward * k.width_px / 4.0, k.cy_px, photo.pose, k, plane_z_m=0.0)
+    except NavError:
+        return None
+    run = math.dist(a, b)
+    if run <= 0.0:
+        return None
+    return (x0 + (b[0] - a[0]) / run * baseline, y0 + (b[1] - a[1]) / run * baseline, look.alt_m)
+
+
+def _same_aside(
+    first: _Look, upper_m: float, outline_px: float, shapes: tuple[Shape, ...], photo: Photo
+) -> int | None:
+    """Which of ``shapes`` (a look from aside, `_side_step`) is ``first``'s candidate; the
+    outlines are simplified to within ``outline_px``."""
+    shape = first.shapes[first.judgement.candidate]
+    return same_roof_aside(shape, first.photo, shapes, photo, upper_m, outline_px)
 
 
 def _resolving_altitude_m(
