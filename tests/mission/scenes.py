@@ -110,6 +110,14 @@ def cross_target() -> Scene:
     return scene_from_dict(data, source="cross")
 
 
+def cyan_target() -> Scene:
+    """Paper with the red building painted cyan: its picture is the red building's outline
+    in a colour no building of paper has."""
+    data = _paper()
+    _red(data)["color"] = [40, 200, 200]
+    return scene_from_dict(data, source="cyan")
+
+
 def out_of_view() -> Scene:
     """Only the red building, 150 m east: the overview photo from home shows nothing."""
     data = _paper()

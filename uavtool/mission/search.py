@@ -141,7 +141,8 @@ def search(
         k = todo.pop(0)
         poi = pois[k]
         looks, upper = yield from look_at(k, todo)
-        top = max(look.judgement.score for look in looks)
+        # a building of another colour is no near miss, however alike its outline
+        top = max((look.judgement.score for look in looks if look.judgement.same_hue), default=0.0)
         if top > best_score:
             best_score, best_poi = top, k
         look = looks[-1]  # a match ends the looking: the last look is the match if any
@@ -192,10 +193,14 @@ def search(
                 roof = None
             matches.append(_found(poi, look, roof))
     if best is None:
-        where = f" at point of interest {best_poi}" if best_poi >= 0 else ""
-        raise m.end(
-            Status.NO_MATCH, f"no building matched the target (best score {best_score:.3f}{where})"
+        where = f"best score {best_score:.3f} at point of interest {best_poi}"
+        if best_poi < 0:
+            where = "none of the target's colour"
+        unseen = "".join(
+            f"; {k}, of the target's colour, could not be judged ({_why_unjudged(look.judgement)})"
+            for k, look in unjudged
         )
+        raise m.end(Status.NO_MATCH, f"no building matched the target ({where}){unseen}")
     _judged_all(m, best, unjudged)
     # a match by score alone (its outline not compared) leaves any doubt standing; one
     # whose outline lies on the target's, only a doubt of walls (its rival's outline was
