@@ -223,7 +223,7 @@ def test_no_match_reports_and_lands(scene_name: str, why: str, visits: int) -> N
 def test_a_building_of_another_colour_is_no_near_miss() -> None:
     """The target picture is paper's red building in cyan: the red building's outline is
     the target's, but no building of its colour stands there. The reason names none as the
-    best score (it named the red one, 1.000, as if the target had almost matched)."""
+    best score (it named the red one, 0.995, as if the target had almost matched)."""
     flown = fly(load_scene("paper"), target_scene=scenes.cyan_target())
     outcome = flown.outcome
     assert outcome.status is Status.NO_MATCH

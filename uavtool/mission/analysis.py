@@ -25,6 +25,7 @@ from uavtool.nav.heights import (
 from uavtool.vision import Shape, best_match, mirror_score, vectorize
 from uavtool.vision.merge import merge_touching
 from uavtool.vision.model3d import central_shape
+from uavtool.vision.shapes import perimeter
 from uavtool.vision.vectorize import ground_mask, hue_distance_deg, inner_walls
 from uavtool.vision.verify import (
     detail_differs,
@@ -250,19 +251,14 @@ def same_roof_aside(
         ends = [ground_point(u, v, photo.pose, k, plane_z_m=z) for z in (0.0, top)]
     except NavError:
         return None
-    (a, b) = (
-        tuple(px[:2])
-        for px in project(
-            np.array([[x, y, z] for (x, y), z in zip(ends, (0.0, top), strict=True)]), aside.pose, k
-        )
-    )
-    ring = np.asarray(shape.polygon_px, np.float64)
-    perimeter = float(np.hypot(*np.diff(np.vstack([ring, ring[:1]]), axis=0).T).sum())
+    lands = project(np.array([[*ends[0], 0.0], [*ends[1], top]]), aside.pose, k)
+    a, b = (float(lands[0, 0]), float(lands[0, 1])), (float(lands[1, 0]), float(lands[1, 1]))
+    around = perimeter(np.asarray(shape.polygon_px, np.float64))
     alike = [
         i
         for i, s in enumerate(shapes)
         if not s.cut_by_border
-        and abs(s.area_px - shape.area_px) <= perimeter * outline_px
+        and abs(s.area_px - shape.area_px) <= around * outline_px
         and point_segment_distance(s.centroid_px, a, b) <= outline_px
     ]
     return alike[0] if len(alike) == 1 else None

@@ -266,24 +266,23 @@ def inspect(
         step = None
         if closer is None and still is not None:
             step = _step_down(m, looks[-1], still.upper_m)
-        aside = None
         if closer is None and step is None and still is not None and not sided:
             aside = _side_step(m, looks[-1])
-        if aside is not None and still is not None:
-            sided = True
-            off = math.dist(aside[:2], looks[-1].photo.pose.pos_enu_m[:2])
-            m.event(
-                Level.INFO,
-                f"point of interest {k}: drawn too small to judge; its roof not measured (at "
-                f"most {still.upper_m:.1f} m above home) and no lower look is clear: looking "
-                f"again from {off:.1f} m aside, at {aside[2]:.1f} m, to measure it",
-            )
-            yield from _shift(m, aside, f"point of interest {k}, look {n}")
-            same = functools.partial(
-                _same_aside, looks[-1], still.upper_m, m.params.vectorize.rdp_epsilon_px
-            )
-            looks.append((yield from _look(m, k, n, aside[2], poi.colour_rgb, same)))
-            continue
+            if aside is not None:
+                sided = True
+                off = math.dist(aside[:2], looks[-1].photo.pose.pos_enu_m[:2])
+                m.event(
+                    Level.INFO,
+                    f"point of interest {k}: drawn too small to judge; its roof not measured "
+                    f"(at most {still.upper_m:.1f} m above home) and no lower look is clear: "
+                    f"looking again from {off:.1f} m aside, at {aside[2]:.1f} m, to measure it",
+                )
+                yield from _shift(m, aside, f"point of interest {k}, look {n}")
+                same = functools.partial(
+                    _same_aside, looks[-1], still.upper_m, m.params.vectorize.rdp_epsilon_px
+                )
+                looks.append((yield from _look(m, k, n, aside[2], poi.colour_rgb, same)))
+                continue
         if step is not None and still is not None:
             m.event(
                 Level.INFO,
@@ -651,7 +650,8 @@ def _look(
     not from the other), only measured."""
     photo = yield from m.photo(f"poi-{k}" if n == 1 else f"poi-{k}-{n}", -90.0)
     shapes = photo_shapes(m, photo)
-    if find is not None and (chosen := find(shapes, photo)) is None:
+    chosen = None if find is None else find(shapes, photo)
+    if find is not None and chosen is None:
         j = Judgement((), -1, 0.0, False)
         m.emit(Recognition(photo.frame_index, k, (), -1, 0.0, False, 0.0))
         m.event(
@@ -666,7 +666,7 @@ def _look(
         photo.intrinsics,
         aimed_rgb,
         target_stepped=m.target_stepped,
-        chosen=None if find is None else chosen,
+        chosen=chosen,
     )
     if find is not None:  # as small as the look that could not judge it: to measure only
         j = replace(j, matched=False, judgeable=False, too_small=True)
