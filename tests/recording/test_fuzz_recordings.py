@@ -21,6 +21,7 @@ from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from tests.fuzzing import examples
 from uavtool.cli import cli
 from uavtool.errors import INCOMPLETE_EXIT, UavtoolError
 from uavtool.recording import RecordingReader, RecordingWriter
@@ -30,7 +31,7 @@ from uavtool.replay.refly import refly_config
 
 GOLDEN = Path(__file__).parents[2] / "recordings" / "golden" / "paper.mcap"
 _SETTINGS = settings(
-    max_examples=40,
+    max_examples=examples(40),
     deadline=None,
     derandomize=True,  # the same examples on every run: a failure is reproducible
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],

@@ -80,8 +80,9 @@ def test_fly_writes_where_it_is_told(
         monkeypatch.setattr(module, name, spy)
     monkeypatch.setattr(runner, "core_to_spare", lambda: spare)
     out = tmp_path / "f.mcap"
-    result = CliRunner().invoke(cli, ["fly", "--writer", choice, "-o", str(out), "-q"])
-    assert result.exit_code == 0, result.output
+    short = ["--link-outage", "15:1e6", "--set", "mission.link_lost_abort_s=5"]  # as _SHORT
+    result = CliRunner().invoke(cli, ["fly", "--writer", choice, "-o", str(out), "-q", *short])
+    assert result.exit_code == 1, result.output  # aborted: the link is lost for good
     assert made == [used]
     assert summarize(out).whole
 

@@ -12,6 +12,7 @@ from typing import Any
 from hypothesis import event, given, settings
 from hypothesis import strategies as st
 
+from tests.fuzzing import examples
 from tests.sitl.client import Client
 from tests.sitl.pilot import Pilot
 from uavtool.mavlink import mavlink as M
@@ -219,7 +220,7 @@ def hostile_commands(draw: st.DrawFn) -> Any:
     return M.MAVLink_command_int_message(1, 1, frame, command, 0, 0, *p[:4], x, y, p[6])
 
 
-@settings(max_examples=400, deadline=None, derandomize=True, database=None)
+@settings(max_examples=examples(400), deadline=None, derandomize=True, database=None)
 @given(st.lists(hostile_commands(), min_size=1, max_size=8))
 def test_hostile_command_params_are_refused_with_one_ack_each(msgs: list[Any]) -> None:
     pilot = Pilot()
@@ -237,7 +238,7 @@ def test_hostile_command_params_are_refused_with_one_ack_each(msgs: list[Any]) -
 FUZZ_STATS: Counter[str] = Counter()
 
 
-@settings(max_examples=120, deadline=None, derandomize=True, database=None)
+@settings(max_examples=examples(120), deadline=None, derandomize=True, database=None)
 @given(st.lists(hostile_messages(), min_size=1, max_size=40))
 def test_hostile_values_are_refused_and_the_vehicle_still_flies(msgs: list[Any]) -> None:
     pilot = Pilot()

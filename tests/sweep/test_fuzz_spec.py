@@ -12,6 +12,7 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
+from tests.fuzzing import examples
 from uavtool.errors import UavtoolError
 from uavtool.sweep.plan import MAX_FLIGHTS, flight_count, plan_flights
 from uavtool.sweep.spec import load_spec, parse_spec
@@ -65,7 +66,7 @@ _SPEC = st.fixed_dictionaries(
     },
 )
 _SETTINGS = settings(
-    max_examples=300,
+    max_examples=examples(300),
     deadline=None,
     derandomize=True,
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
