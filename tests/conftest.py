@@ -4,7 +4,9 @@
   use cores. Many tests wait on real time (a ground station's heartbeat each second, a
   real-time link, a browser drawing, a recorder's ``--duration``) and leave their core idle
   meanwhile: with a worker per core the suite kept 1.3 of 2 cores busy and took 4 min 33 s,
-  with one more 1.65 and 3 min 30 s. ``-n N`` sets it; ``-n 0`` runs in this process.
+  with one more 1.65 and 3 min 30 s (a smaller suite). Two more is no faster: on 2 cores the
+  suite of 30 Nov 2026 took 5 min 12 s with 3 workers (1.6 cores busy) and 5 min 10 s with 4
+  (1.9 busy, 11 % more CPU spent). ``-n N`` sets it; ``-n 0`` runs in this process.
 - What runs together (``--dist loadscope`` in ``pyproject.toml``): a module's tests on one
   worker, so its module-scoped fixtures (a recorded flight, a sweep) are made once, and the
   real autopilots' tests (``tests/integration``) all on one worker, one after the other: PX4
