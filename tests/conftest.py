@@ -1,12 +1,14 @@
 """Suite-wide settings.
 
-- Workers (pytest-xdist, ``-n auto`` in ``pyproject.toml``): one more than this process may
+- Workers (pytest-xdist, ``-n auto`` in ``pyproject.toml``): two more than this process may
   use cores. Many tests wait on real time (a ground station's heartbeat each second, a
   real-time link, a browser drawing, a recorder's ``--duration``) and leave their core idle
-  meanwhile: with a worker per core the suite kept 1.3 of 2 cores busy and took 4 min 33 s,
-  with one more 1.65 and 3 min 30 s (a smaller suite). Two more is no faster: on 2 cores the
-  suite of 30 Nov 2026 took 5 min 12 s with 3 workers (1.6 cores busy) and 5 min 10 s with 4
-  (1.9 busy, 11 % more CPU spent). ``-n N`` sets it; ``-n 0`` runs in this process.
+  meanwhile. The modules that do little else (``ON_THE_CLOCK``) run one after the other as
+  one scope, which keeps one worker; the others share the cores. On 2 cores (30 Nov 2026):
+  3 workers, each module its own scope, 5 min 12 s (1.6 cores busy); 4 workers so, 5 min 10 s
+  (1.9 busy, and 11 % more CPU spent: four flights at once on two cores); 4 workers with the
+  waiting modules as one scope, 4 min 28 s and 4 min 52 s in two runs (1.9 busy). ``-n N``
+  sets it; ``-n 0`` runs in this process.
 - What runs together (``--dist loadscope`` in ``pyproject.toml``): a module's tests on one
   worker, so its module-scoped fixtures (a recorded flight, a sweep) are made once, and the
   real autopilots' tests (``tests/integration``) all on one worker, one after the other: PX4
@@ -32,6 +34,18 @@ from xdist.scheduler import LoadScopeScheduling
 ONE_WORKER = ("tests/integration/",)
 """Folders whose tests run on one worker, one after the other."""
 
+ON_THE_CLOCK = (
+    "tests/recorder/test_stops.py",
+    "tests/recorder/test_fleet.py",
+    "tests/runner/test_lossy_link.py",
+    "tests/sitl/test_udp_admission.py",
+    "tests/sitl/test_commands.py",
+    "tests/sitl/test_security.py",
+)
+"""Modules that mostly wait on the wall clock (a recorder's ``--duration``, a vehicle at 10x
+or 20x, a flood of ground stations expiring): one scope, one after the other on one worker,
+which then leaves the cores to the others."""
+
 _SECONDS_KEY = "uavtool/scope_seconds"
 """Where pytest's cache keeps each scope's seconds (setup, call and teardown) of its last run."""
 
@@ -40,6 +54,8 @@ def _scope(nodeid: str) -> str:
     for folder in ONE_WORKER:
         if nodeid.startswith(folder):
             return folder
+    if nodeid.startswith(ON_THE_CLOCK):
+        return "on the clock"
     return nodeid.split("::", 1)[0]  # the module, as xdist's loadscope splits a function's
 
 
@@ -104,7 +120,7 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
         cores = len(os.sched_getaffinity(0))
     except (AttributeError, OSError):
         cores = os.cpu_count() or 1
-    return cores + 1
+    return cores + 2
 
 
 def pytest_configure(config: pytest.Config) -> None:
