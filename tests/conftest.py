@@ -7,8 +7,9 @@
   one scope, which keeps one worker; the others share the cores. On 2 cores (30 Nov 2026):
   3 workers, each module its own scope, 5 min 12 s (1.6 cores busy); 4 workers so, 5 min 10 s
   (1.9 busy, and 11 % more CPU spent: four flights at once on two cores); 4 workers with the
-  waiting modules as one scope, 4 min 28 s and 4 min 52 s in two runs (1.9 busy). ``-n N``
-  sets it; ``-n 0`` runs in this process.
+  waiting modules as one scope, 4 min 28 s and 4 min 52 s in two runs (1.9 busy), 4 min 51 s
+  with no record of the scopes' seconds (below). ``-n N`` sets it; ``-n 0`` runs in this
+  process.
 - What runs together (``--dist loadscope`` in ``pyproject.toml``): a module's tests on one
   worker, so its module-scoped fixtures (a recorded flight, a sweep) are made once, and the
   real autopilots' tests (``tests/integration``) all on one worker, one after the other: PX4
@@ -100,7 +101,8 @@ _spent: dict[str, float] = {}
 
 
 def pytest_runtest_logreport(report: pytest.TestReport) -> None:
-    _spent[_scope(report.nodeid)] = _spent.get(_scope(report.nodeid), 0.0) + report.duration
+    scope = _scope(report.nodeid)
+    _spent[scope] = _spent.get(scope, 0.0) + report.duration
 
 
 def pytest_sessionfinish(session: pytest.Session) -> None:

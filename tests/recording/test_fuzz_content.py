@@ -121,9 +121,9 @@ def _everything_reads(path: Path, work: Path, *, output_altered: bool) -> None:
     if output_altered:  # the mission cannot have made it: never "identical"
         assert "identical" not in checked, checked
     if "observations replayed" not in checked:
-        # --check refused before replaying (no Outcome, a cut file): the plain replay goes on
-        # where it stopped. Once --check has replayed, the plain replay is the same code on the
-        # same file, and its run would only double the test's time.
+        # --check refused before replaying (no Outcome, a cut file), and the plain replay reads
+        # further. Once --check has replayed, the plain replay is the same code on the same
+        # file, and its run would only double the test's time.
         _run(["replay", str(path)])
 
 
