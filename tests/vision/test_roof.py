@@ -4,6 +4,7 @@ walls facing it brighter than the roof, and the roof is still what the vectorize
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -13,6 +14,7 @@ from uavtool.camera import CameraPose, Intrinsics, project
 from uavtool.vision import VectorizeParams, vectorize
 from uavtool.vision.vectorize import non_ground
 from uavtool.world import Block, Building, Lighting, Scene, load_scene, render
+from uavtool.world.render import add_noise
 
 K = Intrinsics.from_hfov(width_px=640, height_px=480)
 CAMERA = CameraPose((0.0, 0.0, 80.0), 0.0, -90.0)
@@ -77,3 +79,31 @@ def test_an_obstacles_roof_is_its_roof_in_any_light(sun_az: float, sun_el: float
     image = render(_scene(GREY, sun_az, sun_el), CAMERA, K)
     (shape,) = non_ground(image)
     assert _iou(shapely.Polygon(shape.polygon_px), _roof_drawn()) > 0.95
+
+
+# Lights under which the walls this test sees are lit 12–20 DN off the roof (V 163–179):
+# close enough that a fixed tolerance of 20 DN took them for roof, as far as a noise-free
+# photo tells them apart.
+LIT_WALLS = [(180.0, 42.0), (270.0, 42.0), (180.0, 50.0), (270.0, 50.0)]
+
+
+@pytest.mark.parametrize(("sun_az", "sun_el"), LIT_WALLS)
+def test_walls_lit_near_the_roofs_shade_are_not_roof(sun_az: float, sun_el: float) -> None:
+    """A flat roof is one shade: in a photo without noise a wall a few DN off it is a wall,
+    and the outline lies on the roof's edges within the vectorizer's accuracy (half a
+    pixel's diagonal), not a wall's width (24 px here) outside them."""
+    image = render(_scene(GREEN, sun_az, sun_el), CAMERA, K)
+    (shape,) = vectorize(image, VectorizeParams(roof_only=True))
+    gap = shapely.hausdorff_distance(shapely.Polygon(shape.polygon_px), _roof_drawn())
+    assert gap <= math.sqrt(0.5)
+
+
+@pytest.mark.parametrize(("sun_az", "sun_el"), [*LIT_WALLS, (0.0, 90.0), (270.0, 8.0)])
+def test_sensor_noise_leaves_the_roof_whole(sun_az: float, sun_el: float) -> None:
+    """With the sensor's noise (σ 3 DN) the roof's own shade spreads, and so does what counts
+    as roof: none of the roof is lost to the noise."""
+    image = render(_scene(GREEN, sun_az, sun_el), CAMERA, K)
+    add_noise(image, seed=7)
+    (shape,) = vectorize(image, VectorizeParams(roof_only=True))
+    roof = _roof_drawn()
+    assert roof.difference(shapely.Polygon(shape.polygon_px)).area < 0.005 * roof.area

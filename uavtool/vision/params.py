@@ -42,8 +42,10 @@ class VectorizeParams:
     from above): each region's shade on its edges facing away from the photo's nadir, where
     a roof's edge is whatever the light (`uavtool.vision.roof`)."""
     roof_value_tolerance: int = 20
-    """With ``roof_only``, HSV values (0–255) this far from the roof's shade still count as
-    roof (sensor noise); a wall lit within this of its roof is taken with it."""
+    """With ``roof_only``, the furthest an HSV value (0–255) may lie from the roof's shade
+    and count as roof. Within it, what counts is the roof's own spread (its noise, measured
+    on its edges: :func:`uavtool.vision.roof.roof_tolerance`); a wall lit within that of
+    its roof is taken with it."""
     point_spacing_px: float = 2.0
     """Distance between the evenly spaced points put along each border: larger is faster
     and coarser."""

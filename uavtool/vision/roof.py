@@ -14,6 +14,7 @@ mask gives the same pixels on every machine.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import cv2
@@ -90,3 +91,33 @@ def roof_value(
     centre = int(np.argmax(window))
     inside = np.sort(shades[np.abs(shades - centre) <= half])
     return int(inside[(len(inside) - 1) // 2])
+
+
+NOISE_SIGMAS = 5.0
+"""How many of the roof's own standard deviations (from its edge pixels' median absolute
+deviation) a pixel's shade may lie from the roof's and still be roof: noise that is
+Gaussian, or bounded as the renderer's is, leaves no roof pixel further out."""
+LEAST_SPREAD_DN = 3
+"""What counts as roof beyond the roof's own spread, DN: a flat roof in a noise-free photo
+is one shade, give or take the rounding of its colour and the camera's."""
+
+
+def roof_tolerance(
+    value: CvArray,
+    votes: tuple[npt.NDArray[np.intp], npt.NDArray[np.intp]],
+    shade: int,
+    limit: int,
+) -> int:
+    """How far (DN) a shade may lie from the roof's ``shade`` and be the roof's: the spread
+    its edge pixels ``votes`` show around it (`NOISE_SIGMAS` robust standard deviations,
+    plus `LEAST_SPREAD_DN`), never beyond ``limit``. A wall is another face, lit otherwise:
+    one that differs from the roof by more than the roof's own noise is a wall, however
+    close in shade — at a fixed ``limit`` of 20 DN a wall lit 5 DN off its roof was drawn
+    with it, and the outline lay a wall's width outside the roof's edge."""
+    vs, us = votes
+    shades = value[vs, us].astype(np.int16)
+    near = np.sort(np.abs(shades - shade)[np.abs(shades - shade) <= limit // 2])
+    if near.size == 0:
+        return limit
+    mad = float(near[(near.size - 1) // 2])  # the median (np.median imports numpy.ma)
+    return min(limit, math.ceil(NOISE_SIGMAS * 1.4826 * mad) + LEAST_SPREAD_DN)

@@ -28,7 +28,13 @@ from uavtool.vision.outline import (
     simplify_rings_detail,
 )
 from uavtool.vision.params import VectorizeParams
-from uavtool.vision.roof import INSET_PX, far_edge_pixels, roof_value
+from uavtool.vision.roof import (
+    INSET_PX,
+    LEAST_SPREAD_DN,
+    far_edge_pixels,
+    roof_tolerance,
+    roof_value,
+)
 from uavtool.vision.shapes import STAIRCASE_PX, FloatArray, Shape, orient
 
 U8Array = npt.NDArray[np.uint8]
@@ -126,11 +132,12 @@ def _roofs(
     p: VectorizeParams,
 ) -> CvArray:
     """The part of ``mask`` (one colour, a box at frame pixel ``at``; ``val``: the frame's
-    HSV V channel) that is roof: each region's pixels within
-    ``roof_value_tolerance`` of the shade its far edges show (:mod:`uavtool.vision.roof`).
-    A region with less of a far edge in the picture than ``min_edge_px`` takes the shade its
-    colour's other regions show; a colour with too little anywhere keeps its brightest
-    shade, as light from high above draws a roof."""
+    HSV V channel) that is roof: each region's pixels as near the shade its far edges show
+    as those edges' own pixels are (`roof_tolerance`: the roof's noise, at most
+    ``roof_value_tolerance``; :mod:`uavtool.vision.roof`). A region with less of a far
+    edge in the picture than ``min_edge_px`` takes the shade (and spread) its colour's other
+    regions show; a colour with too little anywhere keeps its brightest shade, as light
+    from high above draws a roof."""
     bh, bw = mask.shape
     (fx, fy), (fh, fw) = at, frame_hw
     px0, py0 = max(fx - _PAD_PX, 0), max(fy - _PAD_PX, 0)
@@ -147,15 +154,24 @@ def _roofs(
         return brightest_shade(value[fy - py0 : fy - py0 + bh, fx - px0 : fx - px0 + bw], mask, p)
     count, labels = cv2.connectedComponents(padded, connectivity=8)
     shades = np.full(count, shade, np.int16)
+    spread = roof_tolerance(value, votes, shade, tol)
+    tols = np.full(count, spread, np.int16)
     vs, us = votes
     owner = labels[vs, us]
     # (np.unique would import numpy.ma: tests/test_imports.py)
     for label in np.flatnonzero(np.bincount(owner, minlength=count) >= least).tolist():
         mine = owner == label
         own = roof_value(value, (vs[mine], us[mine]), tol)
-        shades[label] = shade if own is None else own
-    near = np.abs(value.astype(np.int16) - shades[labels]) <= tol
-    roof = np.where(near & (padded > 0), 255, 0).astype(np.uint8)
+        if own is not None:
+            shades[label] = own
+            tols[label] = roof_tolerance(value, (vs[mine], us[mine]), own, tol)
+    near = np.abs(value.astype(np.int16) - shades[labels]) <= tols[labels]
+    roof: CvArray = np.where(near & (padded > 0), 255, 0).astype(np.uint8)
+    if p.denoise_px > 1 and int(tols.max()) > LEAST_SPREAD_DN:
+        # in a noisy photo a wall lit just beyond the roof's spread has pixels within it:
+        # specks, which the median drops as it drops them from the colour classes (a photo
+        # without noise has none)
+        roof = cv2.bitwise_and(cv2.medianBlur(roof, p.denoise_px), padded)
     return roof[fy - py0 : fy - py0 + bh, fx - px0 : fx - px0 + bw]
 
 
