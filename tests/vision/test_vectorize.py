@@ -2,8 +2,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import shapely
 
-from uavtool.camera import CameraPose, Intrinsics
+from uavtool.camera import CameraPose, Intrinsics, project
 from uavtool.vision import VectorizeParams, vectorize
 from uavtool.vision.errors import ImageError, VisionParamError
 from uavtool.vision.vectorize import non_ground
@@ -151,3 +152,35 @@ def test_non_ground_finds_what_vectorize_leaves_out() -> None:
     assert len(west_south) == 1 and west_south[0].colour_rgb[0] > 150  # the red roof
     assert all(not s.cut_by_border for s in roofs)
     assert non_ground(np.full((480, 640, 3), 128, np.uint8)) == ()
+
+
+def test_non_ground_finds_every_building_a_region_joins() -> None:
+    """World scene 50124: a 3.4 m building of the ground's own hue (brighter), a car park
+    it stands on the edge of and a building beyond it are one region of what is not
+    ground. The region's roof is one of them; the others are roofs too, or the obstacle map
+    has a hole where a building stands (a side photo was once flown 2.2 m from it)."""
+    scene = scene_from_dict(
+        {
+            "target": "magenta",
+            "ground": {
+                "color": [107, 161, 195],
+                "areas": [{"name": "car park", "color": [149, 148, 143],
+                           "polygon": [[-2, -8], [14, -8], [14, 8], [-2, 8]]}],
+            },
+            "buildings": [
+                {"name": "blue", "color": [54, 146, 217],
+                 "blocks": [{"footprint": [[-10, -4], [0, -4], [0, 4], [-10, 4]], "top_m": 3.4}]},
+                {"name": "magenta", "color": [217, 54, 171],
+                 "blocks": [{"footprint": [[12, -3], [18, -3], [18, 3], [12, 3]], "top_m": 10}]},
+            ],
+        }
+    )  # fmt: skip
+    k = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
+    pose = CameraPose((2.0, 0.0, 60.0), 0.0, -90.0)
+    image = render(scene, pose, k)
+    roofs = non_ground(image)
+    for building in scene.buildings:
+        (block,) = building.blocks
+        corners = np.array([(x, y, block.top_m) for x, y in block.footprint_enu_m])
+        drawn = shapely.Polygon(project(corners, pose, k)[:, :2])
+        assert any(drawn.contains(shapely.Point(s.centroid_px)) for s in roofs), building.name

@@ -231,6 +231,7 @@ def non_ground(
     tolerance_dn: int = 15,
     within: CvArray | None = None,
     nadir_px: tuple[float, float] | None = None,
+    _depth: int = 0,
 ) -> tuple[Shape, ...]:
     """The roofs of everything in an RGB frame that is not the ground, whatever its colour,
     largest first. Not ground: pixels differing from the ground's colour (the frame's most
@@ -241,7 +242,11 @@ def non_ground(
     (walls are shaded darker than roofs by light from high above).
     This is what the obstacle map is made of: grey, white or black roofs, and a darker shade
     of a colour, which :func:`vectorize` leaves out, are here. ``within`` (a mask of the
-    frame's size, non-zero where to look) keeps only what lies in it."""
+    frame's size, non-zero where to look) keeps only what lies in it.
+    A region may join several things that touch in the photo (a building, the car park
+    beside it, another building of the ground's hue beyond): once its roof and that roof's
+    own paint (its walls) are taken out, what is left of another colour is looked at again,
+    as regions of their own (up to `_PARTS_DEEP` times)."""
     p = params if params is not None else VectorizeParams()
     frame = _check_frame(frame_rgb)
     mask = _not_ground_mask(frame, p, tolerance_dn)
@@ -251,6 +256,7 @@ def non_ground(
     nadir = nadir_px if nadir_px is not None else _centre(frame)
     least = max(int(np.ceil(p.min_edge_px)), 1)
     roofs: list[_Region] = []
+    parts: list[Shape] = []
     for r in regions:
         inside = np.zeros_like(mask)
         cv2.drawContours(inside, [r.contour], 0, 255, cv2.FILLED)
@@ -261,9 +267,25 @@ def non_ground(
         found = _regions(roof, roof, (0, 0), frame.shape[:2], 1, p)
         if found:
             roofs.append(max(found, key=lambda f: cv2.contourArea(f.contour)))
+        if _depth < _PARTS_DEEP:
+            rest = inside.copy()
+            rest[(roof > 0) | same_paint(frame, rgb)] = 0
+            if cv2.countNonZero(rest) >= p.min_area_px:
+                parts.extend(
+                    non_ground(
+                        frame, p, tolerance_dn=tolerance_dn, within=rest, nadir_px=nadir,
+                        _depth=_depth + 1,
+                    )
+                )  # fmt: skip
     shapes = [(-shape.area_px, order, shape) for order, _r, shape in _traced(frame, roofs, p)]
+    shapes += [(-shape.area_px, len(shapes) + i, shape) for i, shape in enumerate(parts)]
     shapes.sort(key=lambda t: t[:2])
     return tuple(s for *_, s in shapes)
+
+
+_PARTS_DEEP = 2
+"""How many times what is left of a region, its roof and walls taken out, is looked at again
+(`non_ground`): a building, the car park it touches and one more beyond."""
 
 
 def not_ground_regions(
