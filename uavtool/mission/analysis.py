@@ -163,11 +163,20 @@ def judge(
     judgeable = matches[candidate].judgeable
     # at the candidate's size, would three quarters of the target's edges be edges at all?
     size = math.sqrt(max(centre.area_px, 0.0))
-    too_small = judgeable and quartile_edge_share(target) * size < params.vectorize.min_edge_px
-    judgeable = judgeable and not too_small
+    least = params.vectorize.min_edge_px
+    too_small = judgeable and quartile_edge_share(target) * size < least
     hue_limit = params.mission.match_hue_tolerance_deg
     same_hue = hue_limit <= 0 or hue_distance_deg(centre.colour_rgb, target.colour_rgb) <= hue_limit
     rp = params.recognize
+    if judgeable and not too_small and same_hue and not target_stepped and score < rp.threshold:
+        # corners under the threshold rule a building of the target's hue out only where
+        # every edge of the target would be kept: one edge lost turns the target's own
+        # corners into another sequence (world 50076: the target, 16 px across, scored 0).
+        # The colour classes' median filter rounds each corner, shortening an edge by up to
+        # half its aperture at either end.
+        kept = least + max(params.vectorize.denoise_px - 1, 0)
+        too_small = edge_share(target, shortest=True) * size < kept
+    judgeable = judgeable and not too_small
     mirrored = mirror_score(target, centre, rp)
     gap = 1.0 - mirror_score(target, target, rp)  # how unlike its mirror image the target is
     not_mirror = score - mirrored >= rp.mirror_margin * gap - rp.mirror_tolerance
@@ -216,6 +225,12 @@ def quartile_edge_share(shape: Shape) -> float:
     drawn per pixel of a photo's scale. (Not the shortest: a target picture's outline may
     hold a short edge or two that are no corner of the footprint, a higher tier's walls seen
     in perspective.)"""
+    return edge_share(shape, shortest=False)
+
+
+def edge_share(shape: Shape, *, shortest: bool) -> float:
+    """The shortest (or, not ``shortest``, the lower quartile) of the edges of ``shape``'s
+    outline, holes included, over the square root of its area."""
     edges = sorted(
         float(e)
         for ring in (shape.polygon_px, *shape.holes_px)
@@ -224,7 +239,8 @@ def quartile_edge_share(shape: Shape) -> float:
     )
     if not edges:
         return 0.0
-    return edges[(len(edges) - 1) // 4] / math.sqrt(max(shape.area_px, 1.0))
+    edge = edges[0] if shortest else edges[(len(edges) - 1) // 4]
+    return edge / math.sqrt(max(shape.area_px, 1.0))
 
 
 def same_roof_aside(

@@ -212,7 +212,11 @@ def search(
     m.event(
         Level.INFO,
         f"target is point of interest {best.poi.index} (score {best.score:.3f}), "
-        f"roof {best.roof_m:.1f} m above home",
+        + (
+            f"roof {best.roof_m:.1f} m above home"
+            if best.roof_measured
+            else f"roof not measured (assumed {best.roof_m:.1f} m above home)"
+        ),
     )
     return best
 
@@ -358,9 +362,10 @@ def _walls_inside(m: SearchMission, look: _Look) -> bool:
     at least ``vectorize.min_area_px`` pixels inside it (a pixel in from its edge) of its
     paint (`same_paint`) whose brightness differs from the roof's by more than the roof's
     own spread (three median deviations, at least 2 DN) but no more than
-    ``vectorize.roof_value_tolerance``, within which the vectorizer takes a shade for roof.
-    A lit wall, seen from close, then moves the outline by its width (world scene 50334:
-    the target's inner corner, 15 DN brighter than its roof, put its outline 12.9 % off)."""
+    ``vectorize.roof_value_tolerance``, the most the vectorizer ever takes a shade for roof
+    within (in a noisy photo; `uavtool.vision.roof.roof_tolerance`). A lit wall, seen from
+    close, then moves the outline by its width (world scene 50334: the target's inner
+    corner, 15 DN brighter than its roof, put its outline 12.9 % off)."""
     shape = look.shapes[look.judgement.candidate]
     image = look.photo.image_rgb
     inside = cv2.erode(outline_mask(image, shape), np.ones((3, 3), np.uint8)) > 0
