@@ -6,14 +6,18 @@ from __future__ import annotations
 
 import dataclasses
 from pathlib import Path
+from types import SimpleNamespace
 
 import shapely
 
 from tests.mission.driver import fly
-from uavtool.mission import Status
+from uavtool.camera import CameraPose, Intrinsics
+from uavtool.mission import Params, Photo, Status
+from uavtool.mission.analysis import nadir_shapes
+from uavtool.mission.ground import lies_on_ground
 from uavtool.runner.fly import FlyConfig
 from uavtool.runner.fly import fly as fly_scene
-from uavtool.world import load_scene
+from uavtool.world import load_scene, render
 from uavtool.world.ground import GroundArea, GroundTexture, TextureKind
 from uavtool.world.scene import dump_scene
 
@@ -91,15 +95,27 @@ def test_a_tower_a_lawn_of_unknown_height_explained_stays_an_obstacle_once_it_is
 def test_the_ground_beside_a_darker_field_of_its_hue_is_ground() -> None:
     """World scene 50015: a brown ground with a grain, and a darker brown field beside the
     road. The ground, a region of its own colour as wide as the frame, lies on the ground
-    by parallax, but the field along its outline looked like its walls (another shade of
-    its colour), and it stayed a building of unknown height under every way: looks flew at
-    116 m and small buildings of the target's colour were never judged. The field's own
-    parallax shows it lies on the ground too: no walls, and the ground is no obstacle."""
+    by parallax, but the field along its outline looks like its walls (another shade of
+    its colour): as long as it did, the ground stayed a building of unknown height under
+    every way, looks flew at 116 m and small buildings of the target's colour were never
+    judged. The field's own parallax shows it lies on the ground too, in a photo that sees
+    it from elsewhere: no walls, and the ground is no obstacle. (Photographed here from
+    where a flight's tour once took its photos: whether a flight has such a photo depends
+    on which roofs its tour measures, and since the roofs' walls were told from them by the
+    roof's own spread, the flight over this scene takes none that tells.)"""
     scene = load_scene(str(Path(__file__).parent / "data" / "world-50015.yaml"))
-    flown = fly(scene)
-    mission = flown.mission
-    assert mission.plan is not None
-    assert all(poi.area_px < 640 * 480 / 2 for poi in mission.plan.pois)
-    # the overview from 117 m covers some 14,000 m²: no place of unknown height is most of it
-    widest = max(shapely.Polygon(place.footprint).area for place in mission.unknown.values())
-    assert widest < 2_000.0
+    params = Params()
+    k = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
+
+    def photo(tag: str, x: float, y: float, z: float) -> Photo:
+        pose = CameraPose((x, y, z), 270.0, -90.0)
+        return Photo(0, 0, tag, 0, pose, k, render(scene, pose, k))
+
+    high = photo("overview-2", 0.0, 0.0, 117.4)
+    low = photo("overview", 0.0, 0.0, 45.1)
+    aside = photo("measure-2", -48.0, -2.4, 117.4)
+    ground = max(nadir_shapes(params, high.image_rgb), key=lambda s: s.area_px)
+    assert ground.area_px > 640 * 480 / 2
+    m = SimpleNamespace(params=params)
+    assert not lies_on_ground(m, ground, high, (low,), one_colour=False)  # type: ignore[arg-type]
+    assert lies_on_ground(m, ground, high, (low, aside), one_colour=False)  # type: ignore[arg-type]
