@@ -115,8 +115,8 @@ def roof_tolerance(
     close in shade — at a fixed ``limit`` of 20 DN a wall lit 5 DN off its roof was drawn
     with it, and the outline lay a wall's width outside the roof's edge."""
     vs, us = votes
-    shades = value[vs, us].astype(np.int16)
-    near = np.sort(np.abs(shades - shade)[np.abs(shades - shade) <= limit // 2])
+    off = np.abs(value[vs, us].astype(np.int16) - shade)
+    near = np.sort(off[off <= limit // 2])
     if near.size == 0:
         return limit
     mad = float(near[(near.size - 1) // 2])  # the median (np.median imports numpy.ma)

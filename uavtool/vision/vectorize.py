@@ -231,7 +231,6 @@ def non_ground(
     tolerance_dn: int = 15,
     within: CvArray | None = None,
     nadir_px: tuple[float, float] | None = None,
-    _depth: int = 0,
 ) -> tuple[Shape, ...]:
     """The roofs of everything in an RGB frame that is not the ground, whatever its colour,
     largest first. Not ground: pixels differing from the ground's colour (the frame's most
@@ -249,34 +248,49 @@ def non_ground(
     as regions of their own (up to `_PARTS_DEEP` times)."""
     p = params if params is not None else VectorizeParams()
     frame = _check_frame(frame_rgb)
-    mask = _not_ground_mask(frame, p, tolerance_dn)
+    free = _not_ground_mask(frame, p, tolerance_dn)
+    mask = free
     if within is not None:
-        mask = cv2.bitwise_and(mask, cv2.threshold(within, 0, 255, cv2.THRESH_BINARY)[1])
-    regions = _regions(mask, mask, (0, 0), frame.shape[:2], 1, p)
+        mask = cv2.bitwise_and(free, cv2.threshold(within, 0, 255, cv2.THRESH_BINARY)[1])
     nadir = nadir_px if nadir_px is not None else _centre(frame)
+    return _non_ground_in(frame, free, mask, _colour_codes(frame), nadir, p, 0)
+
+
+def _non_ground_in(
+    frame: U8Array,
+    free: CvArray,
+    mask: CvArray,
+    codes: npt.NDArray[np.int32],
+    nadir: tuple[float, float],
+    p: VectorizeParams,
+    depth: int,
+) -> tuple[Shape, ...]:
+    """`non_ground`'s roofs of the regions of ``mask`` (part of ``free``, the frame's pixels
+    that are not ground; ``codes``: the frame's `_colour_codes`), and, ``depth`` times
+    looked at again so far, of what each region holds besides its roof and that roof's
+    paint."""
+    regions = _regions(mask, mask, (0, 0), frame.shape[:2], 1, p)
     least = max(int(np.ceil(p.min_edge_px)), 1)
     roofs: list[_Region] = []
     parts: list[Shape] = []
     for r in regions:
         inside = np.zeros_like(mask)
         cv2.drawContours(inside, [r.contour], 0, 255, cv2.FILLED)
-        rgb = _roof_rgb(frame, inside, _far_edge(inside, r.contour, nadir), least)
+        rgb = _roof_rgb(codes, inside, _far_edge(inside, r.contour, nadir), least)
         roof = cv2.bitwise_and(_near(frame, rgb, _ROOF_TOLERANCE_DN), inside)
         if p.denoise_px > 1:
             roof = cv2.medianBlur(roof, p.denoise_px)
         found = _regions(roof, roof, (0, 0), frame.shape[:2], 1, p)
         if found:
             roofs.append(max(found, key=lambda f: cv2.contourArea(f.contour)))
-        if _depth < _PARTS_DEEP:
-            rest = inside.copy()
-            rest[(roof > 0) | same_paint(frame, rgb)] = 0
+        if depth < _PARTS_DEEP:
+            x, y, w, h = cv2.boundingRect(r.contour)
+            box = (slice(y, y + h), slice(x, x + w))
+            rest = inside.copy()  # zero outside the region's box
+            rest[box][(roof[box] > 0) | same_paint(frame[box], rgb)] = 0
             if cv2.countNonZero(rest) >= p.min_area_px:
-                parts.extend(
-                    non_ground(
-                        frame, p, tolerance_dn=tolerance_dn, within=rest, nadir_px=nadir,
-                        _depth=_depth + 1,
-                    )
-                )  # fmt: skip
+                more = cv2.bitwise_and(free, rest)
+                parts.extend(_non_ground_in(frame, free, more, codes, nadir, p, depth + 1))
     shapes = [(-shape.area_px, order, shape) for order, _r, shape in _traced(frame, roofs, p)]
     shapes += [(-shape.area_px, len(shapes) + i, shape) for i, shape in enumerate(parts)]
     shapes.sort(key=lambda t: t[:2])
@@ -520,20 +534,21 @@ def _far_edge(
 
 
 def _roof_rgb(
-    frame: U8Array,
+    codes: npt.NDArray[np.int32],
     mask: CvArray,
     far_edge: tuple[npt.NDArray[np.intp], npt.NDArray[np.intp]],
     least: int,
 ) -> tuple[int, int, int]:
-    """The colour (to 8 levels) most of the ``far_edge`` pixels show, when there are at least
-    ``least`` of them; else the brightest colour holding at least `_ROOF_SHARE` of the pixels
-    under ``mask``: light from high above lights a roof better than the walls around it."""
+    """The colour (to 8 levels; ``codes``: the frame's `_colour_codes`) most of the
+    ``far_edge`` pixels show, when there are at least ``least`` of them; else the brightest
+    colour holding at least `_ROOF_SHARE` of the pixels under ``mask``: light from high
+    above lights a roof better than the walls around it."""
     if len(far_edge[0]) >= least:
-        edge_codes = _colour_codes(frame)[far_edge]
+        edge_codes = codes[far_edge]
         return _code_rgb(int(np.argmax(np.bincount(edge_codes, minlength=1 << 15))))
-    codes = _colour_codes(frame)[mask != 0]
-    counts = np.bincount(codes, minlength=1 << 15)
-    common = np.flatnonzero(counts >= _ROOF_SHARE * len(codes))
+    under = codes[mask != 0]
+    counts = np.bincount(under, minlength=1 << 15)
+    common = np.flatnonzero(counts >= _ROOF_SHARE * len(under))
     if len(common) == 0:
         common = np.array([int(np.argmax(counts))])
     brightness = (common >> 10) + ((common >> 5) & 31) + (common & 31)
