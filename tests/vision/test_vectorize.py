@@ -154,6 +154,18 @@ def test_non_ground_finds_what_vectorize_leaves_out() -> None:
     assert non_ground(np.full((480, 640, 3), 128, np.uint8)) == ()
 
 
+def test_non_ground_takes_a_region_one_or_two_pixels_thin() -> None:
+    """A region two pixels high (a wall's edge seen end on, world scene 50078's tour) is
+    looked at for what it holds besides its roof in its box grown to what the paint test
+    takes: the survey once stopped with "image too small: 67x2"."""
+    image = np.full((120, 160, 3), 90, np.uint8)
+    image[50:52, 20:100] = (200, 40, 40)
+    image[118:120, 20:100] = (200, 40, 40)  # at the frame's edge: the box cannot grow down
+    image[80:100, 20:60] = (40, 40, 200)
+    roofs = non_ground(image)
+    assert any(s.colour_rgb == (40, 40, 200) for s in roofs)
+
+
 def test_non_ground_finds_every_building_a_region_joins() -> None:
     """World scene 50124: a 3.4 m building of the ground's own hue (brighter), a car park
     it stands on the edge of and a building beyond it are one region of what is not

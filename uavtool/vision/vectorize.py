@@ -285,7 +285,10 @@ def _non_ground_in(
             roofs.append(max(found, key=lambda f: cv2.contourArea(f.contour)))
         if depth < _PARTS_DEEP:
             x, y, w, h = cv2.boundingRect(r.contour)
-            box = (slice(y, y + h), slice(x, x + w))
+            # a region a line thin (a wall's edge seen end on) is looked at in a box of at
+            # least 3 pixels each way: what `same_paint` takes
+            x, y = min(x, frame.shape[1] - 3), min(y, frame.shape[0] - 3)
+            box = (slice(y, y + max(h, 3)), slice(x, x + max(w, 3)))
             rest = inside.copy()  # zero outside the region's box
             rest[box][(roof[box] > 0) | same_paint(frame[box], rgb)] = 0
             if cv2.countNonZero(rest) >= p.min_area_px:
