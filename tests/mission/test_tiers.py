@@ -11,18 +11,22 @@ import math
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 from shapely.geometry import Point, Polygon  # type: ignore[import-untyped]
 
 from tests.mission.scenes import on_grey_ground
 from uavtool.camera import CameraPose, Intrinsics
-from uavtool.mission import Status
+from uavtool.mission import MissionInputs, SearchMission, Status
 from uavtool.mission.analysis import NOT_FLAT_M, nadir_shapes, not_flat, roof_between
 from uavtool.mission.observations import Photo
 from uavtool.mission.params import Params
 from uavtool.mission.unknown import (
     Known,
+    Overview,
+    Unknown,
     evidence,
+    footprint_at,
     region_of,
     unexplained,
     unknown_place,
@@ -277,6 +281,36 @@ def test_a_taller_part_whose_roof_is_beyond_the_frame_is_not_explained_by_the_wi
     assert unknown_place(rest[0], home, 111.0, (), regions).upper_m == 111.0
     # Of unknown height, the wing explains its whole region: nothing is left.
     assert unexplained(home, (wing,), (25.0,), (False,), regions, VectorizeParams()) == []
+
+
+def test_a_wing_measured_late_leaves_its_tower_as_high_as_anything_may_be() -> None:
+    """The wing of the test before, its roof of unknown height after the survey: it may stand
+    anywhere in its region, walls and all, up to 111 m. A look measures it later (14 m): the
+    walls it does not explain stand where they are, of unknown height. Measuring the wing
+    once dropped the whole region from what may stand high, and a closer look could have
+    descended beside the tower."""
+    home = _photo(_tower_on_a_wing(), 0.0, 0.0, 117.0, 0)
+    wing = _shape(home, (54, 160, 217))
+    regions = tuple(not_ground_regions(home.image_rgb))
+
+    def place_of(shape: Shape) -> Unknown:
+        return unknown_place(shape, home, 111.0, (), regions)
+
+    m = SearchMission(Params(), MissionInputs(np.asarray(render(_scene(), home.pose, K))))
+    m.ceiling_m = 117.0
+    m.overview = Overview(home, (wing,), [None], regions, place_of, VectorizeParams())
+    m.unknown = {0: place_of(wing)}
+    tower = (46.5, -2.0)
+    high = m.floor_at(*tower)
+    assert high > 111.0  # over the highest a building there may be, by the margin
+    m.learn_roof(0, footprint_at(wing, home, 14.0), 14.0)
+    assert 0 not in m.unknown and m.overview.roofs_m == [14.0]
+    assert [place.upper_m for place in m.unknown.values()] == [111.0]
+    assert m.floor_at(*tower) == high  # the tower's walls still count
+    # had the wing's roof been all its region held, the floor over the tower would be 14 m
+    # and the margin
+    m.unknown = {}
+    assert m.floor_at(*tower) < 30.0
 
 
 def test_buildings_measured_right_explain_all_they_show(photos: tuple[Photo, Photo]) -> None:

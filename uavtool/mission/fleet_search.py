@@ -68,6 +68,7 @@ class _Shared:
     peeks: list[Any]
     unknown: dict[int, Any]
     roofs: tuple[Any, ...]
+    overview: Any
 
 
 class SearchCrew(Crew):
@@ -172,7 +173,14 @@ class FleetSearchMission(FleetMember, SearchMission):
     def inspector(self, seen: Survey, transit_m: float) -> Inspector | None:
         crew = self.crew
         crew.shared = _Shared(
-            seen, transit_m, self.ceiling_m, self.seen_ground, self.peeks, self.unknown, self.roofs
+            seen,
+            transit_m,
+            self.ceiling_m,
+            self.seen_ground,
+            self.peeks,
+            self.unknown,
+            self.roofs,
+            self.overview,
         )
         if crew.size == 1:
             return None
@@ -304,6 +312,7 @@ class FleetSearchMission(FleetMember, SearchMission):
         self.transit_m = self.layer_m()
         self.ceiling_m, self.seen_ground = shared.ceiling_m, shared.seen_ground
         self.peeks, self.unknown, self.roofs = shared.peeks, shared.unknown, shared.roofs
+        self.overview = shared.overview
         self.plan = None
         seen = shared.seen
         layer = self.transit_m

@@ -37,6 +37,7 @@ from uavtool.mission.survey import (
 )
 from uavtool.mission.unknown import (
     Known,
+    Overview,
     Unknown,
     evidence,
     footprint_at,
@@ -45,6 +46,7 @@ from uavtool.mission.unknown import (
     unknown_place,
 )
 from uavtool.nav import NavError, frame_on_plane, ground_point
+from uavtool.nav.geometry import segment_polygon_distance
 from uavtool.nav.heights import roof_from_cut_outline
 from uavtool.nav.parallax import STOREY_M
 from uavtool.vision import Shape
@@ -254,6 +256,16 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
             for j, o in enumerate(obstacles)
             if not o.measured
         }
+    )
+    m.overview = Overview(
+        seen.photo,
+        shapes,
+        [None if i in m.unknown else roofs[i] for i in range(len(shapes))],
+        seen.regions,
+        place_of,
+        m.params.vectorize,
+        tuple(photos),
+        {-1 - j: o.shape for j, o in enumerate(obstacles) if not o.measured},
     )
     return replace(
         seen,
@@ -491,3 +503,50 @@ def _disagreement_px(
         return None
     metres_per_px = (photo.pose.pos_enu_m[2] - roof_m) / k.fx_px
     return math.dist(a, b) / metres_per_px if metres_per_px > 0.0 else None
+
+
+def measure_in_the_way(
+    m: SearchMission, x: float, y: float, photo: Photo, shapes: tuple[Shape, ...]
+) -> bool:
+    """Measure the roofs of unknown height within the safety margin of (x, y) that the
+    higher overview shows whole against ``photo``, a later look from above (its building
+    ``shapes``), as the survey's tour measures them against its own photos: a roof placed
+    at one height by both, or a region lying on the ground by parallax (against the
+    survey's photos too: what a roof measured late leaves of its region was never tried
+    against them). A look taken lower and elsewhere sees from another place than any of
+    the tour's. Whether any was measured (the floor there may then be lower)."""
+    ov = m.overview
+    if ov is None:
+        return False
+    margin_m = m.params.viewpoints.safety_margin_m
+
+    def near(ring: tuple[tuple[float, float], ...]) -> bool:
+        return segment_polygon_distance((x, y), (x, y), ring) <= margin_m
+
+    below_m = ov.photo.pose.pos_enu_m[2] - 1.0
+    regions: tuple[Shape, ...] | None = None  # what is not ground in the look, if needed
+    learnt = False
+    for i, place in sorted(m.unknown.items()):
+        if i >= len(ov.shapes) or (i < 0 and i not in ov.others) or place.top_m(near) is None:
+            continue
+        shape, against = (ov.shapes[i], shapes) if i >= 0 else (ov.others[i], None)
+        if against is None:  # an obstacle is a region: measured against the look's regions
+            if regions is None:
+                regions = non_ground(photo.image_rgb, m.params.vectorize)
+            against = regions
+        roof = None
+        if not shape.cut_by_border:  # a roof measured by the edges a border left is no
+            roof = measure_roof(m, shape, ov.photo, photo, against, below_m=below_m)  # floor
+        if roof is None or roof <= STOREY_M:
+            flat = lies_on_ground(m, shape, ov.photo, [photo, *ov.photos], one_colour=False)
+            roof = 0.0 if flat else roof
+        if roof is None:
+            continue
+        m.learn_roof(i, footprint_at(shape, ov.photo, roof), roof)
+        m.event(
+            Level.INFO,
+            f"a building of unknown height near ({x:.1f}, {y:.1f}) measured at last: "
+            + ("it lies on the ground" if roof == 0.0 else f"roof {roof:.1f} m above home"),
+        )
+        learnt = True
+    return learnt

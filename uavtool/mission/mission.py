@@ -29,7 +29,7 @@ from uavtool.mission.outputs import (
 )
 from uavtool.mission.params import Params
 from uavtool.mission.peek import Peek, peek
-from uavtool.mission.unknown import Unknown
+from uavtool.mission.unknown import Overview, Unknown
 from uavtool.nav.geometry import (
     point_in_polygon,
     point_segment_distance,
@@ -38,6 +38,7 @@ from uavtool.nav.geometry import (
 from uavtool.vision.vectorize import enclosed_openings
 
 if TYPE_CHECKING:
+    from uavtool.mission.observations import Photo
     from uavtool.mission.outputs import PointOfInterest
     from uavtool.mission.search import Found, Inspector, Look
     from uavtool.mission.survey import Survey
@@ -93,6 +94,9 @@ class SearchMission(FlightMission):
         crosses over that by the margin."""
         self.roofs: tuple[tuple[tuple[tuple[float, float], ...], float], ...] = ()
         """Every measured roof: (footprint, height above home)."""
+        self.overview: Overview | None = None
+        """The higher overview's roofs as the survey left them, for a look to measure
+        more of (None before the survey, or when it measured every roof)."""
         self.viewpoints: Viewpoints | None = None
         self.model: ModelBuilt | None = None
         self._frames_seen = 0
@@ -293,9 +297,26 @@ class SearchMission(FlightMission):
     def learn_roof(
         self, index: int, footprint: tuple[tuple[float, float], ...], roof_m: float
     ) -> None:
-        """A roof of unknown height (overview shape ``index``) measured at last."""
-        self.unknown.pop(index, None)
+        """A roof of unknown height (overview shape ``index``) measured at last. What of
+        its region it leaves unexplained (a building of no building colour merged with it
+        in the overview) may stand as high as a building of unknown height there may."""
+        place = self.unknown.pop(index, None)
         self.roofs = (*self.roofs, (footprint, roof_m))
+        ov = self.overview
+        if place is None or ov is None or not 0 <= index < len(ov.shapes):
+            return
+        ov.roofs_m[index] = roof_m
+        for rest in ov.rest_of(index, roof_m):
+            key = min([-1_000_000, *ov.others]) - 1  # past the survey's obstacles
+            self.unknown[key] = ov.place(rest)
+            ov.others[key] = rest
+
+    def measure_near(self, x: float, y: float, photo: Photo, shapes: tuple[Shape, ...]) -> bool:
+        """Measure, against ``photo`` (a look from above; its building ``shapes``), the roofs
+        of unknown height that the floor over (x, y) counts with; whether any was."""
+        from uavtool.mission.measure import measure_in_the_way  # noqa: PLC0415 - uses this
+
+        return measure_in_the_way(self, x, y, photo, shapes)
 
     def _over_unknown(self, here: Vec3, there: tuple[float, float]) -> float:
         """The altitude that clears, by the margin, the highest every building of unknown

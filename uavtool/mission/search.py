@@ -257,7 +257,11 @@ def inspect(
     sided = False  # a look from beside the first, to measure a roof by parallax, taken
     for n in range(2, p.max_looks + 1):
         closer = None
-        if not poi.roof_measured:
+        # a roof the overview's border cut was measured by the edges it shows: for plans,
+        # not to descend by (it counts as high as its region allows); whole in the looks,
+        # they measure it
+        known = poi.roof_measured and poi.shape_index not in m.unknown
+        if not known:
             before = [(overview_shapes[poi.shape_index], overview)] + [
                 (look.shapes[look.judgement.candidate], look.photo)
                 for look in looks[:-1]
@@ -266,7 +270,7 @@ def inspect(
             closer = _closer_look(m, looks[-1], before, poi.shape_index)
         elif looks[-1].judgement.too_small:
             closer = _closer_look(m, looks[-1], [], poi.shape_index, roof_m)
-        still = None if poi.roof_measured else m.unknown.get(poi.shape_index)
+        still = None if known else m.unknown.get(poi.shape_index)
         step = None
         if closer is None and still is not None:
             step = _step_down(m, looks[-1], still.upper_m)
@@ -753,8 +757,11 @@ def _closer_look(
     lower = max(fit, roof + p.min_above_roof_m)
     u, v = shape.centroid_px
     x, y = ground_point(u, v, photo.pose, k, plane_z_m=plane)
+    clear = look.alt_m - p.recheck_climb_m / 2.0
+    if lower <= clear < m.floor_at(x, y):  # held up by roofs of unknown height: the look
+        m.measure_near(x, y, photo, look.shapes)  # may measure them
     lower = max(lower, m.floor_at(x, y))
-    if lower > look.alt_m - p.recheck_climb_m / 2.0:
+    if lower > clear:
         return None
     return (x, y, lower), roof
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
 import cv2
@@ -48,6 +48,47 @@ class Unknown(NamedTuple):
         if not self.bands:
             return self.upper_m if near(self.footprint) else None
         return max((top for ring, top in self.bands if near(ring)), default=None)
+
+
+@dataclass(slots=True)
+class Overview:
+    """The higher overview as the survey left it: its photo, its building shapes with each
+    roof's height (None: not known, or known only for plans), its regions of what is not
+    ground, and where a building of unknown height seen in it may stand (``place``:
+    :func:`unknown_place` against the photos the survey took). A look taken later measures
+    more of its roofs (`rest_of` tells what of a region that leaves unexplained)."""
+
+    photo: Photo
+    shapes: tuple[Shape, ...]
+    roofs_m: list[float | None]
+    regions: tuple[Shape, ...]
+    place: Callable[[Shape], Unknown]
+    params: VectorizeParams
+    photos: tuple[Photo, ...] = ()
+    """The survey's other photos from above (the lower overview, the tour's)."""
+    others: dict[int, Shape] = field(default_factory=dict)
+    """What is not ground and no building shape explains, of unknown height, by its key in
+    the mission's ``unknown`` (negative): the survey's obstacles, and what of a region a
+    roof measured later leaves unexplained."""
+
+    def rest_of(self, index: int, roof_m: float) -> list[Shape]:
+        """What of the region of shape ``index`` no roof explains once that roof is measured
+        ``roof_m`` high: another building merged with it in the photo, of no building
+        colour. A roof still of unknown height explains its whole region."""
+        region = region_of(self.shapes[index], self.regions)
+        if region is None:
+            return []
+        roofs = list(self.roofs_m)
+        roofs[index] = roof_m
+        inside = [i for i, s in enumerate(self.shapes) if region_of(s, [region]) is region]
+        return unexplained(
+            self.photo,
+            [self.shapes[i] for i in inside],
+            [roofs[i] or 0.0 for i in inside],
+            [roofs[i] is not None for i in inside],
+            [region],
+            self.params,
+        )
 
 
 def footprint_at(shape: Shape, photo: Photo, roof_m: float) -> tuple[tuple[float, float], ...]:

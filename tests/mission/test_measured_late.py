@@ -1,0 +1,56 @@
+"""Roofs the survey left of unknown height, measured by the looks that come after it.
+
+A building of unknown height may stand anywhere along the rays through its outline, up to
+just below the camera: near it, no look descends. The survey's tour measures what it can;
+a look taken later, lower and elsewhere, sees from another place than any of the tour's,
+and measures more. Each scene below is a world scene (``uavtool scene random --hard --town
+--world --anywhere --seed N``) flown on the built-in vehicle, whose flight ended "which is
+the target is not known" before: a building of the target's colour drawn too small to
+judge, no closer look allowed over it."""
+
+from __future__ import annotations
+
+from tests.mission.scenes import fly_data_scene
+from uavtool.mission import Status
+
+
+def test_a_field_the_survey_could_not_place_is_found_on_the_ground_by_a_look() -> None:
+    """World scene 50044: a field with buildings standing on it, which no photo of the
+    survey told from a building, may be a tower up to 92 m over the whole way down to a
+    candidate of the target's colour (an 18 m roof drawn too small from 96.6 m): the closer
+    look was refused. The look itself tells by parallax that the field lies on the ground;
+    the closer look follows, and the target is found."""
+    summary, texts = fly_data_scene("world-50044")
+    assert any("measured at last: it lies on the ground" in t for t in texts), texts
+    assert any("looking again from closer" in t for t in texts), texts
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == summary.evaluation.target_building == "b00"
+
+
+def test_a_rival_whose_roof_the_border_cut_is_measured_from_aside() -> None:
+    """World scene 50011: the target (b03, a 43.9 m U) matches; a near shape of its colour
+    and height, its roof cut by the overview's border, is drawn too small to judge from the
+    ceiling. The survey measured it by the edges the border left: a height for plans, not
+    one to descend by (a tier of a stepped tower once came out 21 m low that way), so it
+    counted as high as its region allowed, and it held its own closer look up. Whole in the
+    look and in a look from aside, its roof is measured, the look from closer tells it from
+    the target."""
+    summary, texts = fly_data_scene("world-50011")
+    assert any("m aside, at 11" in t for t in texts), texts
+    assert any("its roof measured 43.9 m above home: looking again from closer" in t for t in texts)
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == summary.evaluation.target_building == "b03"
+
+
+def test_what_a_roof_measured_late_leaves_of_its_region_is_measured_too() -> None:
+    """World scene 50061: a near shape of the target's colour stands beside a car park, one
+    region with it in the overview. Of unknown height, the building explained its whole
+    region; once its roof was measured (17.5 m) the car park was no longer covered by
+    anything. Now what a roof leaves of its region stands, of unknown height, as the
+    survey's obstacles do, and held the closer look up, until the look and the survey's
+    photos told by parallax that both parts of the car park lie on the ground."""
+    summary, texts = fly_data_scene("world-50061")
+    assert sum("measured at last: it lies on the ground" in t for t in texts) == 2, texts
+    assert any("its roof measured 17.5 m above home: looking again from closer" in t for t in texts)
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == summary.evaluation.target_building == "b04"
