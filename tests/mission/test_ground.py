@@ -8,16 +8,21 @@ import dataclasses
 from pathlib import Path
 from types import SimpleNamespace
 
+import numpy as np
 import shapely
 
 from tests.mission.driver import fly
-from uavtool.camera import CameraPose, Intrinsics
-from uavtool.mission import Params, Photo, Status
+from tests.mission.scenes import fly_data_scene
+from uavtool.camera import CameraPose, Intrinsics, project
+from uavtool.mission import MissionInputs, Params, Photo, SearchMission, Status
 from uavtool.mission.analysis import nadir_shapes
-from uavtool.mission.ground import lies_on_ground
+from uavtool.mission.ground import lies_on_ground, regions_off_ground
+from uavtool.mission.unknown import region_of, unexplained
 from uavtool.runner.fly import FlyConfig
 from uavtool.runner.fly import fly as fly_scene
-from uavtool.world import load_scene, render
+from uavtool.vision.params import VectorizeParams
+from uavtool.vision.vectorize import not_ground_regions
+from uavtool.world import load_scene, render, scene_from_dict
 from uavtool.world.ground import GroundArea, GroundTexture, TextureKind
 from uavtool.world.scene import dump_scene
 
@@ -119,3 +124,67 @@ def test_the_ground_beside_a_darker_field_of_its_hue_is_ground() -> None:
     m = SimpleNamespace(params=params)
     assert not lies_on_ground(m, ground, high, (low,), one_colour=False)  # type: ignore[arg-type]
     assert lies_on_ground(m, ground, high, (low, aside), one_colour=False)  # type: ignore[arg-type]
+
+
+def test_a_lawn_on_the_ground_is_no_part_of_the_building_on_it_but_its_neighbour_still_is() -> None:
+    """A 12 m blue building stands on a lawn, and a 30 m grey tower (no building colour)
+    touches the lawn's far edge: from 80 m they are one region of what is not ground. Of
+    unknown height, the building may stand anywhere in its region: with the lawn, over the
+    whole of it and up to the tower (world scene 50217: a car park, a lawn and a field held
+    every look near a candidate 66 m up). Once the lawn lies on the ground, the building
+    stands in its own part; the tower, in no building's part, is still what no roof
+    explains (an obstacle), as it must be (`test_a_tower_a_lawn_...` above)."""
+    scene = scene_from_dict(
+        {
+            "target": "blue",
+            "ground": {
+                "color": [107, 161, 195],
+                "areas": [{"name": "lawn", "color": [48, 128, 55],
+                           "polygon": [[-14, -8], [12, -8], [12, 8], [-14, 8]]}],
+            },
+            "buildings": [
+                {"name": "blue", "color": [54, 84, 217],
+                 "blocks": [{"footprint": [[-9, -3], [-3, -3], [-3, 3], [-9, 3]], "top_m": 12}]},
+                {"name": "tower", "color": [128, 128, 128],
+                 "blocks": [{"footprint": [[12, -2], [16, -2], [16, 2], [12, 2]], "top_m": 30}]},
+            ],
+        }
+    )  # fmt: skip
+    k = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
+    pose = CameraPose((0.0, 0.0, 80.0), 0.0, -90.0)
+    photo = Photo(0, 0, "overview-2", 0, pose, k, render(scene, pose, k))
+    shapes = nadir_shapes(Params(), photo.image_rgb)
+    blue = next(s for s in shapes if s.colour_rgb[2] > 150 and s.colour_rgb[0] < 100)
+    lawn = next(s for s in shapes if s.colour_rgb[1] > s.colour_rgb[0] + 40 and s is not blue)
+    regions = not_ground_regions(photo.image_rgb)
+    whole = region_of(blue, regions)
+    assert whole is not None and region_of(lawn, regions) is whole
+    m = SearchMission(Params(), MissionInputs(photo.image_rgb))
+    parts = regions_off_ground(m, photo, regions, [lawn])
+    own = region_of(blue, parts)
+    assert own is not None and own.area_px < 0.5 * whole.area_px
+    rest = unexplained(
+        photo, (blue, lawn), (25.0, 0.0), (False, True), regions, VectorizeParams(), parts
+    )
+    top = project(np.array([(14.0, 0.0, 30.0)]), pose, k)[0, :2]
+    assert any(shapely.Polygon(r.polygon_px).contains(shapely.Point(*top)) for r in rest)
+    # the whole region, lawn and tower, was the building's before
+    assert (
+        unexplained(photo, (blue, lawn), (25.0, 0.0), (False, True), regions, VectorizeParams())
+        == []
+    )
+
+
+def test_a_building_on_a_car_park_beside_a_lawn_is_looked_at_low_enough_to_judge() -> None:
+    """World scene 50217: the target's mirror image (6.5 m, the target's colour) stands on
+    a car park that touches a lawn and a field, all three on the ground by parallax, and a
+    teal stepped building stands on the lawn. In the overview all of them are one region;
+    of unknown height, the teal building might have stood anywhere in it, up to 66 m over
+    the mirror image, whose look stayed at 70.6 m, where it was drawn too small to judge:
+    the flight ended "which is the target is not known". The teal building stands in its
+    own part of the region: the mirror image is looked at from over its roof and ruled
+    out, and the target (b06) is found."""
+    summary, events = fly_data_scene("world-50217")
+    assert any("as much like the target's mirror image" in e for e in events), events
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == summary.evaluation.target_building == "b06"

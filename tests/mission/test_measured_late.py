@@ -43,14 +43,15 @@ def test_a_rival_whose_roof_the_border_cut_is_measured_from_aside() -> None:
 
 
 def test_what_a_roof_measured_late_leaves_of_its_region_is_measured_too() -> None:
-    """World scene 50061: a near shape of the target's colour stands beside a car park, one
-    region with it in the overview. Of unknown height, the building explained its whole
-    region; once its roof was measured (17.5 m) the car park was no longer covered by
-    anything. Now what a roof leaves of its region stands, of unknown height, as the
-    survey's obstacles do, and held the closer look up, until the look and the survey's
-    photos told by parallax that both parts of the car park lie on the ground."""
-    summary, texts = fly_data_scene("world-50061")
-    assert sum("measured at last: it lies on the ground" in t for t in texts) == 2, texts
-    assert any("its roof measured 17.5 m above home: looking again from closer" in t for t in texts)
+    """World scene 50130: the target's mirror image (b06, 7.6 m, the target's colour)
+    touches a road in the overview, one region with it. Of unknown height, it explained
+    its whole region; once a look from straight above measured its roof, the road was
+    covered by nothing at all. What a roof measured late leaves of its region now stands
+    of unknown height, as the survey's obstacles do (the road: up to 54 m, over the way
+    down to the mirror image), until the look and the survey's photos tell it lies on the
+    ground. The look from closer then follows, and rules the mirror image out."""
+    summary, texts = fly_data_scene("world-50130")
+    assert sum("measured at last: it lies on the ground" in t for t in texts) == 1, texts
+    assert any("just below the threshold; its roof measured 12.0 m" in t for t in texts), texts
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
-    assert summary.evaluation.matched_building == summary.evaluation.target_building == "b04"
+    assert summary.evaluation.matched_building == summary.evaluation.target_building == "b01"

@@ -14,7 +14,13 @@ import numpy.typing as npt
 from uavtool.mission.observations import Photo
 from uavtool.nav.parallax import STOREY_M, least_telling_m, on_ground
 from uavtool.vision import Shape
-from uavtool.vision.vectorize import near_colour, non_ground, outline_mask, same_paint
+from uavtool.vision.vectorize import (
+    near_colour,
+    non_ground,
+    not_ground_regions,
+    outline_mask,
+    same_paint,
+)
 
 if TYPE_CHECKING:
     from uavtool.mission.mission import SearchMission
@@ -187,6 +193,23 @@ def without_ground(
         if cv2.countNonZero(rest) >= least:
             kept.extend(non_ground(photo.image_rgb, m.params.vectorize, within=rest))
     return kept, flat
+
+
+def regions_off_ground(
+    m: SearchMission, photo: Photo, regions: tuple[Shape, ...], ground: Sequence[Shape]
+) -> tuple[Shape, ...]:
+    """``regions`` (what is not ground in nadir ``photo`` by its colour) without the pixels
+    of ``ground`` (shapes of ``photo`` that lie on the ground by parallax) in their own
+    colour: a lawn a building stands on is no part of that building, and a building of
+    unknown height may stand anywhere in its region. What stands on them, of another
+    colour, stays."""
+    if not ground:
+        return regions
+    keep: CvArray = np.full(photo.image_rgb.shape[:2], 255, np.uint8)
+    for shape in ground:
+        flat = cv2.bitwise_and(outline_mask(photo.image_rgb, shape), _near(photo, shape.colour_rgb))
+        keep = cv2.bitwise_and(keep, cv2.bitwise_not(flat))
+    return not_ground_regions(photo.image_rgb, m.params.vectorize, within=keep)
 
 
 def _near(photo: Photo, rgb: tuple[int, int, int]) -> CvArray:

@@ -24,7 +24,7 @@ import cv2
 import numpy as np
 
 from uavtool.mission.analysis import not_flat, placed_roof, roof_between
-from uavtool.mission.ground import lies_on_ground, without_ground
+from uavtool.mission.ground import lies_on_ground, regions_off_ground, without_ground
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
 from uavtool.mission.search import photo_shapes
@@ -146,7 +146,13 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     # its region allows. Ground explains only itself: a lawn of unknown height explained
     # its whole region, and a tower beside it was once left out of every obstacle when the
     # lawn was found to be ground.
-    later = unexplained(seen.photo, seen.shapes, roofs, measured, seen.regions, m.params.vectorize)
+    # A building of unknown height stands in its region's part off the ground: a lawn it
+    # stands on is no part of it (nor a reason to count it cut by the frame).
+    flat_shapes = [*seen.ground, *(seen.shapes[i] for i in ground)]
+    parts = regions_off_ground(m, seen.photo, seen.regions, flat_shapes)
+    later = unexplained(
+        seen.photo, seen.shapes, roofs, measured, seen.regions, m.params.vectorize, parts
+    )
     others += later
     others_m += _measured_by(m, later, seen.photo, photos, below_m)
     flat = 0
@@ -180,7 +186,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     hue = m.params.vectorize.hue_tolerance_deg
 
     def place_of(o: Shape) -> Unknown:
-        return unknown_place(o, seen.photo, tallest_m, views, seen.regions, hue_tolerance_deg=hue)
+        return unknown_place(o, seen.photo, tallest_m, views, parts, hue_tolerance_deg=hue)
 
     # What is not ground and has the target's hue, though the vectorizer kept no roof of it
     # (walls whose roof lies beyond the frame, a darker shade), may be the target: it is a
@@ -264,6 +270,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         seen.regions,
         place_of,
         m.params.vectorize,
+        parts,
         tuple(photos),
         {-1 - j: o.shape for j, o in enumerate(obstacles) if not o.measured},
     )

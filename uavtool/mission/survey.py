@@ -57,6 +57,9 @@ class Survey:
     """The shapes that are regions of the target's hue showing no roof (walls whose roof
     lay beyond the frame, a darker shade): points of interest whose look must show a
     building that explains them (:func:`~uavtool.mission.unknown.shows_as`)."""
+    ground: tuple[Shape, ...] = ()
+    """The shapes of a building colour in ``photo`` that the two overviews tell lie on the
+    ground (lawns, roads): no buildings, not in ``shapes``."""
 
     @property
     def highest_roof_m(self) -> float:
@@ -138,7 +141,16 @@ def survey(m: SearchMission) -> Wait[Survey]:
     )
     uppers = tuple(place.upper_m for place in places)
     return Survey(
-        high, shapes, tuple(roofs), tuple(measured), footprints, pois, uppers, regions, lower=low
+        high,
+        shapes,
+        tuple(roofs),
+        tuple(measured),
+        footprints,
+        pois,
+        uppers,
+        regions,
+        lower=low,
+        ground=tuple(ground),
     )
 
 

@@ -64,6 +64,9 @@ class Overview:
     regions: tuple[Shape, ...]
     place: Callable[[Shape], Unknown]
     params: VectorizeParams
+    parts: tuple[Shape, ...] | None = None
+    """``regions`` with what lies on the ground taken out (`ground.regions_off_ground`): a
+    building of unknown height stands in its part of its region."""
     photos: tuple[Photo, ...] = ()
     """The survey's other photos from above (the lower overview, the tour's)."""
     others: dict[int, Shape] = field(default_factory=dict)
@@ -88,6 +91,7 @@ class Overview:
             [roofs[i] is not None for i in inside],
             [region],
             self.params,
+            self.parts,
         )
 
 
@@ -363,14 +367,16 @@ def unexplained(
     measured: Sequence[bool],
     regions: Sequence[Shape],
     params: VectorizeParams,
+    parts: Sequence[Shape] | None = None,
 ) -> list[Shape]:
     """What is not ground in a nadir ``photo``, in a region (of ``regions``: what is not
     ground, :func:`~uavtool.vision.vectorize.not_ground_regions`) holding a building the
     vectorizer found (``shapes``), but outside every such building as measured: its roof at
     the height measured (``roofs_m``, where ``measured``), its walls down to the ground. A
-    building of unknown height explains its whole region: it may stand anywhere in it. A
-    taller tier of one colour whose roof lies beyond the frame, or a neighbour of a darker
-    shade merged with a building, shows here."""
+    building of unknown height explains its whole region: it may stand anywhere in it (in
+    its part of it, of ``parts``, when given: the regions with what lies on the ground
+    taken out). A taller tier of one colour whose roof lies beyond the frame, or a
+    neighbour of a darker shade merged with a building, shows here."""
     p, k = params, photo.intrinsics
     touched = np.zeros((k.height_px, k.width_px), np.uint8)
     explained = np.zeros_like(touched)
@@ -383,7 +389,8 @@ def unexplained(
             for ring in _prism_px(shape, photo, roof_m):  # one by one: overlaps stay filled
                 cv2.fillPoly(explained, [ring], 255)
         else:
-            cv2.fillPoly(explained, [pixels(region.polygon_px)], 255)
+            part = None if parts is None else region_of(shape, parts)
+            cv2.fillPoly(explained, [pixels((part or region).polygon_px)], 255)
     # Outlines are simplified (by up to rdp_epsilon_px) and denoised (a median of
     # denoise_px): a building's own edge may lie that far off.
     reach = math.ceil(p.rdp_epsilon_px) + p.denoise_px // 2 + 1

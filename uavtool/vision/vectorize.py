@@ -306,14 +306,21 @@ _PARTS_DEEP = 2
 
 
 def not_ground_regions(
-    frame_rgb: U8Array, params: VectorizeParams | None = None, *, tolerance_dn: int = 15
+    frame_rgb: U8Array,
+    params: VectorizeParams | None = None,
+    *,
+    tolerance_dn: int = 15,
+    within: CvArray | None = None,
 ) -> tuple[Shape, ...]:
     """The outlines of the regions of an RGB frame that are not the ground (as
     :func:`non_ground` tells it), roofs and walls together, largest first: one building
-    with everything seen of it, or several that touch in the photo."""
+    with everything seen of it, or several that touch in the photo. ``within``: only
+    where that mask is non-zero (what else is known to lie on the ground left out)."""
     p = params if params is not None else VectorizeParams()
     frame = _check_frame(frame_rgb)
     mask = _not_ground_mask(frame, p, tolerance_dn)
+    if within is not None:
+        mask = cv2.bitwise_and(mask, within)
     regions = _regions(mask, mask, (0, 0), frame.shape[:2], 1, p)
     shapes = [(-shape.area_px, order, shape) for order, _r, shape in _traced(frame, regions, p)]
     shapes.sort(key=lambda t: t[:2])
