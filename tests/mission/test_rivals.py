@@ -308,3 +308,18 @@ def test_the_targets_lit_wall_is_not_its_outline_and_no_near_shape_is_found() ->
     assert summary.outcome.status is Status.NO_MATCH, summary.outcome.reason
     gaps = [float(t.split("outline ")[1].split(" %")[0]) for t in texts if ": MATCH (" in t]
     assert gaps and min(gaps) <= 0.5, texts  # the target's own outline, walls left out
+
+
+def test_a_building_a_look_from_aside_cannot_tell_apart_stays_unjudged() -> None:
+    """World scene 50023: the target (b01, a small L) is drawn too small to judge from the
+    ceiling, its roof unknown; a look from straight above it draws it as small again, and
+    the look from aside that would measure its roof cannot tell it from the shapes around
+    it. A near shape of the target's colour then matches within the accuracy its own look
+    allows. The look from aside, which showed no building of the target's colour, was once
+    the last word on the target: it was forgotten, and the near shape was reported found
+    and modelled. What a look leaves unjudged stays so until a look judges it."""
+    summary, events = fly_data_scene("world-50023")
+    assert any("not told apart from others here" in e for e in events), events
+    assert summary.outcome.status is Status.NO_MATCH, summary.outcome.reason
+    assert "could not be judged" in summary.outcome.reason
+    assert summary.evaluation.matched_building == ""

@@ -147,8 +147,8 @@ def search(
             best_score, best_poi = top, k
         look = looks[-1]  # a match ends the looking: the last look is the match if any
         j = look.judgement
-        if not j.judgeable and j.candidate >= 0 and j.same_hue:
-            unjudged.append((k, look))
+        if (left := _left_unjudged(looks)) is not None:
+            unjudged.append((k, left))
         elif (doubt := _doubtful(m, looks)) is not None:
             doubtful.append((k, *doubt))
         if (
@@ -328,6 +328,19 @@ def inspect(
         yield from _shift(m, pos, f"point of interest {k}, look {n}")
         looks.append((yield from _look(m, k, n, pos[2], poi.colour_rgb)))
     return looks, upper
+
+
+def _left_unjudged(looks: list[_Look]) -> _Look | None:
+    """The look that left a building of the target's hue unjudged (drawn too small, cut by
+    the border), unless a later look judged one: a later look that shows none (a look
+    from aside that could not tell the building apart from others, world 50023) leaves it
+    unjudged all the same, and the search may not call another building the target."""
+    left = None
+    for look in looks:
+        j = look.judgement
+        if j.candidate >= 0 and j.same_hue:
+            left = None if j.judgeable else look
+    return left
 
 
 def _doubtful(m: SearchMission, looks: list[_Look]) -> tuple[_Look, bool] | None:
