@@ -148,8 +148,8 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     # lawn was found to be ground.
     # A building of unknown height stands in its region's part off the ground: a lawn it
     # stands on is no part of it (nor a reason to count it cut by the frame).
-    flat_shapes = [*seen.ground, *(seen.shapes[i] for i in ground)]
-    parts = regions_off_ground(m, seen.photo, seen.regions, flat_shapes)
+    on_ground = [*seen.ground, *(seen.shapes[i] for i in ground)]
+    parts = regions_off_ground(m, seen.photo, seen.regions, on_ground)
     later = unexplained(
         seen.photo, seen.shapes, roofs, measured, seen.regions, m.params.vectorize, parts
     )
@@ -534,13 +534,16 @@ def measure_in_the_way(
     regions: tuple[Shape, ...] | None = None  # what is not ground in the look, if needed
     learnt = False
     for i, place in sorted(m.unknown.items()):
-        if i >= len(ov.shapes) or (i < 0 and i not in ov.others) or place.top_m(near) is None:
+        if place.top_m(near) is None:
             continue
-        shape, against = (ov.shapes[i], shapes) if i >= 0 else (ov.others[i], None)
-        if against is None:  # an obstacle is a region: measured against the look's regions
+        if 0 <= i < len(ov.shapes):
+            shape, against = ov.shapes[i], shapes
+        elif i in ov.others:  # a region of no building colour: against the look's regions
             if regions is None:
                 regions = non_ground(photo.image_rgb, m.params.vectorize)
-            against = regions
+            shape, against = ov.others[i], regions
+        else:
+            continue
         roof = None
         if not shape.cut_by_border:  # a roof measured by the edges a border left is no
             roof = measure_roof(m, shape, ov.photo, photo, against, below_m=below_m)  # floor
