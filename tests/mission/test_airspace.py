@@ -37,6 +37,22 @@ def test_a_claim_is_granted_only_apart_from_every_other() -> None:
     assert space.request(1, lower)  # 9 m under it: apart
 
 
+def test_a_vehicle_knows_whom_it_holds_up_until_the_way_is_granted() -> None:
+    space = Airspace(((0.0, 0.0), (30.0, 0.0)), separation_m=5.0, margin_m=1.5)
+    assert space.request(0, Claim.point((0.0, 0.0), 40.0))  # waiting, hovering
+    down = Claim.column((3.0, 0.0), 0.6, 20.0, 60.0)  # the other's way down past it
+    assert not space.request(1, down)
+    assert space.holding_up(0) == 1 and space.holding_up(1) is None
+    assert space.wanted == {1: down}
+    assert space.request(0, Claim.point((0.0, 30.0), 40.0))  # it gave way
+    assert space.holding_up(0) is None  # the refused claim, asked again, is granted next
+    assert space.request(1, down) and space.wanted == {}
+    # A vehicle that lands is waiting for nothing any more.
+    assert not space.request(0, Claim.column((3.0, 3.0), 0.6, 0.0, 60.0))
+    space.park(0, (0.0, 30.0))
+    assert space.wanted == {}
+
+
 def test_a_parked_vehicle_holds_only_where_it_stands() -> None:
     space = Airspace(((0.0, 0.0), (10.0, 0.0)), separation_m=5.0, margin_m=1.5)
     assert space.request(0, Claim.lane((0.0, 0.0), (0.0, 50.0), 20.0))

@@ -81,6 +81,8 @@ class Airspace:
         self.held: list[Claim] = [Claim.parked_at(at, "home") for at in starts]
         self.refusals = 0
         """How many requests were refused (each one a wait of one telemetry period)."""
+        self.wanted: dict[int, Claim] = {}
+        """Vehicle → the claim it was last refused and still waits for."""
 
     def blocker(self, vehicle: int, claim: Claim) -> int | None:
         """The first other vehicle whose claim is nearer ``claim`` than the separation (with
@@ -99,9 +101,21 @@ class Airspace:
         other vehicle's; False, and nothing changes, if not."""
         if self.blocker(vehicle, claim) is not None:
             self.refusals += 1
+            self.wanted[vehicle] = claim
             return False
         self.held[vehicle] = claim
+        self.wanted.pop(vehicle, None)
         return True
+
+    def waits_for(self, vehicle: int, other: int) -> bool:
+        """Whether ``vehicle`` waits for a claim that ``other``'s holds up."""
+        wanted, held = self.wanted.get(vehicle), self.held[other]
+        return wanted is not None and gap_m(wanted, held) < self.needed_m(wanted, held)
+
+    def holding_up(self, vehicle: int) -> int | None:
+        """The first other vehicle waiting for a claim that ``vehicle``'s holds up, or None
+        (a vehicle that only waits may give way)."""
+        return next((o for o in sorted(self.wanted) if self.waits_for(o, vehicle)), None)
 
     def shrink(self, vehicle: int, at: EN, alt_m: float, what: str = "") -> None:
         """The vehicle arrived: it holds only the point where it is (always granted: the point
@@ -116,6 +130,7 @@ class Airspace:
     def park(self, vehicle: int, at: EN) -> None:
         """The vehicle landed and disarmed: it holds only where it stands."""
         self.held[vehicle] = Claim.parked_at(at)
+        self.wanted.pop(vehicle, None)
 
 
 def _segment_segment(a: EN, b: EN, c: EN, d: EN) -> float:

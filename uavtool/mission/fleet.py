@@ -19,6 +19,7 @@ the first vehicle's home (:attr:`FleetMember.home_en_m` is the difference).
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -255,35 +256,148 @@ class FleetMember(FlightMission):
                 return None
             return Claim(at, (x, y), tol, min(here[2], z), max(layer, here[2], z), what)
 
-        yield from self.claim(way, what)
+        here = last.pos_enu_m
+        if (
+            math.hypot(here[0] - x, here[1] - y) > tol
+            and abs(here[2] - z) > tol
+            and not airspace.request(self.index, way() or airspace.held[self.index])
+        ):
+            # The straight way, up or down across, is held: the higher way in two legs (up,
+            # then across; or across, then down), nowhere lower than the straight one.
+            first = (here[0], here[1], z) if z > here[2] else (x, y, here[2])
+            yield from self.move(first, heading_deg, what)
+            yield from self.move(pos_enu_m, heading_deg, what)
+            return
+        if (yield from self.claim(way, what, give_way=True)):
+            # It climbed out of the way of a vehicle that waited for it: from there again.
+            yield from self.move(pos_enu_m, heading_deg, what)
+            return
         yield from super().move(pos_enu_m, heading_deg, what)
         if not below:
             airspace.shrink(self.index, (x, y), z, what)
         else:  # only the way back up to its layer is still needed
             airspace.narrow(self.index, Claim.column((x, y), tol, z, max(layer, z), what))
 
-    def claim(self, claim: Claim | Callable[[], Claim | None], what: str) -> Wait[None]:
+    def claim(
+        self,
+        claim: Claim | Callable[[], Claim | None],
+        what: str,
+        *,
+        give_way: bool = False,
+    ) -> Wait[bool]:
         """Wait (hovering where it is, or flying on to its last target) until the airspace
         grants ``claim`` (or the claim ``claim()`` makes each time it asks, from where the
-        vehicle then is; None: nothing to ask for); ABORTED after ``claim_wait_s``."""
+        vehicle then is; None: nothing to ask for); ABORTED after ``claim_wait_s``. With
+        ``give_way``, when the vehicle holding it up waits in turn for this one and goes
+        first (the lower index), this one climbs out of its way instead (:meth:`give_way`)
+        and True says the claim was not granted: the caller asks again from there."""
         airspace = self.crew.airspace
         make = claim if callable(claim) else lambda: claim
+        got = False
 
         def granted(_t: Telemetry | None = None) -> bool:
+            nonlocal got
             wanted = make()
-            return wanted is None or airspace.request(self.index, wanted)
+            got = wanted is None or airspace.request(self.index, wanted)
+            return got
+
+        def deadlock() -> int | None:
+            """A vehicle with a lower index that waits for this one while this one waits
+            for it."""
+            return next(
+                (
+                    o
+                    for o in range(self.index)
+                    if airspace.waits_for(self.index, o) and airspace.waits_for(o, self.index)
+                ),
+                None,
+            )
 
         if granted():
-            return
+            return False
         self.event(
             Level.INFO, f"{what}: waiting for vehicle {self._blocker(make)} to clear the way"
         )
         wait_s = self.crew.fleet.claim_wait_s
-        if not (yield from self.wait_until(granted, wait_s)):
-            raise self.end(
-                Status.ABORTED,
-                f"{what}: vehicle {self._blocker(make)} held the way for {wait_s:g} s",
-            )
+        t0 = self.now_ms()
+        yielding = [give_way]  # until it tried once and could not
+
+        def settled(t: Telemetry) -> bool:
+            return granted(t) or (yielding[0] and deadlock() is not None)
+
+        while True:
+            left_s = wait_s - (self.now_ms() - t0) / 1000.0
+            yield from self.wait_until(settled, max(left_s, 0.0))
+            if got:
+                return False
+            other = deadlock() if yielding[0] else None
+            if other is not None and (yield from self.give_way(other)):
+                return True
+            if self.now_ms() - t0 >= wait_s * 1000.0:
+                raise self.end(
+                    Status.ABORTED,
+                    f"{what}: vehicle {self._blocker(make)} held the way for {wait_s:g} s",
+                )
+            if other is not None:  # it could not climb: no more giving way
+                yielding[0] = False
+
+    def wait_giving_way(self, until: Callable[[], bool], timeout_s: float) -> Wait[bool]:
+        """Wait, hovering, until ``until()`` (False after ``timeout_s``); a vehicle that waits
+        meanwhile for airspace this one holds is let through: this one climbs out of its way
+        (:meth:`give_way`), each time it can."""
+        airspace = self.crew.airspace
+        t0 = self.now_ms()
+        can = [True]
+
+        def settled(_t: Telemetry) -> bool:
+            return until() or (can[0] and airspace.holding_up(self.index) is not None)
+
+        while not until():
+            left_s = timeout_s - (self.now_ms() - t0) / 1000.0
+            if left_s <= 0.0:
+                return False
+            yield from self.wait_until(settled, left_s)
+            other = airspace.holding_up(self.index)
+            if not until() and other is not None and can[0]:
+                can[0] = yield from self.give_way(other)
+        return True
+
+    def give_way(self, other: int) -> Wait[bool]:
+        """Out of the way of vehicle ``other``'s wanted claim by the separation (with both
+        margins): straight up over it where it is, or else aside, across at its altitude,
+        where the mission says the way is clear (:meth:`clear_aside`). False, without
+        moving, when it stands on the ground, ``other`` wants nothing, or neither way is
+        granted."""
+        last = self.last
+        airspace = self.crew.airspace
+        wanted = airspace.wanted.get(other)
+        if last is None or last.landed or wanted is None:
+            return False
+        x, y, z = last.pos_enu_m
+        tol = self.flight.arrive_radius_m
+        gap = airspace.needed_m(Claim.point((x, y), z), wanted) + tol
+        what = f"giving way to vehicle {other + 1}"
+        top = wanted.high_m + gap
+        up = Claim.column((x, y), tol, z, top, what)
+        if top > z and airspace.request(self.index, up):
+            self.event(Level.INFO, f"{what}: up to {top:.1f} m")
+            yield from FlightMission.move(self, (x, y, top), None, what)
+            airspace.shrink(self.index, (x, y), top, what)
+            return True
+        aside = _aside((x, y), wanted, wanted.radius_m + gap, self.home_en_m)
+        lane = Claim((x, y), aside, tol, z, z, what)
+        if not self.clear_aside((x, y), aside, z) or not airspace.request(self.index, lane):
+            return False
+        self.event(Level.INFO, f"{what}: aside to ({aside[0]:.1f}, {aside[1]:.1f})")
+        yield from FlightMission.move(self, (*aside, z), None, what)
+        airspace.shrink(self.index, aside, z, what)
+        return True
+
+    def clear_aside(self, a: EN, b: EN, alt_m: float) -> bool:  # noqa: ARG002
+        """Whether the straight way from ``a`` to ``b`` at ``alt_m`` is clear of everything
+        the mission knows stands there (a mission that knows its world says; by default
+        no member moves aside, only up)."""
+        return False
 
     def _blocker(self, make: Callable[[], Claim | None]) -> str:
         wanted = make()
@@ -306,6 +420,28 @@ class FleetMember(FlightMission):
             # Landed and disarmed: it holds only where it stands.
             self.crew.airspace.park(self.index, self.last.pos_enu_m[:2])
         return super().outcome_for(status, reason)
+
+
+def _aside(at: EN, claim: Claim, distance_m: float, home: EN) -> EN:
+    """The point ``distance_m`` from ``claim``'s segment, straight away from it through
+    ``at`` (towards ``home`` when ``at`` lies on it)."""
+    (ax, ay), (bx, by) = claim.a, claim.b
+    dx, dy = bx - ax, by - ay
+    length2 = dx * dx + dy * dy
+    t = (
+        0.0
+        if length2 == 0.0
+        else max(0.0, min(1.0, ((at[0] - ax) * dx + (at[1] - ay) * dy) / length2))
+    )
+    px, py = ax + t * dx, ay + t * dy
+    ux, uy = at[0] - px, at[1] - py
+    norm = math.hypot(ux, uy)
+    if norm < 1e-6:
+        ux, uy = home[0] - px, home[1] - py
+        norm = math.hypot(ux, uy)
+        if norm < 1e-6:
+            ux, uy, norm = 1.0, 0.0, 1.0
+    return (px + ux / norm * distance_m, py + uy / norm * distance_m)
 
 
 def _sysid(index: int | None) -> str:
