@@ -161,6 +161,46 @@ def test_a_viewpoint_where_another_vehicle_stands_is_planned_again() -> None:
     assert s.closest_approach_m >= 5.0
 
 
+def _wide_fleet(seed: int) -> tuple[FleetSummary, list[tuple[int, str]]]:
+    """Scene ``seed`` of the fleet benchmark, flown by three vehicles."""
+    scene = generate_hard_scene(
+        seed=seed, options=HardOptions(spread_m=75.0, min_buildings=6, max_buildings=9)
+    )
+    params = with_overrides(FleetSearchParams(), {"mission.search_radius_m": 80.0})
+    said: list[tuple[int, str]] = []
+    s = fly_fleet(
+        FlyConfig(scene=scene, params=params, no_record=True, seed=seed, offset_line=None,
+                  mission="fleet-search", vehicles=3),
+        progress=lambda sysid, text, _t: said.append((sysid, text)),
+    )  # fmt: skip
+    return s, said
+
+
+def test_two_vehicles_each_in_the_others_way_do_not_wait_for_ever() -> None:
+    """Scene 61060: the helpers leave for their first looks on layers 5 m apart, each one's
+    way across the other's home, where the other climbs: each waited for the other until
+    both aborted. The one that goes second (the higher index) climbs out of the first's way,
+    and the fleet models the target."""
+    s, said = _wide_fleet(61060)
+    assert s.status is Status.COMPLETED and "model built" in s.reason, s.reason
+    assert any(v == 3 and t.startswith("giving way to vehicle 2: up to ") for v, t in said)
+    assert not any("held the way" in t for _, t in said)
+    assert s.closest_approach_m >= 5.0
+
+
+def test_a_vehicle_that_cannot_climb_out_of_the_way_gives_way_aside() -> None:
+    """Scene 61036: two points of interest 2 m apart; a helper measuring one roof low is in
+    the way of the other coming down to look, which waits right above it, so it cannot climb:
+    it moves aside, across at its altitude over ground it knows is clear. (Both used to wait
+    until one aborted and the leader's battery failed over: pilot-takeover.) The target is
+    not found, as one vehicle does not find it: an honest no-match."""
+    s, said = _wide_fleet(61036)
+    assert s.status is Status.NO_MATCH, s.reason
+    assert any(v == 3 and t.startswith("giving way to vehicle 2: aside to ") for v, t in said)
+    assert not any("held the way" in t for _, t in said)
+    assert s.closest_approach_m >= 5.0
+
+
 def test_homes_closer_than_the_claims_take_off_one_after_another() -> None:
     # 8.5 m apart: more than the separation, less than two take-off columns with their
     # margins (5 + 2 × 1.5 + 2 × 0.6 m), so the second waits for the first to reach its layer.
@@ -276,6 +316,18 @@ def test_a_fleet_finds_and_models_the_target_apart(
     assert any(": looking at it for vehicle 1" in line for line in said if line[0] in "23")
     modeller = [v for v in s.vehicles if v.outcome.reason == "model built for vehicle 1"]
     assert len(modeller) == 1 and modeller[0].sysid in (2, 3)
+    # The other helper took one of the side photos at the same time, and handed it over
+    # before the model was built from it.
+    side = [v for v in s.vehicles if v.outcome.reason == "took a side photo for the model"]
+    assert len(side) == 1 and {side[0].sysid, modeller[0].sysid} == {2, 3}
+    m, h = modeller[0].sysid, side[0].sysid
+    handed = [line for line in said if line.startswith(f"{m}: vehicle {h} takes the ")]
+    assert len(handed) == 1, said
+    name = handed[0].split(" takes the ")[1].split()[0]
+    assert name in ("front", "right")
+    assert not any("brought no photo" in line for line in said)
+    landing = said.index(next(x for x in said if x.startswith("1: landing")))
+    assert said.index(handed[0]) < landing  # the leader stays up until the photo is in
     assert s.vehicles[0].outcome.reason == "model built" and s.vehicles[0].outcome.model_built
     assert not any(v.outcome.status is Status.CRASHED for v in s.vehicles)
 

@@ -195,6 +195,12 @@ class FlightMission:
     def done(self) -> bool:
         return self.outcome is not None
 
+    @property
+    def working(self) -> bool:
+        """Whether :meth:`fly` still runs: the mission has not ended, nor begun its way
+        home."""
+        return self._in_fly
+
     def _take(self) -> list[Output]:
         out, self._out = self._out, []
         return out

@@ -8,9 +8,11 @@ then takes the next point of its visiting order that no one has. A helper flies 
 looks at it as the leader would (:func:`~uavtool.mission.search.inspect`: the same looks,
 closer looks and looks again) and gives the leader its looks. The leader judges every point in
 the visiting order, from the helpers' looks (its own when no helper is left), with the
-search's own logic: the same match, rivals and refusals. Once it has decided, the helpers
-not needed are called off (they fly home and land); the helper at the target photographs it
-from three sides and builds the model while the leader lands.
+search's own logic: the same match, rivals and refusals. Once it has decided, the helper at
+the target photographs it from above and plans the side photos; the helper still flying nearest
+to the target takes one side photo meanwhile (:meth:`FleetSearchMission.side_elsewhere`), the
+modeller the other, and builds the model; the other helpers are called off (they fly home and
+land), and the leader lands once the side photo handed over is in.
 
 Each member crosses at a transit altitude of its own (the leader's, one layer step higher per
 helper) and claims every move's airspace (:class:`~uavtool.mission.fleet.FleetMember`), so the
@@ -19,6 +21,7 @@ vehicles never come closer than ``fleet.separation_m``.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, ClassVar
@@ -38,12 +41,18 @@ from uavtool.mission.search import (
     inspect,
     measure_from_another_altitude,
 )
+from uavtool.mission.sides import HandedSide, side_view
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from uavtool.mission.base import Wait
     from uavtool.mission.outputs import PointOfInterest
+    from uavtool.mission.sides import SidePlan
     from uavtool.mission.survey import Survey
+    from uavtool.nav import Viewpoint
     from uavtool.vision import Shape
+    from uavtool.vision.model3d import View
 
 
 STANDBY_M = 10.0
@@ -96,6 +105,14 @@ class SearchCrew(Crew):
         """Point of interest → the roof height its helper measured after a match."""
         self.model_done = False
         """The modeller has photographed the target and tried to build the model."""
+        self.side_helper: int | None = None
+        """The helper that takes one side photo for the modeller, at once (the nearest to
+        the target of those still flying)."""
+        self.side_job: tuple[SidePlan, Viewpoint, tuple[int, int, int]] | None = None
+        """The side photo the modeller hands over: its plan, viewpoint and the roof's colour."""
+        self.side_result: tuple[View, Viewpoint] | None = None
+        self.side_done = False
+        """The side helper has taken its photo, or failed to."""
 
     def next_task(self, helper: int) -> int | None:
         """The first point of interest still to judge that no one has, now ``helper``'s."""
@@ -107,7 +124,7 @@ class SearchCrew(Crew):
         return None
 
     def call_off(self, index: int) -> str | None:
-        if index > 0 and self.decided and index != self.modeller:
+        if index > 0 and self.decided and index not in (self.modeller, self.side_helper):
             return "the first vehicle's search has decided"
         return None
 
@@ -208,7 +225,57 @@ class FleetSearchMission(FleetMember, SearchMission):
             helper = crew.looked_by.get(found.poi.index)
             if helper is not None and not crew.members[helper].done:
                 crew.modeller = helper
+                crew.side_helper = self._side_helper(found)
         crew.decided = True
+
+    def _side_helper(self, found: Found) -> int | None:
+        """The helper, still flying, nearest to the target that is not the modeller: it takes
+        one side photo while the modeller takes the other."""
+        crew = self.crew
+        x, y = found.poi.pos_en_m
+        free = [
+            i for i, member in enumerate(crew.members) if 0 < i != crew.modeller and member.working
+        ]
+        return min(free, key=lambda i: (_distance(crew.members[i], x, y), i), default=None)
+
+    def side_elsewhere(
+        self,
+        plan: SidePlan,
+        viewpoints: tuple[Viewpoint, ...],
+        colour_rgb: tuple[int, int, int],
+    ) -> HandedSide | None:
+        crew = self.crew
+        h = crew.side_helper
+        if h is None or h == self.index or not crew.members[h].working or len(viewpoints) < 2:
+            return None
+        helper = crew.members[h]
+        # the helper takes the viewpoint nearer to it; this vehicle, over the target, the other
+        vp = min(viewpoints, key=lambda v: _distance(helper, v.pos_enu_m[0], v.pos_enu_m[1]))
+        # Its own copy of the plan: it crosses on its own layer and learns on its own way.
+        crew.side_job = (
+            dataclasses.replace(
+                plan,
+                obstacles=list(plan.obstacles),
+                cautious=list(plan.cautious),
+                unknown=list(plan.unknown),
+                heights=list(plan.heights),
+            ),
+            vp,
+            colour_rgb,
+        )
+        self.event(Level.INFO, f"vehicle {h + 1} takes the {vp.name} photo meanwhile")
+
+        def collect() -> Wait[tuple[View, Viewpoint] | None]:
+            yield from self.wait_until(
+                lambda _t: crew.side_done or helper.done, self.flight.land_timeout_s * 10
+            )
+            got = crew.side_result
+            if got is not None and crew.side_job is not None and crew.side_job[0].grown:
+                # its photo showed the building taller: planned for that from now on
+                plan.taller(self, crew.side_job[0].params.assumed_height_m)
+            return got
+
+        return HandedSide(vp.name, collect)
 
     def standing_vehicles(self) -> list[tuple[tuple[tuple[float, float], ...], float]]:
         """The other members' homes, where each stands before it flies and lands when it is
@@ -233,6 +300,14 @@ class FleetSearchMission(FleetMember, SearchMission):
         self.event(Level.INFO, f"vehicle {h + 1}, at the target, photographs it and models it")
         crew.model_job = (found, seen)
         helper = crew.members[h]
+        s = crew.side_helper
+        if s is not None:
+            # Up above every layer until the side photo handed over is in: its landing's
+            # column would hold that vehicle's way, which may cross home.
+            side = crew.members[s]
+            yield from self.wait_until(
+                lambda _t: crew.side_done or side.done, self.flight.land_timeout_s * 10
+            )
         # Home meanwhile: the leader's part in the air is done.
         yield from self.land_at_home(f"vehicle {h + 1} builds the model")
         yield from self.wait_until(
@@ -338,10 +413,19 @@ class FleetSearchMission(FleetMember, SearchMission):
                     crew.measured[k] = yield from measure_from_another_altitude(
                         self, k, poi, look, shape
                     )
-        if self.candidates and not crew.decided:
-            # It found a match: the leader may choose it to photograph the target.
-            self.event(Level.INFO, "waiting over its last look for the leader's decision")
-            yield from self.wait_until(lambda _t: crew.decided, self.flight.land_timeout_s * 10)
+        if not crew.decided:
+            if self.candidates:
+                # It found a match: the leader may choose it to photograph the target.
+                self.event(Level.INFO, "waiting over its last look for the leader's decision")
+                yield from self.wait_giving_way(
+                    lambda: crew.decided, self.flight.land_timeout_s * 10
+                )
+            else:
+                # Another may find it: this one may take a side photo of it meanwhile.
+                yield from self._wait_aside(lambda: crew.decided, "the leader's decision")
+        if crew.decided and crew.side_helper == self.index:
+            yield from self._side_photo()
+            return "took a side photo for the model"
         if crew.decided and crew.modeller == self.index:
             yield from self.wait_until(lambda _t: crew.model_job is not None, 1e9)
             assert crew.model_job is not None
@@ -356,6 +440,52 @@ class FleetSearchMission(FleetMember, SearchMission):
             return "model built for vehicle 1"
         points = "point" if self.inspected == 1 else "points"
         return f"looked at {self.inspected} {points} of interest for vehicle 1"
+
+    def _side_photo(self) -> Wait[None]:
+        """The side photo the modeller hands over, once it does (nothing when it never
+        does: its top photo showed no building, or it planned no such viewpoint)."""
+        crew = self.crew
+        modeller = crew.members[crew.modeller] if crew.modeller is not None else None
+        try:
+            yield from self._wait_aside(
+                lambda: (
+                    crew.side_job is not None
+                    or crew.model_done
+                    or modeller is None
+                    or modeller.done
+                ),
+                "the side photo",
+            )
+            job = crew.side_job
+            if job is None or crew.model_done:
+                return
+            plan, vp, colour = job
+            plan.transit_m = max(plan.transit_m, self.layer_m())
+            # handed over from where the photo was taken, before climbing back
+            crew.side_result = yield from side_view(self, plan, vp, colour, climb=False)
+            crew.side_done = True
+            if crew.side_result is not None:
+                x, y, _ = crew.side_result[1].pos_enu_m
+                yield from self.move(
+                    (x, y, plan.transit_m), None, f"climb from the {vp.name} viewpoint"
+                )
+        finally:
+            crew.side_done = True
+
+    def clear_aside(self, a: tuple[float, float], b: tuple[float, float], alt_m: float) -> bool:
+        """Over ground a photo from above saw, and above every roof near the way by the
+        margin (of unknown height too)."""
+        return self._seen_way(a, b) and self.floor_along(a, b) <= alt_m
+
+    def _wait_aside(self, until: Callable[[], bool], what: str) -> Wait[None]:
+        """Wait for ``what`` on this member's layer, in no other's way down to a look or a
+        viewpoint (and out of the way of any that still waits for it)."""
+        last = self.last
+        layer = self.layer_m()
+        if last is not None and last.pos_enu_m[2] < layer - self.flight.arrive_radius_m:
+            x, y, _ = last.pos_enu_m
+            yield from self.move((x, y, layer), None, f"up to its layer, waiting for {what}")
+        yield from self.wait_giving_way(until, self.flight.land_timeout_s * 10)
 
     def _standby_m(self) -> float:
         """Where a helper waits over home for the leader's survey: low, under every

@@ -41,7 +41,9 @@ if TYPE_CHECKING:
     from uavtool.mission.observations import Photo
     from uavtool.mission.outputs import PointOfInterest
     from uavtool.mission.search import Found, Inspector, Look
+    from uavtool.mission.sides import HandedSide, SidePlan
     from uavtool.mission.survey import Survey
+    from uavtool.nav import Viewpoint
     from uavtool.vision import Shape
 
 
@@ -147,6 +149,18 @@ class SearchMission(FlightMission):
         clear of (each a footprint and a height, as a building's): none for one vehicle (a
         fleet's member: the others' homes)."""
         return []
+
+    def side_elsewhere(
+        self,
+        plan: SidePlan,
+        viewpoints: tuple[Viewpoint, ...],
+        colour_rgb: tuple[int, int, int],
+    ) -> HandedSide | None:
+        """Hand one of the side photos planned (``viewpoints``) to another vehicle, which
+        takes it while this one takes the other; None when no other vehicle takes one (one
+        vehicle takes both; a fleet's member hands one to a helper still flying)."""
+        del plan, viewpoints, colour_rgb
+        return None
 
     def model_target(self, found: Found, seen: Survey, transit_m: float) -> Wait[None]:
         """Photograph the target from three sides and build its model (a fleet's leader

@@ -216,7 +216,32 @@ def photograph_and_model(
     views: dict[str, View] = {}
     taken: dict[str, Viewpoint] = {}
     planned = {"front": front, "right": right}
-    for name in ("front", "right"):
+    # Another vehicle (a fleet's) may take one side photo while this one takes the other.
+    handed = m.side_elsewhere(
+        sides, tuple(v for v in (front, right) if isinstance(v, Viewpoint)), obj.colour_rgb
+    )
+    names: tuple[str, ...] = ("front", "right")
+    if handed is not None:
+        theirs = handed.name
+        names = tuple(sorted(names, key=lambda n: n == theirs))  # its own first
+    for name in names:
+        if handed is not None and name == handed.name:
+            got = yield from handed.collect()
+            if got is not None:
+                views[name], taken[name] = got
+                continue
+            m.event(Level.INFO, f"{name} viewpoint: the other vehicle brought no photo: taking it")
+            handed = None
+        elif handed is not None:
+            # its own photo first, then it waits there for the other's: the model is built
+            # where the last photo was taken (any way on, home or the diagonal photo's,
+            # climbs first)
+            vp = planned[name]
+            if isinstance(vp, Viewpoint):
+                got = yield from side_view(m, sides, vp, obj.colour_rgb, climb=False)
+                if got is not None:
+                    views[name], taken[name] = got
+                    continue
         for _ in range(p.max_looks):
             vp = planned[name]
             if isinstance(vp, ViewpointFailure):

@@ -39,6 +39,8 @@ from uavtool.vision.model3d import View, same_colour
 from uavtool.vision.shapes import EDGE_PX, cut_edges
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from uavtool.mission.base import Wait
     from uavtool.mission.mission import SearchMission
 
@@ -108,6 +110,16 @@ class SidePlan:
         return found
 
 
+@dataclass(frozen=True, slots=True)
+class HandedSide:
+    """A side photo another vehicle takes meanwhile: its ``name`` (front, right) and a way
+    to wait for it (``collect``: its view and the viewpoint it was taken from, or None when
+    it brought none)."""
+
+    name: str
+    collect: Callable[[], Wait[tuple[View, Viewpoint] | None]]
+
+
 def _for_height(m: SearchMission, plan: SidePlan, height_m: float) -> ViewpointParams:
     return for_building(plan.params, height_m, least_alt_m=m.params.viewpoints.camera_alt_m)
 
@@ -130,12 +142,14 @@ def side_view(
     colour_rgb: tuple[int, int, int],
     *,
     fresh: bool = False,
+    climb: bool = True,
 ) -> Wait[tuple[View, Viewpoint] | None]:
     """A side photo from ``vp`` — planned again first if the building proved taller since,
     unless ``fresh`` (planned with the plan's parameters as they are) — and the viewpoint it
-    was finally taken from (see the module doc for the photos taken again). None when ``vp``
-    lies beyond the ground the overview saw and a look down from the ceiling shows a
-    building may stand within the margin of it."""
+    was finally taken from (see the module doc for the photos taken again), climbed back to
+    the plan's transit altitude unless not ``climb`` (the caller climbs). None when ``vp`` lies
+    beyond the ground the overview saw and a look down from the ceiling shows a building may
+    stand within the margin of it."""
     p = m.params.mission
     if not fresh:
         vp = plan.again(m, vp)
@@ -184,7 +198,10 @@ def side_view(
         vp = moved
         x, y, z = vp.pos_enu_m
         yield from m.travel((x, y, z), vp.heading_deg, plan.transit_m, f"{vp.name} viewpoint")
-    yield from m.move((x, y, plan.transit_m), vp.heading_deg, f"climb from the {vp.name} viewpoint")
+    if climb:  # else the caller climbs, from where the photo was taken
+        yield from m.move(
+            (x, y, plan.transit_m), vp.heading_deg, f"climb from the {vp.name} viewpoint"
+        )
     footprints, heights = plan.sight()
     hidden = heights is not None and foot_hidden(
         photo.pose.pos_enu_m, plan.rect.corners(), footprints, heights
