@@ -12,7 +12,8 @@ search's own logic: the same match, rivals and refusals. Once it has decided, th
 the target photographs it from above and plans the side photos; the helper still flying nearest
 to the target takes one side photo meanwhile (:meth:`FleetSearchMission.side_elsewhere`), the
 modeller the other, and builds the model; the other helpers are called off (they fly home and
-land), and the leader lands once the side photo handed over is in.
+land), and the leader lands once the side photos are handed out (once the one handed over is
+in, when its landing would hold either vehicle's way to its side photo).
 
 Each member crosses at a transit altitude of its own (the leader's, one layer step higher per
 helper) and claims every move's airspace (:class:`~uavtool.mission.fleet.FleetMember`), so the
@@ -42,6 +43,7 @@ from uavtool.mission.search import (
     measure_from_another_altitude,
 )
 from uavtool.mission.sides import HandedSide, side_view
+from uavtool.nav.geometry import point_segment_distance
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -113,6 +115,9 @@ class SearchCrew(Crew):
         self.side_result: tuple[View, Viewpoint] | None = None
         self.side_done = False
         """The side helper has taken its photo, or failed to."""
+        self.side_ways: list[tuple[tuple[float, float], tuple[float, float]]] = []
+        """Where the modeller and the side helper fly for the side photos, from where each is
+        when the photo is handed over (fleet frame, metres)."""
 
     def next_task(self, helper: int) -> int | None:
         """The first point of interest still to judge that no one has, now ``helper``'s."""
@@ -264,6 +269,11 @@ class FleetSearchMission(FleetMember, SearchMission):
             colour_rgb,
         )
         self.event(Level.INFO, f"vehicle {h + 1} takes the {vp.name} photo meanwhile")
+        own = next(v for v in viewpoints if v is not vp)
+        crew.side_ways = [
+            (_where(member), (v.pos_enu_m[0], v.pos_enu_m[1]))
+            for member, v in ((self, own), (helper, vp))
+        ]
 
         def collect() -> Wait[tuple[View, Viewpoint] | None]:
             yield from self.wait_until(
@@ -302,12 +312,21 @@ class FleetSearchMission(FleetMember, SearchMission):
         helper = crew.members[h]
         s = crew.side_helper
         if s is not None:
-            # Up above every layer until the side photo handed over is in: its landing's
-            # column would hold that vehicle's way, which may cross home.
+            # Up above every layer until the side photos are handed out; and until the one
+            # handed over is in, if its landing's column would hold the way of either vehicle
+            # to its side photo.
             side = crew.members[s]
             yield from self.wait_until(
-                lambda _t: crew.side_done or side.done, self.flight.land_timeout_s * 10
+                lambda _t: crew.side_job is not None or crew.side_done or side.done,
+                self.flight.land_timeout_s * 10,
             )
+            if self._landing_in_the_way():
+                self.event(
+                    Level.INFO, f"waiting for vehicle {s + 1}'s side photo: home is on the way"
+                )
+                yield from self.wait_until(
+                    lambda _t: crew.side_done or side.done, self.flight.land_timeout_s * 10
+                )
         # Home meanwhile: the leader's part in the air is done.
         yield from self.land_at_home(f"vehicle {h + 1} builds the model")
         yield from self.wait_until(
@@ -318,6 +337,18 @@ class FleetSearchMission(FleetMember, SearchMission):
         self.viewpoints, self.no_model = helper.viewpoints, helper.no_model
         if self.model_built:
             self.event(Level.INFO, f"vehicle {h + 1} built the model")
+
+    def _landing_in_the_way(self) -> bool:
+        """Whether the column this member lands in would come nearer a way to a side photo
+        still to be taken than two claims may (the separation, both margins and both
+        widths)."""
+        crew = self.crew
+        if crew.side_done:
+            return False
+        fleet, tol = crew.fleet, self.flight.arrive_radius_m
+        near_m = fleet.separation_m + 2.0 * fleet.margin_m + 2.0 * tol
+        home = self.home_en_m
+        return any(point_segment_distance(home, a, b) < near_m for a, b in crew.side_ways)
 
     def measure_roof(
         self, k: int, poi: PointOfInterest, look: Look, shape: Shape
@@ -511,6 +542,12 @@ class FleetSearchMission(FleetMember, SearchMission):
         if self.index > 0 and status is Status.NO_MATCH:
             status = Status.COMPLETED  # a helper judges nothing: its part was the looking
         return super().outcome_for(status, reason)
+
+
+def _where(member: FleetMember) -> tuple[float, float]:
+    """Where ``member`` is (fleet frame): its last position, else its home."""
+    last = member.last
+    return (last.pos_enu_m[0], last.pos_enu_m[1]) if last is not None else member.home_en_m
 
 
 def _distance(member: FleetMember, x: float, y: float) -> float:
