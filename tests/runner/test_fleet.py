@@ -179,9 +179,20 @@ def _wide_fleet(seed: int) -> tuple[FleetSummary, list[tuple[int, str]]]:
 def test_two_vehicles_each_in_the_others_way_do_not_wait_for_ever() -> None:
     """Scene 61060: the helpers leave for their first looks on layers 5 m apart, each one's
     way across the other's home, where the other climbs: each waited for the other until
-    both aborted. The one that goes second (the higher index) climbs out of the first's way,
-    and the fleet models the target."""
+    both aborted. Vehicle 3 now flies around vehicle 2, which hovers on its way, and the
+    fleet models the target."""
     s, said = _wide_fleet(61060)
+    assert s.status is Status.COMPLETED and "model built" in s.reason, s.reason
+    assert any(v == 3 and ": around vehicle 2, by (" in t for v, t in said), said
+    assert not any("held the way" in t for _, t in said)
+    assert s.closest_approach_m >= 5.0
+
+
+def test_a_vehicle_waiting_in_anothers_way_climbs_out_of_it() -> None:
+    """Scene 61042: a helper waits over its last look (it found the target) right where the
+    other's way across goes: the other waited until it aborted. Now the waiting one climbs
+    until the other's way passes under it by the separation, and models the target."""
+    s, said = _wide_fleet(61042)
     assert s.status is Status.COMPLETED and "model built" in s.reason, s.reason
     assert any(v == 3 and t.startswith("giving way to vehicle 2: up to ") for v, t in said)
     assert not any("held the way" in t for _, t in said)

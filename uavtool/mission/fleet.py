@@ -268,6 +268,19 @@ class FleetMember(FlightMission):
             yield from self.move(first, heading_deg, what)
             yield from self.move(pos_enu_m, heading_deg, what)
             return
+        if abs(here[2] - z) <= tol and not below:
+            wanted = way()
+            if wanted is not None and not airspace.request(self.index, wanted):
+                via = self._around(wanted)
+                if via is not None:
+                    # Across, held where a vehicle hovers or lands: around it, where the
+                    # mission says the way is clear, instead of waiting.
+                    wx, wy, holder = via
+                    around = f"{what}: around vehicle {holder}"
+                    self.event(Level.INFO, f"{around}, by ({wx:.1f}, {wy:.1f})")
+                    yield from self.move((wx, wy, z), None, around)
+                    yield from self.move(pos_enu_m, heading_deg, what)
+                    return
         if (yield from self.claim(way, what, give_way=True)):
             # It climbed out of the way of a vehicle that waited for it: from there again.
             yield from self.move(pos_enu_m, heading_deg, what)
@@ -392,6 +405,39 @@ class FleetMember(FlightMission):
         yield from FlightMission.move(self, (*aside, z), None, what)
         airspace.shrink(self.index, aside, z, what)
         return True
+
+    def _around(self, lane: Claim) -> tuple[float, float, int] | None:
+        """A point to fly ``lane`` (across, at one altitude) around the vehicle whose point or
+        column holds it, both legs apart from every other claim and clear of what the
+        mission knows stands there (:meth:`clear_aside`); and which vehicle. None when the
+        holder flies a way of its own (it moves on) or no such point is found: beyond the
+        lane's end straight away from the holder, or beside the holder, either side."""
+        airspace = self.crew.airspace
+        other = airspace.blocker(self.index, lane)
+        if other is None:
+            return None
+        held = airspace.held[other]
+        if held.a != held.b:
+            return None
+        tol = self.flight.arrive_radius_m
+        z = lane.low_m
+        gap = 1.2 * (airspace.needed_m(lane, held) + held.radius_m + tol)
+        (ax, ay), (bx, by), (cx, cy) = lane.a, lane.b, held.a
+        candidates = []
+        d = math.hypot(bx - cx, by - cy)
+        if d > 1e-6:
+            candidates.append((bx + (bx - cx) / d * gap, by + (by - cy) / d * gap))
+        length = math.hypot(bx - ax, by - ay)
+        if length > 1e-6:
+            nx, ny = -(by - ay) / length, (bx - ax) / length
+            candidates += [(cx + nx * gap, cy + ny * gap), (cx - nx * gap, cy - ny * gap)]
+        for w in candidates:
+            legs = (Claim(lane.a, w, tol, z, z), Claim(w, lane.b, tol, z, z))
+            if all(airspace.blocker(self.index, leg) is None for leg in legs) and all(
+                self.clear_aside(leg.a, leg.b, z) for leg in legs
+            ):
+                return (w[0], w[1], other + 1)
+        return None
 
     def clear_aside(self, a: EN, b: EN, alt_m: float) -> bool:  # noqa: ARG002
         """Whether the straight way from ``a`` to ``b`` at ``alt_m`` is clear of everything
