@@ -30,6 +30,7 @@ from uavtool.mission.airspace import EN, Airspace, Claim
 from uavtool.mission.base import FlightMission, MissionInputs, Wait
 from uavtool.mission.observations import Observation, Photo, Telemetry
 from uavtool.mission.outputs import GoTo, Level, Outcome, Output, Status, Vec3
+from uavtool.nav.geometry import closest_on_segment
 
 
 @dataclass(frozen=True, slots=True)
@@ -471,15 +472,7 @@ class FleetMember(FlightMission):
 def _aside(at: EN, claim: Claim, distance_m: float, home: EN) -> EN:
     """The point ``distance_m`` from ``claim``'s segment, straight away from it through
     ``at`` (towards ``home`` when ``at`` lies on it)."""
-    (ax, ay), (bx, by) = claim.a, claim.b
-    dx, dy = bx - ax, by - ay
-    length2 = dx * dx + dy * dy
-    t = (
-        0.0
-        if length2 == 0.0
-        else max(0.0, min(1.0, ((at[0] - ax) * dx + (at[1] - ay) * dy) / length2))
-    )
-    px, py = ax + t * dx, ay + t * dy
+    px, py = closest_on_segment(at, claim.a, claim.b)
     ux, uy = at[0] - px, at[1] - py
     norm = math.hypot(ux, uy)
     if norm < 1e-6:

@@ -345,8 +345,7 @@ class FleetSearchMission(FleetMember, SearchMission):
         crew = self.crew
         if crew.side_done:
             return False
-        fleet, tol = crew.fleet, self.flight.arrive_radius_m
-        near_m = fleet.separation_m + 2.0 * fleet.margin_m + 2.0 * tol
+        near_m = crew.fleet.layer_step_m + 2.0 * self.flight.arrive_radius_m
         home = self.home_en_m
         return any(point_segment_distance(home, a, b) < near_m for a, b in crew.side_ways)
 
@@ -551,7 +550,5 @@ def _where(member: FleetMember) -> tuple[float, float]:
 
 
 def _distance(member: FleetMember, x: float, y: float) -> float:
-    last = member.last
-    hx, hy = member.home_en_m
-    px, py = (last.pos_enu_m[0], last.pos_enu_m[1]) if last is not None else (hx, hy)
+    px, py = _where(member)
     return math.hypot(px - x, py - y)

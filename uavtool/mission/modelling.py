@@ -220,10 +220,10 @@ def photograph_and_model(
     handed = m.side_elsewhere(
         sides, tuple(v for v in (front, right) if isinstance(v, Viewpoint)), obj.colour_rgb
     )
-    names: tuple[str, ...] = ("front", "right")
-    if handed is not None:
-        theirs = handed.name
-        names = tuple(sorted(names, key=lambda n: n == theirs))  # its own first
+    # its own photo first, the one handed over last
+    names = (
+        ("right", "front") if handed is not None and handed.name == "front" else ("front", "right")
+    )
     for name in names:
         if handed is not None and name == handed.name:
             got = yield from handed.collect()
@@ -232,16 +232,6 @@ def photograph_and_model(
                 continue
             m.event(Level.INFO, f"{name} viewpoint: the other vehicle brought no photo: taking it")
             handed = None
-        elif handed is not None:
-            # its own photo first, then it waits there for the other's: the model is built
-            # where the last photo was taken (any way on, home or the diagonal photo's,
-            # climbs first)
-            vp = planned[name]
-            if isinstance(vp, Viewpoint):
-                got = yield from side_view(m, sides, vp, obj.colour_rgb, climb=False)
-                if got is not None:
-                    views[name], taken[name] = got
-                    continue
         for _ in range(p.max_looks):
             vp = planned[name]
             if isinstance(vp, ViewpointFailure):
@@ -249,7 +239,9 @@ def photograph_and_model(
                 break
             if vp.fallback:
                 m.event(Level.INFO, f"{vp.name} viewpoint: {vp.fallback}")
-            got = yield from side_view(m, sides, vp, obj.colour_rgb)
+            # With the other photo handed over, this one waits where it took its own: the
+            # model is built there (any way on, home or the diagonal photo's, climbs first).
+            got = yield from side_view(m, sides, vp, obj.colour_rgb, climb=handed is None)
             if got is not None:
                 views[name], taken[name] = got
                 break

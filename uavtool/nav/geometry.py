@@ -63,15 +63,20 @@ def convex_hull(points: Iterable[Point]) -> list[Point]:
     return hull if len(hull) >= 2 else pts[:1]
 
 
-def point_segment_distance(p: Point, a: Point, b: Point) -> float:
-    """Distance from ``p`` to the closed segment ``a``–``b``."""
+def closest_on_segment(p: Point, a: Point, b: Point) -> Point:
+    """The point of the closed segment ``a``–``b`` nearest ``p``."""
     dx, dy = b[0] - a[0], b[1] - a[1]
     den = dx * dx + dy * dy
     if den == 0.0:
-        return dist(p, a)
+        return a
     t = ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / den
     t = min(1.0, max(0.0, t))
-    return dist(p, (a[0] + t * dx, a[1] + t * dy))
+    return (a[0] + t * dx, a[1] + t * dy)
+
+
+def point_segment_distance(p: Point, a: Point, b: Point) -> float:
+    """Distance from ``p`` to the closed segment ``a``–``b``."""
+    return dist(p, closest_on_segment(p, a, b))
 
 
 def point_in_polygon(p: Point, poly: Sequence[Point]) -> bool:
