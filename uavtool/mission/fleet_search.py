@@ -455,7 +455,11 @@ class FleetSearchMission(FleetMember, SearchMission):
                 yield from self._wait_aside(lambda: crew.decided, "the leader's decision")
         if crew.decided and crew.side_helper == self.index:
             yield from self._side_photo()
-            return "took a side photo for the model"
+            if crew.side_result is not None:
+                return "took a side photo for the model"
+            if crew.side_job is None:
+                return "was handed no side photo to take"
+            return "could not take the side photo it was handed"
         if crew.decided and crew.modeller == self.index:
             yield from self.wait_until(lambda _t: crew.model_job is not None, 1e9)
             assert crew.model_job is not None
