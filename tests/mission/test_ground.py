@@ -188,3 +188,18 @@ def test_a_building_on_a_car_park_beside_a_lawn_is_looked_at_low_enough_to_judge
     assert any("as much like the target's mirror image" in e for e in events), events
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == summary.evaluation.target_building == "b06"
+
+
+def test_a_lawn_found_on_the_ground_leaves_room_for_the_side_photos() -> None:
+    """World scene 50007: its green ground (109, 151, 78) is a shape of a building colour
+    covering the whole overview, of unknown height until the tour's photos tell it lies
+    on the ground. Kept as an obstacle of height 0 (and, cut by the frame, swept past it),
+    it stood within the safety margin of every side viewpoint: the target was found and
+    no model built ("no front photo"). Ground is no obstacle: the model is built."""
+    summary, texts = fly_data_scene("world-50007")
+    assert any(
+        "lie on the ground (parallax between the overview and the photos" in t for t in texts
+    ), texts
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == summary.evaluation.target_building == "b05"
+    assert summary.outcome.model_built

@@ -284,6 +284,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         pois=pois,
         obstacles=obstacles,
         roofless=frozenset(range(len(seen.shapes), len(shapes))),
+        on_ground=ground,
     )
 
 

@@ -60,6 +60,11 @@ class Survey:
     ground: tuple[Shape, ...] = ()
     """The shapes of a building colour in ``photo`` that the two overviews tell lie on the
     ground (lawns, roads): no buildings, not in ``shapes``."""
+    on_ground: frozenset[int] = frozenset()
+    """The indices of ``shapes`` that the photos taken later tell lie on the ground (their
+    roofs measured at 0): no building, so no obstacle and no point of interest. A lawn as
+    wide as the frame, kept as an obstacle of height 0, once left no room for any side
+    photo."""
 
     @property
     def highest_roof_m(self) -> float:
@@ -289,8 +294,8 @@ def obstacles_around(
     """The survey's footprints of every building but the target (and its other roofs), and
     of everything else that is not ground, each with its roof's height (where not measured,
     the highest it may be)."""
-    own = same_building(m, seen, target)
-    return [(f, seen.uppers_m[i]) for i, f in enumerate(seen.footprints) if i not in own] + [
+    skip = same_building(m, seen, target) | seen.on_ground
+    return [(f, seen.uppers_m[i]) for i, f in enumerate(seen.footprints) if i not in skip] + [
         (o.footprint, o.height_m) for o in seen.obstacles
     ]
 
@@ -309,8 +314,8 @@ def beyond_the_frame(seen: Survey) -> list[tuple[tuple[float, float], ...]]:
         "bottom": (k.cx_px, k.height_px - 1.0),
     }
     out = []
-    for shape, footprint in zip(seen.shapes, seen.footprints, strict=True):
-        if not shape.cut_by_border or len(footprint) < 3:
+    for i, (shape, footprint) in enumerate(zip(seen.shapes, seen.footprints, strict=True)):
+        if not shape.cut_by_border or len(footprint) < 3 or i in seen.on_ground:
             continue
         swept = list(footprint)
         for edge in cut_edges((shape,), k):
@@ -330,10 +335,10 @@ def remeasured_obstacles(
     measured again against a later nadir ``photo`` (its ``shapes``) where it shows them
     whole."""
     p = m.params.mission
-    own = same_building(m, seen, target)
+    skip = same_building(m, seen, target) | seen.on_ground
     out = [(o.footprint, o.height_m) for o in seen.obstacles]
     for i, shape in enumerate(seen.shapes):
-        if i in own:
+        if i in skip:
             continue
         footprint = seen.footprints[i]
         height = seen.uppers_m[i]
