@@ -203,3 +203,17 @@ def test_a_lawn_found_on_the_ground_leaves_room_for_the_side_photos() -> None:
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == summary.evaluation.target_building == "b05"
     assert summary.outcome.model_built
+
+
+def test_the_ground_at_the_foot_of_a_building_of_its_hue_is_ground() -> None:
+    """World scene 50246: a dark green ground (29, 83, 39) around green buildings, one of
+    them at a car park's edge, its darker wall just outside the ground's outline. That wall
+    was taken for the ground's own, so the ground, of the target's hue and as wide as the
+    frame, stayed a building of unknown height, cut by the border from every look: "could
+    not be judged", no match. The wall is joined, through shades of its paint, to its own
+    roof: it is that building's, and the ground is ground by parallax."""
+    summary, texts = fly_data_scene("world-50246")
+    assert any("lie on the ground (parallax between the overviews)" in t for t in texts), texts
+    assert not any("cut by the image border" in t for t in texts), texts
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == summary.evaluation.target_building == "b03"

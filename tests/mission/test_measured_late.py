@@ -18,11 +18,18 @@ def test_a_field_the_survey_could_not_place_is_found_on_the_ground_by_a_look() -
     """World scene 50044: a field with buildings standing on it, which no photo of the
     survey told from a building, may be a tower up to 92 m over the whole way down to a
     candidate of the target's colour (an 18 m roof drawn too small from 96.6 m): the closer
-    look was refused. The look itself tells by parallax that the field lies on the ground;
-    the closer look follows, and the target is found."""
+    look was refused. The look itself told by parallax that the field lies on the ground,
+    and the closer look followed. Since the field's walls are no longer taken from the
+    buildings of its hue standing on its edge (`uavtool.mission.ground.wall_pixels`), the
+    tour's photos tell it lies on the ground before any look (the look's own measuring
+    is kept by world 50130, below). Either way the field holds nothing up, and the target
+    is found."""
     summary, texts = fly_data_scene("world-50044")
-    assert any("measured at last: it lies on the ground" in t for t in texts), texts
-    assert any("looking again from closer" in t for t in texts), texts
+    assert any("measured at last: it lies on the ground" in t for t in texts) or any(
+        "more region(s) lie on the ground (parallax between the overview and the photos" in t
+        for t in texts
+    ), texts
+    assert not any("drawn too small to judge" in t for t in texts), texts
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == summary.evaluation.target_building == "b00"
 

@@ -42,15 +42,19 @@ def lies_on_ground(
     others: Sequence[Photo],
     *,
     one_colour: bool,
+    beside: Sequence[Shape] = (),
 ) -> bool:
     """Whether ``shape`` (in nadir ``photo``) is ground, by parallax against one of
     ``others`` (nadir photos from elsewhere): False when none can tell. With ``one_colour``
     (a region of everything that is not ground, which may join a building and a road it
-    touches), only a region of one colour may be: else what it holds besides might stand."""
+    touches), only a region of one colour may be: else what it holds besides might stand.
+    ``beside``: the roofs ``photo`` shows (its shapes); what lies inside another's outline
+    is that roof, not this region's walls (a brighter roof of a lawn's hue on its edge
+    once kept the lawn from being ground)."""
     if not others:
         return False
     least = m.params.vectorize.min_area_px
-    walls = wall_pixels(photo, shape, shape.colour_rgb)
+    walls = wall_pixels(photo, shape, shape.colour_rgb, beside)
     if _count(walls) >= m.params.vectorize.min_edge_px and not _painted(
         walls, photo, others, least, m.params.vectorize.min_edge_px
     ):
@@ -126,14 +130,20 @@ def _count(mask: npt.NDArray[np.bool_]) -> int:
 
 
 def measured_flat(
-    shape: Shape, photo: Photo, other: Photo, roof_m: float, *, least_px: float
+    shape: Shape,
+    photo: Photo,
+    other: Photo,
+    roof_m: float,
+    *,
+    least_px: float,
+    beside: Sequence[Shape] = (),
 ) -> bool:
     """Whether a roof measured ``roof_m`` above home from ``photo`` and ``other`` lies lower
     than those two photos tell from the ground there (and they tell a storey, `STOREY_M`),
     and shows no walls (`shows_walls`, at least ``least_px`` pixels of them): a lawn, a
-    painted area, measured like a roof, is ground."""
+    painted area, measured like a roof, is ground. ``beside``: as for `wall_pixels`."""
     region = outline_mask(photo.image_rgb, shape)
-    if shows_walls(photo, shape, shape.colour_rgb, least_px=least_px):
+    if _count(wall_pixels(photo, shape, shape.colour_rgb, beside)) >= least_px:
         return False
     least = least_telling_m(
         region,
@@ -158,10 +168,16 @@ def shows_walls(
 
 
 def wall_pixels(
-    photo: Photo, shape: Shape, colour_rgb: tuple[int, int, int]
+    photo: Photo,
+    shape: Shape,
+    colour_rgb: tuple[int, int, int],
+    beside: Sequence[Shape] = (),
 ) -> npt.NDArray[np.bool_]:
     """The pixels just outside ``shape``'s outer outline that show another shade of
-    ``colour_rgb`` (`shows_walls`)."""
+    ``colour_rgb`` (`shows_walls`), but for those joined, through shades of that paint, to
+    another of ``beside`` (the roofs the photo shows): that roof and its walls, not
+    ``shape``'s. A lawn at the foot of a building of its hue, or around a brighter roof of
+    its hue, was never ground so."""
     outer = np.zeros(photo.image_rgb.shape[:2], np.uint8)
     cv2.fillPoly(outer, [np.round(shape.polygon_px).astype(np.int32).reshape(-1, 1, 2)], 255)
     kernel = np.ones((2 * _WALL_BAND_PX + 1, 2 * _WALL_BAND_PX + 1), np.uint8)
@@ -169,6 +185,14 @@ def wall_pixels(
     walls: npt.NDArray[np.bool_] = (
         (band > 0) & same_paint(photo.image_rgb, colour_rgb) & (_near(photo, colour_rgb) == 0)
     )
+    others = [b for b in beside if b is not shape]
+    if others and walls.any():
+        shades = same_paint(photo.image_rgb, colour_rgb) & (_near(photo, colour_rgb) == 0)
+        _, labels = cv2.connectedComponents(shades.astype(np.uint8), connectivity=8)
+        theirs = np.zeros(int(labels.max()) + 1, bool)
+        theirs[labels[shades & _inside(photo, others)]] = True
+        theirs[0] = False
+        walls &= ~theirs[labels]
     return walls
 
 
@@ -210,6 +234,15 @@ def regions_off_ground(
         flat = cv2.bitwise_and(outline_mask(photo.image_rgb, shape), _near(photo, shape.colour_rgb))
         keep = cv2.bitwise_and(keep, cv2.bitwise_not(flat))
     return not_ground_regions(photo.image_rgb, m.params.vectorize, within=keep)
+
+
+def _inside(photo: Photo, shapes: Sequence[Shape]) -> npt.NDArray[np.bool_]:
+    """The pixels of ``photo`` inside any of ``shapes``' outer outlines."""
+    mask = np.zeros(photo.image_rgb.shape[:2], np.uint8)
+    for s in shapes:
+        cv2.fillPoly(mask, [np.round(s.polygon_px).astype(np.int32).reshape(-1, 1, 2)], 255)
+    inside: npt.NDArray[np.bool_] = mask > 0
+    return inside
 
 
 def _near(photo: Photo, rgb: tuple[int, int, int]) -> CvArray:

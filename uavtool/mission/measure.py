@@ -137,7 +137,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         i
         for i, s in enumerate(seen.shapes)
         if not (measured[i] and roofs[i] > STOREY_M)
-        and lies_on_ground(m, s, seen.photo, photos, one_colour=False)
+        and lies_on_ground(m, s, seen.photo, photos, one_colour=False, beside=seen.shapes)
     )
     for i in ground:
         roofs[i], measured[i] = 0.0, True
@@ -549,7 +549,9 @@ def measure_in_the_way(
         if not shape.cut_by_border:  # a roof measured by the edges a border left is no
             roof = measure_roof(m, shape, ov.photo, photo, against, below_m=below_m)  # floor
         if roof is None or roof <= STOREY_M:
-            flat = lies_on_ground(m, shape, ov.photo, [photo, *ov.photos], one_colour=False)
+            flat = lies_on_ground(
+                m, shape, ov.photo, [photo, *ov.photos], one_colour=False, beside=ov.shapes
+            )
             roof = 0.0 if flat else roof
         if roof is None:
             continue

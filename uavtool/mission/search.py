@@ -83,16 +83,17 @@ def photo_shapes(
     photo: Photo,
     *,
     nadir: bool = True,
-    keep: Callable[[Shape], bool] | None = None,
+    keep: Callable[[Shape, tuple[Shape, ...]], bool] | None = None,
 ) -> tuple[Shape, ...]:
     """Vectorize a photo (from above, or from the side) and emit its shapes (those ``keep``
-    keeps, if given)."""
+    keeps, if given: it is given each shape and all the photo's)."""
     if nadir:
         shapes = nadir_shapes(m.params, photo.image_rgb)
     else:
         shapes = side_shapes(m.params, photo.image_rgb)
     if keep is not None:
-        shapes = tuple(s for s in shapes if keep(s))
+        every = shapes
+        shapes = tuple(s for s in every if keep(s, every))
     m.emit(Shapes(photo.frame_index, photo.tag, shapes))
     return shapes
 

@@ -105,12 +105,12 @@ def survey(m: SearchMission) -> Wait[Survey]:
     ground: list[Shape] = []
     heights: dict[int, float | None] = {}
 
-    def building(s: Shape) -> bool:
+    def building(s: Shape, every: tuple[Shape, ...]) -> bool:
         h = heights[id(s)] = _measure(m, s, high, low, low_shapes)
         flat = h is not None and measured_flat(
-            s, high, low, h, least_px=m.params.vectorize.min_edge_px
+            s, high, low, h, least_px=m.params.vectorize.min_edge_px, beside=every
         )
-        if flat or lies_on_ground(m, s, high, (low,), one_colour=False):
+        if flat or lies_on_ground(m, s, high, (low,), one_colour=False, beside=every):
             ground.append(s)
             return False
         return True
