@@ -48,9 +48,8 @@ def lies_on_ground(
     ``others`` (nadir photos from elsewhere): False when none can tell. With ``one_colour``
     (a region of everything that is not ground, which may join a building and a road it
     touches), only a region of one colour may be: else what it holds besides might stand.
-    ``beside``: the roofs ``photo`` shows (its shapes); what lies inside another's outline
-    is that roof, not this region's walls (a brighter roof of a lawn's hue on its edge
-    once kept the lawn from being ground)."""
+    ``beside``: the roofs ``photo`` shows (its shapes), whose own roofs and walls are not
+    this region's walls (`wall_pixels`)."""
     if not others:
         return False
     least = m.params.vectorize.min_area_px
@@ -143,7 +142,7 @@ def measured_flat(
     and shows no walls (`shows_walls`, at least ``least_px`` pixels of them): a lawn, a
     painted area, measured like a roof, is ground. ``beside``: as for `wall_pixels`."""
     region = outline_mask(photo.image_rgb, shape)
-    if _count(wall_pixels(photo, shape, shape.colour_rgb, beside)) >= least_px:
+    if shows_walls(photo, shape, shape.colour_rgb, least_px=least_px, beside=beside):
         return False
     least = least_telling_m(
         region,
@@ -156,7 +155,12 @@ def measured_flat(
 
 
 def shows_walls(
-    photo: Photo, shape: Shape, colour_rgb: tuple[int, int, int], *, least_px: float
+    photo: Photo,
+    shape: Shape,
+    colour_rgb: tuple[int, int, int],
+    *,
+    least_px: float,
+    beside: Sequence[Shape] = (),
 ) -> bool:
     """Whether at least ``least_px`` pixels just outside ``shape``'s outer outline (in
     ``photo``) show another shade of its colour: a building's walls, which perspective shows
@@ -164,7 +168,7 @@ def shows_walls(
     none; a lawn beside a building of its hue seems to, and is not taken for ground. Inside
     its holes stands whatever they hold: a courtyard's walls, or a building standing on a
     lawn or a ground of its hue, whose walls are its own."""
-    return _count(wall_pixels(photo, shape, colour_rgb)) >= least_px
+    return _count(wall_pixels(photo, shape, colour_rgb, beside)) >= least_px
 
 
 def wall_pixels(
@@ -178,19 +182,16 @@ def wall_pixels(
     another of ``beside`` (the roofs the photo shows): that roof and its walls, not
     ``shape``'s. A lawn at the foot of a building of its hue, or around a brighter roof of
     its hue, was never ground so."""
-    outer = np.zeros(photo.image_rgb.shape[:2], np.uint8)
-    cv2.fillPoly(outer, [np.round(shape.polygon_px).astype(np.int32).reshape(-1, 1, 2)], 255)
+    outer = _outlines(photo, (shape,))
     kernel = np.ones((2 * _WALL_BAND_PX + 1, 2 * _WALL_BAND_PX + 1), np.uint8)
     band = cv2.subtract(cv2.dilate(outer, kernel), outer)
-    walls: npt.NDArray[np.bool_] = (
-        (band > 0) & same_paint(photo.image_rgb, colour_rgb) & (_near(photo, colour_rgb) == 0)
-    )
+    shades = same_paint(photo.image_rgb, colour_rgb) & (_near(photo, colour_rgb) == 0)
+    walls: npt.NDArray[np.bool_] = (band > 0) & shades
     others = [b for b in beside if b is not shape]
     if others and walls.any():
-        shades = same_paint(photo.image_rgb, colour_rgb) & (_near(photo, colour_rgb) == 0)
         _, labels = cv2.connectedComponents(shades.astype(np.uint8), connectivity=8)
         theirs = np.zeros(int(labels.max()) + 1, bool)
-        theirs[labels[shades & _inside(photo, others)]] = True
+        theirs[labels[shades & (_outlines(photo, others) > 0)]] = True
         theirs[0] = False
         walls &= ~theirs[labels]
     return walls
@@ -236,13 +237,12 @@ def regions_off_ground(
     return not_ground_regions(photo.image_rgb, m.params.vectorize, within=keep)
 
 
-def _inside(photo: Photo, shapes: Sequence[Shape]) -> npt.NDArray[np.bool_]:
-    """The pixels of ``photo`` inside any of ``shapes``' outer outlines."""
+def _outlines(photo: Photo, shapes: Sequence[Shape]) -> CvArray:
+    """A mask of ``photo`` (uint8), 255 inside any of ``shapes``' outer outlines."""
     mask = np.zeros(photo.image_rgb.shape[:2], np.uint8)
-    for s in shapes:
+    for s in shapes:  # one at a time: together, fillPoly would leave their overlaps out
         cv2.fillPoly(mask, [np.round(s.polygon_px).astype(np.int32).reshape(-1, 1, 2)], 255)
-    inside: npt.NDArray[np.bool_] = mask > 0
-    return inside
+    return mask
 
 
 def _near(photo: Photo, rgb: tuple[int, int, int]) -> CvArray:
