@@ -217,3 +217,14 @@ def test_the_ground_at_the_foot_of_a_building_of_its_hue_is_ground() -> None:
     assert not any("cut by the image border" in t for t in texts), texts
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == summary.evaluation.target_building == "b03"
+
+
+def test_a_low_roof_is_not_ground_where_a_plane_below_the_least_telling_fits_it_better() -> None:
+    """World scene 50119: the target, a small L 3.5 m tall (b03). One arm of its roof, drawn
+    as its own region, fitted the ground better than every plane from 3 m up (the lowest the
+    pair of photos told from the ground), and was taken for ground: the target was never
+    judged and the flight ended "no building matched". A plane of 2 m, too low to tell from
+    the ground by itself, fitted it better still; a region is ground only when no plane does."""
+    summary, events = fly_data_scene("world-50119")
+    assert any("target is point of interest" in e for e in events), events
+    assert summary.evaluation.matched_building == summary.evaluation.target_building == "b03"

@@ -117,7 +117,12 @@ def on_ground(
     if not fits or any(f is None for f in fits):
         return None
     tried = [(z, f) for z, f in zip(heights, fits, strict=True) if f is not None]
-    if ground[0] < min(f[0] for _, f in tried):
+    # Below the least telling height a plane moves the region by less than the photos can
+    # be sure of, so it cannot tell the region off the ground; but one that fits better
+    # than the ground does says the region is no better drawn lying on it (a low roof
+    # whose edges are few: a strip of a larger roof of its colour).
+    lower = [f for z in HEIGHTS_M if z < least if (f := misfit(z)) is not None]
+    if ground[0] < min(f[0] for _, f in tried) and all(ground[0] <= f[0] for f in lower):
         return True
     # A region as wide as the frame has little edge, and what stands on it (buildings,
     # each drawn at its own height) weighs on the average: its grain tells, at the median,
