@@ -59,6 +59,6 @@ def test_what_a_roof_measured_late_leaves_of_its_region_is_measured_too() -> Non
     ground. The look from closer then follows, and rules the mirror image out."""
     summary, texts = fly_data_scene("world-50130")
     assert sum("measured at last: it lies on the ground" in t for t in texts) == 1, texts
-    assert any("just below the threshold; its roof measured 12.0 m" in t for t in texts), texts
+    assert any("just below the threshold; its roof measured" in t for t in texts), texts
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == summary.evaluation.target_building == "b01"

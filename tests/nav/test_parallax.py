@@ -11,9 +11,10 @@ import numpy as np
 import pytest
 
 from uavtool.camera import CameraPose, Intrinsics, project
-from uavtool.nav.parallax import on_ground, plane_homography
+from uavtool.nav.parallax import PARALLAX_PX, on_ground, plane_homography, roof_by_alignment
 from uavtool.world import Block, Building, load_scene, render
 from uavtool.world.ground import GroundArea, GroundTexture, TextureKind
+from uavtool.world.scene import Lighting
 
 K = Intrinsics.from_hfov(width_px=640, height_px=480)
 LOW = CameraPose((0.0, 0.0, 45.0), 0.0, -90.0)
@@ -131,3 +132,72 @@ def test_the_ground_plane_maps_a_ground_point_to_itself() -> None:
     here = project(point, LOW, K)[0, :2]
     there = cv2.perspectiveTransform(here.reshape(1, 1, 2), hom)[0, 0]
     assert np.allclose(there, project(point, HIGH, K)[0, :2], atol=1e-6)
+
+
+AHEAD = CameraPose((8.0, 0.0, 117.0), 0.0, -90.0)
+"""A photo from beside HIGH, at its altitude: as a look from aside measures a small roof."""
+TINY = ((0.0, 0.0), (2.0, 0.0), (2.0, 2.5), (0.0, 2.5))
+
+
+def _tiny_tower(top_m: float, light: Lighting | None = None) -> tuple[np.ndarray, ...]:
+    """A green tower 2 x 2.5 m, ``top_m`` tall, among a few others, photographed from HIGH
+    and AHEAD; and its roof's pixels in HIGH's photo and in AHEAD's."""
+    ring = tuple((x + 24.0, y + 10.0) for x, y in TINY)
+    tower = Building("tiny", GREEN, (Block(ring, 0.0, top_m),))
+    others = tuple(
+        Building(f"o{i}", colour, (Block(_at(x, y), 0.0, top),))
+        for i, (x, y, top, colour) in enumerate(
+            [(-14.0, 6.0, 30.0, (200, 60, 60)), (8.0, 22.0, 8.0, (60, 60, 200))]
+        )
+    )
+    base = load_scene("paper")
+    scene = dataclasses.replace(
+        base, buildings=(tower, *others), target="tiny", lighting=light or base.lighting
+    )
+    high, ahead = render(scene, HIGH, K), render(scene, AHEAD, K)
+    roofs = []
+    for pose in (HIGH, AHEAD):
+        px = project(np.array([(x, y, top_m) for x, y in ring]), pose, K)[:, :2]
+        mask = np.zeros((K.height_px, K.width_px), np.uint8)
+        cv2.fillPoly(mask, [np.round(px).astype(np.int32)], 255)
+        roofs.append(mask)
+    return high, ahead, roofs[0], roofs[1]
+
+
+@pytest.mark.parametrize("top_m", [4.0, 12.0, 20.0, 35.0])
+def test_a_roof_drawn_too_small_to_place_is_measured_by_lining_the_photos_up(top_m: float) -> None:
+    """A roof a dozen pixels across: its outline's corners and centroid are a pixel or two
+    off, its height by them many metres. Lined up plane by plane, every pixel tells: the
+    answer errs high, never low, and by less than the height two pixels' shift between
+    the photos stands for there (a plane ``dz`` higher shifts by ``f b dz / (H - z)²``)."""
+    high, ahead, here, there = _tiny_tower(top_m)
+    for args in ((here, high, HIGH, ahead, AHEAD), (there, ahead, AHEAD, high, HIGH)):
+        region, image, pose, other, other_pose = args
+        roof = roof_by_alignment(
+            region, GREEN, image, pose, other, other_pose, K, top_m=100.0, least_px=20.0
+        )
+        assert roof is not None
+        two_px = PARALLAX_PX * (HIGH.pos_enu_m[2] - top_m) ** 2 / (K.fx_px * 8.0)
+        assert top_m <= roof < top_m + two_px
+
+
+def test_a_roof_whose_walls_share_its_shade_is_measured_on_the_safe_side() -> None:
+    """The sun 45° up in the south: the tower's south wall is drawn in its roof's very
+    shade, so the region may hold it, and a plane a little lower lines up almost as well.
+    The answer is then higher than the roof, not lower."""
+    light = Lighting(sun_azimuth_deg=180.0, sun_elevation_deg=45.0, ambient=0.5)
+    high, ahead, here, _ = _tiny_tower(20.0, light)
+    walls = cv2.dilate(here, np.ones((5, 5), np.uint8))  # the roof and what is drawn beside
+    roof = roof_by_alignment(walls, GREEN, high, HIGH, ahead, AHEAD, K, top_m=100.0, least_px=20.0)
+    assert roof is not None
+    assert roof >= 20.0
+
+
+def test_a_roof_the_other_photo_cannot_show_above_is_not_measured() -> None:
+    """Swept up to where the other photo no longer shows the region, a roof as high as the
+    sweep reaches is not told from what may stand higher still."""
+    high, ahead, here, _ = _tiny_tower(20.0)
+    assert (
+        roof_by_alignment(here, GREEN, high, HIGH, ahead, AHEAD, K, top_m=20.5, least_px=20.0)
+        is None
+    )

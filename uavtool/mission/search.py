@@ -24,6 +24,7 @@ from uavtool.mission.analysis import (
     aimed_shape,
     judge,
     nadir_shapes,
+    not_flat,
     quartile_edge_share,
     roof_between,
     same_roof_aside,
@@ -35,6 +36,7 @@ from uavtool.mission.unknown import shows_as
 from uavtool.nav import NavError, ground_point, ground_polygon
 from uavtool.nav.geometry import point_polygon_distance
 from uavtool.nav.heights import fit_altitude_m
+from uavtool.nav.parallax import roof_by_alignment
 from uavtool.vision import Shape
 from uavtool.vision.vectorize import (
     enclosed_openings,
@@ -756,6 +758,8 @@ def _closer_look(
             for seen, earlier in sorted(before, key=lambda b: -abs(b[1].pose.pos_enu_m[2] - alt))
         )
         roof = next((h for h in heights if h is not None), None)
+        if roof is None and j.too_small:
+            roof = _aligned_roof(m, shape, photo, before, index)
         # a roof no closer look could clear is no height to learn (a mismatched pair); one
         # taller than the tallest expected is believed (a tower: 25.4 m for a 25 m roof
         # was once refused, and the target never looked at from closer)
@@ -780,6 +784,54 @@ def _closer_look(
     if lower > clear:
         return None
     return (x, y, lower), roof
+
+
+def _aligned_roof(
+    m: SearchMission, shape: Shape, photo: Photo, before: list[tuple[Shape, Photo]], index: int
+) -> float | None:
+    """The highest the roof of ``shape`` (a look's candidate in ``photo``, drawn too small
+    for two outlines to place it: `roof_between`) may stand, by lining ``photo`` up with
+    an earlier photo of it (``before``: its shape there and the photo, the one from
+    furthest first) plane by plane (`roof_by_alignment`), up to the highest it may be. The
+    sweep is made both ways, each photo's drawing of it carried onto the other's: a larger
+    roof of its colour in one photo lines it up at that roof's height one way only. The
+    higher answer of the two, when both tell and neither photo shows walls inside the
+    outline standing above it (`not_flat`)."""
+    still = m.unknown.get(index)
+    alt = photo.pose.pos_enu_m[2]
+    top = min(still.upper_m if still is not None else alt, alt) - 1.0
+    least = m.params.vectorize.min_area_px
+    away = sorted(before, key=lambda b: -math.dist(b[1].pose.pos_enu_m, photo.pose.pos_enu_m))
+    for seen, earlier in away:
+        if shape.cut_by_border or seen.cut_by_border:
+            continue
+        top_here = min(top, earlier.pose.pos_enu_m[2] - 1.0)
+        ways = ((shape, photo, earlier), (seen, earlier, photo))
+        told = [
+            roof_by_alignment(
+                outline_mask(a.image_rgb, s),
+                s.colour_rgb,
+                a.image_rgb,
+                a.pose,
+                b.image_rgb,
+                b.pose,
+                a.intrinsics,
+                top_m=top_here,
+                least_px=least,
+            )
+            for s, a, b in ways
+        ]
+        if any(h is None for h in told):
+            continue
+        roof = max(h for h in told if h is not None)
+        # one plane may line up a building of tiers too, between them: as `roof_between`,
+        # nothing inside either outline may stand higher
+        if not (
+            not_flat(shape, photo, roof, earlier, seen)
+            or not_flat(seen, earlier, roof, photo, shape)
+        ):
+            return roof
+    return None
 
 
 def _step_down(m: SearchMission, look: _Look, upper_m: float) -> Vec3 | None:

@@ -72,14 +72,11 @@ def roof_from_photos(
     estimates, each weighted by the inverse of its expected variance. None when neither
     can tell."""
     a1, a2 = pose1.pos_enu_m[2], pose2.pos_enu_m[2]
-    estimates: list[tuple[float, float]] = []  # (height, variance)
     by_size = roof_height_m(area1_px=area1_px, alt1_m=a1, area2_px=area2_px, alt2_m=a2)
-    if by_size is not None:
-        s1, s2 = math.sqrt(area1_px), math.sqrt(area2_px)
-        sigma = SIZE_ERROR * s1 * s2 * abs(a2 - a1) / (s2 - s1) ** 2
-        estimates.append((by_size, sigma * sigma))
+    by_rays: float | None = None
     v1 = _run_per_descent(centroid1_px, pose1, intrinsics)
     v2 = _run_per_descent(centroid2_px, pose2, intrinsics)
+    bb = 0.0
     if v1 is not None and v2 is not None:
         (x1, y1, _), (x2, y2, _) = pose1.pos_enu_m, pose2.pos_enu_m
         ax = x1 + a1 * v1[0] - x2 - a2 * v2[0]
@@ -87,12 +84,23 @@ def roof_from_photos(
         bx, by = v1[0] - v2[0], v1[1] - v2[1]
         bb = bx * bx + by * by
         if bb > 1e-12:
-            h = (ax * bx + ay * by) / bb
-            metres_per_px = max(min(a1, a2) - h, 0.0) / intrinsics.fx_px
-            sigma = CENTROID_ERROR_PX * metres_per_px / math.sqrt(bb)
-            estimates.append((h, max(sigma * sigma, 1e-12)))
-    if not estimates:
+            by_rays = (ax * bx + ay * by) / bb
+    told = [h for h in (by_size, by_rays) if h is not None]
+    if not told:
         return None
+    # Each estimate's error grows with the roof's distance below the cameras, so both are
+    # weighed at one distance: the farther the two put it (at most the ground's). Weighed
+    # at its own, an estimate that puts the roof just below the cameras (two sizes that
+    # differ by their outlines' error alone, from two altitudes 2 cm apart) would claim an
+    # error of millimetres and outweigh the rays (world 50008: 117 m for a 20 m roof).
+    low = max(min(told), 0.0)
+    estimates: list[tuple[float, float]] = []  # (height, variance)
+    if by_size is not None:
+        sigma = SIZE_ERROR * (a1 - low) * (a2 - low) / abs(a2 - a1)
+        estimates.append((by_size, sigma * sigma))
+    if by_rays is not None:
+        sigma = CENTROID_ERROR_PX * (min(a1, a2) - low) / intrinsics.fx_px / math.sqrt(bb)
+        estimates.append((by_rays, max(sigma * sigma, 1e-12)))
     weight = sum(1.0 / var for _, var in estimates)
     h = sum(est / var for est, var in estimates) / weight
     return h if h < min(a1, a2) else None

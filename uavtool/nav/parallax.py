@@ -14,6 +14,7 @@ vertical): there, and wherever the other photo does not reach, the answer is "no
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import cv2
@@ -130,6 +131,97 @@ def on_ground(
     # (a storey and up) would misalign it: a grain standing out of the noise.
     storeys = [f[1] for z, f in tried if z >= STOREY_M]
     return bool(storeys) and ground[1] < GRAIN_RATIO * min(storeys)
+
+
+def roof_by_alignment(
+    region: CvArray,
+    colour_rgb: tuple[int, int, int],
+    image: npt.NDArray[np.uint8],
+    pose: CameraPose,
+    other: npt.NDArray[np.uint8],
+    other_pose: CameraPose,
+    intrinsics: Intrinsics,
+    *,
+    top_m: float,
+    least_px: float,
+) -> float | None:
+    """The highest the flat roof ``region`` (uint8 mask over ``image``, a photo from above at
+    ``pose``) of colour ``colour_rgb`` shows may stand (0 to ``top_m``), by the planes that
+    carry ``other`` (a photo from above at ``other_pose``) onto it: for a roof drawn too
+    small for its outline's corners and centroid to be placed to a pixel, every pixel of
+    it, and the edge around it, line up only at its own height.
+
+    A plane's misfit: how far the carried pixels differ from the region's. The planes are
+    swept from the ground up, a quarter of a pixel's shift apart, as far as ``other``
+    shows the region whole. A larger roof of the colour in ``other`` lines up with the
+    region too, at its own height: the caller sweeps both ways. The answer is the highest
+    plane whose misfit is within 1 / `GRAIN_RATIO` of the best's, or drawn within half
+    `PARALLAX_PX` of it; a wall of the roof's shade beside it lines up almost as well a
+    little lower, so the answer errs high, on the safe side. None when no plane ``other``
+    shows above the answer is told from it (drawn `PARALLAX_PX` or more away): what stands
+    higher is not ruled out."""
+    x0, y0, bw, bh = cv2.boundingRect(region)
+    if bw == 0 or bh == 0:
+        return None
+    # the region's box and a border: what lies beside it is what a wrong plane carries in
+    pad = math.ceil(2 * PARALLAX_PX)
+    x1, y1 = min(x0 + bw + pad, image.shape[1]), min(y0 + bh + pad, image.shape[0])
+    x0, y0 = max(x0 - pad, 0), max(y0 - pad, 0)
+    here = image[y0:y1, x0:x1]
+    mine = cv2.bitwise_and(_near(here, colour_rgb), region[y0:y1, x0:x1])
+    count = cv2.countNonZero(mine)
+    if count < least_px:
+        return None
+    contours, _ = cv2.findContours(region, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
+    pts = np.concatenate([c[:, 0, :] for c in contours]).astype(np.float64).reshape(-1, 1, 2)
+    ones = np.full(other.shape[:2], 255, np.uint8)
+    box = np.array([[1.0, 0.0, -x0], [0.0, 1.0, -y0], [0.0, 0.0, 1.0]])
+    size = (x1 - x0, y1 - y0)
+    try:
+        back = cv2.perspectiveTransform(
+            pts, np.linalg.inv(plane_homography(other_pose, pose, intrinsics, 0.0))
+        )
+    except (NavError, np.linalg.LinAlgError):
+        return None
+    heights: list[float] = []
+    drawn: list[npt.NDArray[np.float64]] = []  # the outline's pixels as each plane draws them
+    fits: list[float] = []
+    z = 0.0
+    while True:
+        try:
+            hom = plane_homography(other_pose, pose, intrinsics, z)
+        except NavError:
+            break
+        carried = cv2.warpPerspective(other, box @ hom, size, flags=cv2.INTER_LINEAR)
+        inside = cv2.warpPerspective(ones, box @ hom, size, flags=cv2.INTER_NEAREST)
+        if cv2.countNonZero(cv2.bitwise_and(mine, inside)) < count:
+            break  # from here up, the other photo does not show it whole
+        differ = cv2.absdiff(here, carried).astype(np.float64).sum(axis=2)
+        heights.append(z)
+        drawn.append(cv2.perspectiveTransform(back, hom).reshape(-1, 2))
+        fits.append(float(differ[mine > 0].sum()) / count)
+        if z >= top_m:
+            break
+        # the next plane draws the outline a quarter of a pixel further, at most
+        step = min(1.0, top_m - z)
+        try:
+            ahead = plane_homography(other_pose, pose, intrinsics, z + step)
+        except NavError:
+            break
+        moved = cv2.perspectiveTransform(back, ahead).reshape(-1, 2) - drawn[-1]
+        per_m = float(np.max(np.hypot(*moved.T))) / step
+        z = min(z + PARALLAX_PX / 8.0 / max(per_m, 1e-6), top_m)
+    if not fits:
+        return None
+    best = int(np.argmin(fits))
+    limit = fits[best] / GRAIN_RATIO
+
+    def apart(i: int) -> float:
+        return float(np.max(np.hypot(*(drawn[i] - drawn[best]).T)))
+
+    answer = max(i for i in range(len(fits)) if fits[i] <= limit or apart(i) < PARALLAX_PX / 2.0)
+    told = [i for i in range(answer + 1, len(fits)) if apart(i) - apart(answer) >= PARALLAX_PX]
+    return heights[answer] if told else None
 
 
 def _median(values: npt.NDArray[np.float64]) -> float:
