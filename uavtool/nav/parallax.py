@@ -198,7 +198,7 @@ def roof_by_alignment(
             break  # from here up, the other photo does not show it whole
         differ = cv2.absdiff(here, carried).astype(np.float64).sum(axis=2)
         heights.append(z)
-        drawn.append(cv2.perspectiveTransform(back, hom).reshape(-1, 2))
+        drawn.append(cv2.perspectiveTransform(back, hom).reshape(-1, 2).astype(np.float64))
         fits.append(float(differ[mine > 0].sum()) / count)
         if z >= top_m:
             break
