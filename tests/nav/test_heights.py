@@ -50,6 +50,20 @@ def test_ground_level_and_ill_conditioned_pairs() -> None:
     assert roof_height_m(area1_px=900.0, alt1_m=97.1, area2_px=1000.0, alt2_m=97.1) is None
 
 
+def _roof(seen: list[tuple[tuple[float, float], float]], poses: list[CameraPose]) -> float | None:
+    """`roof_from_photos` of one roof's (centroid, area) in each of two photos."""
+    (c1, a1), (c2, a2) = seen
+    return roof_from_photos(
+        centroid1_px=c1,
+        area1_px=a1,
+        pose1=poses[0],
+        centroid2_px=c2,
+        area2_px=a2,
+        pose2=poses[1],
+        intrinsics=K,
+    )
+
+
 def test_two_photos_from_one_altitude_give_the_height_by_triangulation_alone() -> None:
     """Two photos from one altitude tell the height by triangulation alone. (Hard scene 240
     with home turned, `--random-home`, looked at a roof from as high as the overview; sizes
@@ -62,15 +76,7 @@ def test_two_photos_from_one_altitude_give_the_height_by_triangulation_alone() -
         u = K.cx_px + K.fx_px * (20.0 - pose.pos_enu_m[0]) / (alt_m - roof_m)
         side_px = K.fx_px * side_m / (alt_m - roof_m) * (1.0 if u == K.cx_px else 0.9)
         seen.append(((u, K.cy_px), side_px**2))
-    h = roof_from_photos(
-        centroid1_px=seen[0][0],
-        area1_px=seen[0][1],
-        pose1=poses[0],
-        centroid2_px=seen[1][0],
-        area2_px=seen[1][1],
-        pose2=poses[1],
-        intrinsics=K,
-    )
+    h = _roof(seen, poses)
     assert h == pytest.approx(roof_m, abs=0.01)
 
 
@@ -90,15 +96,7 @@ def test_two_photos_centimetres_apart_in_altitude_are_weighed_at_one_distance() 
         alt_m = pose.pos_enu_m[2]
         u = K.cx_px + K.fx_px * (4.0 - pose.pos_enu_m[0]) / (alt_m - roof_m)
         seen.append(((u, K.cy_px), (K.fx_px * side_m * grain / (alt_m - roof_m)) ** 2))
-    h = roof_from_photos(
-        centroid1_px=seen[0][0],
-        area1_px=seen[0][1],
-        pose1=poses[0],
-        centroid2_px=seen[1][0],
-        area2_px=seen[1][1],
-        pose2=poses[1],
-        intrinsics=K,
-    )
+    h = _roof(seen, poses)
     assert h == pytest.approx(roof_m, abs=0.5)
 
 

@@ -797,13 +797,15 @@ def _aligned_roof(
     roof of its colour in one photo lines it up at that roof's height one way only. The
     higher answer of the two, when both tell and neither photo shows walls inside the
     outline standing above it (`not_flat`)."""
+    if shape.cut_by_border:
+        return None
     still = m.unknown.get(index)
     alt = photo.pose.pos_enu_m[2]
     top = min(still.upper_m if still is not None else alt, alt) - 1.0
     least = m.params.vectorize.min_area_px
     away = sorted(before, key=lambda b: -math.dist(b[1].pose.pos_enu_m, photo.pose.pos_enu_m))
     for seen, earlier in away:
-        if shape.cut_by_border or seen.cut_by_border:
+        if seen.cut_by_border:
             continue
         top_here = min(top, earlier.pose.pos_enu_m[2] - 1.0)
         ways = ((shape, photo, earlier), (seen, earlier, photo))

@@ -88,7 +88,7 @@ def on_ground(
     here = image[box]
     mine = cv2.bitwise_and(_near(here, colour_rgb), region[box])
     ones = np.full(other.shape[:2], 255, np.uint8)
-    shift = np.array([[1.0, 0.0, -x0], [0.0, 1.0, -y0], [0.0, 0.0, 1.0]])
+    size = (x1 - x0, y1 - y0)
 
     def misfit(z: float) -> tuple[float, float] | None:
         """How far the other photo carried as the plane z is from this one over the
@@ -96,12 +96,11 @@ def on_ground(
         surface's edges, and the grain of a textured ground, line up only at their own
         height."""
         try:
-            hom = shift @ plane_homography(other_pose, pose, intrinsics, z)
+            hom = plane_homography(other_pose, pose, intrinsics, z)
         except NavError:
             return None
-        size = (x1 - x0, y1 - y0)
-        carried = cv2.warpPerspective(other, hom, size, flags=cv2.INTER_LINEAR)
-        seen = cv2.bitwise_and(mine, cv2.warpPerspective(ones, hom, size, flags=cv2.INTER_NEAREST))
+        carried, inside = _carry(other, ones, hom, (x0, y0), size)
+        seen = cv2.bitwise_and(mine, inside)
         shown = cv2.countNonZero(seen)
         if shown < least_px:
             return None  # the other photo shows too little of it
@@ -122,8 +121,9 @@ def on_ground(
     # be sure of, so it cannot tell the region off the ground; but one that fits better
     # than the ground does says the region is no better drawn lying on it (a low roof
     # whose edges are few: a strip of a larger roof of its colour).
-    lower = [f for z in HEIGHTS_M if z < least if (f := misfit(z)) is not None]
-    if ground[0] < min(f[0] for _, f in tried) and all(ground[0] <= f[0] for f in lower):
+    if ground[0] < min(f[0] for _, f in tried) and all(
+        f is None or ground[0] <= f[0] for f in (misfit(z) for z in HEIGHTS_M if z < least)
+    ):
         return True
     # A region as wide as the frame has little edge, and what stands on it (buildings,
     # each drawn at its own height) weighs on the average: its grain tells, at the median,
@@ -175,7 +175,6 @@ def roof_by_alignment(
     contours, _ = cv2.findContours(region, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
     pts = np.concatenate([c[:, 0, :] for c in contours]).astype(np.float64).reshape(-1, 1, 2)
     ones = np.full(other.shape[:2], 255, np.uint8)
-    box = np.array([[1.0, 0.0, -x0], [0.0, 1.0, -y0], [0.0, 0.0, 1.0]])
     size = (x1 - x0, y1 - y0)
     try:
         back = cv2.perspectiveTransform(
@@ -192,8 +191,7 @@ def roof_by_alignment(
             hom = plane_homography(other_pose, pose, intrinsics, z)
         except NavError:
             break
-        carried = cv2.warpPerspective(other, box @ hom, size, flags=cv2.INTER_LINEAR)
-        inside = cv2.warpPerspective(ones, box @ hom, size, flags=cv2.INTER_NEAREST)
+        carried, inside = _carry(other, ones, hom, (x0, y0), size)
         if cv2.countNonZero(cv2.bitwise_and(mine, inside)) < count:
             break  # from here up, the other photo does not show it whole
         differ = cv2.absdiff(here, carried).astype(np.float64).sum(axis=2)
@@ -222,6 +220,21 @@ def roof_by_alignment(
     answer = max(i for i in range(len(fits)) if fits[i] <= limit or apart(i) < PARALLAX_PX / 2.0)
     told = [i for i in range(answer + 1, len(fits)) if apart(i) - apart(answer) >= PARALLAX_PX]
     return heights[answer] if told else None
+
+
+def _carry(
+    other: npt.NDArray[np.uint8],
+    ones: CvArray,
+    hom: npt.NDArray[np.float64],
+    corner: tuple[int, int],
+    size: tuple[int, int],
+) -> tuple[CvArray, CvArray]:
+    """``other`` carried by the plane homography ``hom`` into the box of ``size`` whose top
+    left pixel is ``corner``, and where it reaches there (``ones``: 255 over ``other``)."""
+    x0, y0 = corner
+    shift = np.array([[1.0, 0.0, -x0], [0.0, 1.0, -y0], [0.0, 0.0, 1.0]]) @ hom
+    carried = cv2.warpPerspective(other, shift, size, flags=cv2.INTER_LINEAR)
+    return carried, cv2.warpPerspective(ones, shift, size, flags=cv2.INTER_NEAREST)
 
 
 def _median(values: npt.NDArray[np.float64]) -> float:
