@@ -16,7 +16,8 @@ from tests.mission.scenes import fly_data_scene
 from uavtool.camera import CameraPose, Intrinsics, project
 from uavtool.mission import MissionInputs, Params, Photo, SearchMission, Status
 from uavtool.mission.analysis import nadir_shapes
-from uavtool.mission.ground import lies_on_ground, regions_off_ground
+from uavtool.mission.ground import lies_on_ground, regions_off_ground, standing_regions
+from uavtool.mission.peek import Peek
 from uavtool.mission.unknown import region_of, unexplained
 from uavtool.runner.fly import FlyConfig
 from uavtool.runner.fly import fly as fly_scene
@@ -228,3 +229,66 @@ def test_a_low_roof_is_not_ground_where_a_plane_below_the_least_telling_fits_it_
     summary, events = fly_data_scene("world-50119")
     assert any("target is point of interest" in e for e in events), events
     assert summary.evaluation.matched_building == summary.evaluation.target_building == "b03"
+
+
+def test_a_road_beyond_the_overview_is_no_building_beside_a_side_viewpoint() -> None:
+    """World scene 50016: the right viewpoint lay beyond the overview's ground, 4 m from a
+    road. The look down from the ceiling took every region not of the ground's colour for a
+    building that may stand there ("a building may stand 4.1 m from it"): no right photo,
+    no model. Parallax against the photos the flight took from the ceiling shows the road
+    lies on the ground: the photo is taken and the model built."""
+    summary, events = fly_data_scene("world-50016")
+    cleared = "right viewpoint: beyond the overview's ground; no building near it below"
+    assert cleared in events, events
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == summary.evaluation.target_building == "b01"
+
+
+def test_a_look_down_clears_a_road_but_not_a_tower_of_its_grey_beside_it() -> None:
+    """A grey road, and a 20 m tower of the road's own grey touching it: in a look down from
+    the ceiling they are one region of one colour. Parallax against photos from elsewhere
+    shows the road on the ground only where no photo tells the part stands: the tower's
+    walls and the road they join stay; a lane of its own, seen across from elsewhere, is
+    cleared. (A uniform strip seen from along its length only cannot be told: it stays.)"""
+    grey = [86, 87, 86]
+    scene = scene_from_dict(
+        {
+            "target": "red",
+            "ground": {
+                "color": [56, 93, 50],
+                "areas": [
+                    {"name": "road", "color": grey,
+                     "polygon": [[-60, -12], [60, -12], [60, -6], [-60, -6]]},
+                    {"name": "lane", "color": grey,
+                     "polygon": [[-60, 14], [60, 14], [60, 20], [-60, 20]]},
+                ],
+                "texture": {"kind": "noise", "amplitude_dn": 8.5, "scale_m": 1.1, "seed": 3},
+            },
+            "buildings": [
+                {"name": "red", "color": [210, 40, 40],
+                 "blocks": [{"footprint": [[30, 30], [40, 30], [40, 38], [30, 38]], "top_m": 8}]},
+                {"name": "tower", "color": grey,
+                 "blocks": [{"footprint": [[-4, -6], [4, -6], [4, 2], [-4, 2]], "top_m": 20}]},
+            ],
+        }
+    )  # fmt: skip
+    k = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
+
+    def photo(tag: str, x: float, y: float) -> Photo:
+        pose = CameraPose((x, y, 117.0), 0.0, -90.0)
+        return Photo(0, 0, tag, 0, pose, k, render(scene, pose, k))
+
+    look = photo("peek-1", 0.0, 0.0)
+    others = [photo("overview-2", -20.0, 45.0), photo("measure-1", 35.0, -25.0)]
+    m = SearchMission(Params(), MissionInputs(look.image_rgb))
+    before = Peek.of(look, m.params.vectorize)
+    after = Peek.of(look, m.params.vectorize, standing_regions(m, look, others))
+    assert before is not None and after is not None
+    lane, tower = (-30.0, 17.0), (0.0, -2.0)
+    assert before.clear_m(lane) == 0.0
+    assert after.clear_m(lane) > 5.0  # the lane lies on the ground
+    assert after.clear_m(tower) == 0.0  # the tower stands, and the road joining it
+    assert after.clear_m((20.0, -9.0)) == 0.0
+    unseen = standing_regions(m, look, ())  # nothing to tell by: everything stands
+    every = not_ground_regions(look.image_rgb, m.params.vectorize)
+    assert [r.area_px for r in unseen] == [r.area_px for r in every]

@@ -77,6 +77,7 @@ class _Shared:
     ceiling_m: float | None
     seen_ground: Any
     peeks: list[Any]
+    from_above: list[Any]
     unknown: dict[int, Any]
     roofs: tuple[Any, ...]
     overview: Any
@@ -200,6 +201,7 @@ class FleetSearchMission(FleetMember, SearchMission):
             self.ceiling_m,
             self.seen_ground,
             self.peeks,
+            self.from_above,
             self.unknown,
             self.roofs,
             self.overview,
@@ -417,6 +419,7 @@ class FleetSearchMission(FleetMember, SearchMission):
         self.transit_m = self.layer_m()
         self.ceiling_m, self.seen_ground = shared.ceiling_m, shared.seen_ground
         self.peeks, self.unknown, self.roofs = shared.peeks, shared.unknown, shared.roofs
+        self.from_above = shared.from_above
         self.overview = shared.overview
         self.plan = None
         seen = shared.seen

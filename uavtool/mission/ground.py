@@ -12,7 +12,7 @@ import numpy as np
 import numpy.typing as npt
 
 from uavtool.mission.observations import Photo
-from uavtool.nav.parallax import STOREY_M, least_telling_m, on_ground
+from uavtool.nav.parallax import STOREY_M, least_telling_m, on_ground, stands_out
 from uavtool.vision import Shape
 from uavtool.vision.vectorize import (
     near_colour,
@@ -43,9 +43,11 @@ def lies_on_ground(
     *,
     one_colour: bool,
     beside: Sequence[Shape] = (),
+    unanimous: bool = False,
 ) -> bool:
     """Whether ``shape`` (in nadir ``photo``) is ground, by parallax against one of
-    ``others`` (nadir photos from elsewhere): False when none can tell. With ``one_colour``
+    ``others`` (nadir photos from elsewhere): False when none can tell. With ``unanimous``,
+    also when one of them tells it stands. With ``one_colour``
     (a region of everything that is not ground, which may join a building and a road it
     touches), only a region of one colour may be: else what it holds besides might stand.
     ``beside``: the roofs ``photo`` shows (its shapes), whose own roofs and walls are not
@@ -55,7 +57,7 @@ def lies_on_ground(
     least = m.params.vectorize.min_area_px
     walls = wall_pixels(photo, shape, shape.colour_rgb, beside)
     if _count(walls) >= m.params.vectorize.min_edge_px and not _painted(
-        walls, photo, others, least, m.params.vectorize.min_edge_px
+        walls, photo, others, least, m.params.vectorize.min_edge_px, unanimous=unanimous
     ):
         return False
     region = outline_mask(photo.image_rgb, shape)
@@ -63,7 +65,7 @@ def lies_on_ground(
         other_colour = cv2.bitwise_and(region, cv2.bitwise_not(_near(photo, shape.colour_rgb)))
         if cv2.countNonZero(other_colour) >= least:
             return False
-    return _flat(region, shape.colour_rgb, photo, others, least)
+    return _flat(region, shape.colour_rgb, photo, others, least, unanimous=unanimous)
 
 
 def _flat(
@@ -72,9 +74,12 @@ def _flat(
     photo: Photo,
     others: Sequence[Photo],
     least_px: float,
+    *,
+    unanimous: bool = False,
 ) -> bool:
-    """Whether one of ``others`` tells ``region`` (of ``colour_rgb``) lies on the ground."""
-    return any(
+    """Whether one of ``others`` tells ``region`` (of ``colour_rgb``) lies on the ground
+    (and, ``unanimous``, none tells it stands)."""
+    verdicts = (
         on_ground(
             region,
             colour_rgb,
@@ -86,9 +91,12 @@ def _flat(
             top_m=other.pose.pos_enu_m[2] - 1.0,
             least_px=least_px,
         )
-        is True
         for other in others
     )
+    if not unanimous:
+        return any(v is True for v in verdicts)
+    told = {v for v in verdicts if v is not None}
+    return told == {True}
 
 
 def _painted(
@@ -97,6 +105,8 @@ def _painted(
     others: Sequence[Photo],
     least_px: float,
     few_px: float,
+    *,
+    unanimous: bool = False,
 ) -> bool:
     """Whether what looks like walls beside a region (``walls``) is ground of a shade of
     its colour: a field or a lawn. Shade by shade (the median of what is left), the pixels
@@ -118,7 +128,8 @@ def _painted(
         if not hits.any():
             return False
         joined = (hits > 0)[labels]
-        if not _flat(np.where(joined, 255, 0).astype(np.uint8), shade, photo, others, least_px):
+        joined_mask = np.where(joined, 255, 0).astype(np.uint8)
+        if not _flat(joined_mask, shade, photo, others, least_px, unanimous=unanimous):
             return False
         left &= ~joined
     return _count(left) < few_px
@@ -235,6 +246,64 @@ def regions_off_ground(
         flat = cv2.bitwise_and(outline_mask(photo.image_rgb, shape), _near(photo, shape.colour_rgb))
         keep = cv2.bitwise_and(keep, cv2.bitwise_not(flat))
     return not_ground_regions(photo.image_rgb, m.params.vectorize, within=keep)
+
+
+def standing_regions(m: SearchMission, photo: Photo, others: Sequence[Photo]) -> tuple[Shape, ...]:
+    """What is not ground in nadir ``photo`` by its colour (`not_ground_regions`), without
+    what parallax against one of ``others`` (nadir photos from elsewhere) shows lies on the
+    ground: a road or a lawn beyond the overview's frame, which a look down from the ceiling
+    once took for a building beside every place it looked at. A region of several colours
+    (a road joining a field and a building) is told colour by colour, each part of one
+    colour on its own, and only where no photo tells it, or a patch of it, stands
+    (`_clears`): what such a look clears is cleared for every way through its frame.
+    What stands, and whatever else a part's outline holds, is kept."""
+    p = m.params.vectorize
+    regions = not_ground_regions(photo.image_rgb, p)
+    if not others:
+        return regions
+    keep: CvArray = np.full(photo.image_rgb.shape[:2], 255, np.uint8)
+    cut = False
+    for region in regions:
+        if region.area_px < p.min_area_px:
+            continue
+        left = outline_mask(photo.image_rgb, region) > 0
+        for _ in range(_SHADES):
+            if _count(left) < p.min_area_px:
+                break
+            pixels = np.sort(photo.image_rgb[left], axis=0)  # (np.median imports numpy.ma)
+            r, g, b = (int(c) for c in pixels[len(pixels) // 2])
+            shade = (r, g, b)
+            part = np.where(left & (_near(photo, shade) > 0), 255, 0).astype(np.uint8)
+            for piece in not_ground_regions(photo.image_rgb, p, within=part):
+                if piece.area_px >= p.min_area_px and _clears(m, piece, photo, others):
+                    flat = cv2.bitwise_and(outline_mask(photo.image_rgb, piece), part)
+                    keep = cv2.bitwise_and(keep, cv2.bitwise_not(flat))
+                    cut = True
+            left &= part == 0
+    return not_ground_regions(photo.image_rgb, p, within=keep) if cut else regions
+
+
+def _clears(m: SearchMission, piece: Shape, photo: Photo, others: Sequence[Photo]) -> bool:
+    """Whether ``piece`` (of one colour, in nadir ``photo``) lies on the ground as a whole:
+    one of ``others`` tells it does, none tells it stands (`lies_on_ground`), and in none
+    does a patch of it stand out (`stands_out`: what stands on it, joined to it in
+    ``photo``)."""
+    if not lies_on_ground(m, piece, photo, others, one_colour=False, unanimous=True):
+        return False
+    region = outline_mask(photo.image_rgb, piece)
+    return not any(
+        stands_out(
+            region,
+            piece.colour_rgb,
+            photo.image_rgb,
+            photo.pose,
+            other.image_rgb,
+            other.pose,
+            photo.intrinsics,
+            least_px=m.params.vectorize.min_area_px,
+        )
+        for other in others
+    )
 
 
 def _outlines(photo: Photo, shapes: Sequence[Shape]) -> CvArray:

@@ -71,6 +71,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     ceiling_m = seen.photo.pose.pos_enu_m[2]
     m.ceiling_m = ceiling_m
     m.seen_ground = frame_on_plane(seen.photo.pose, seen.photo.intrinsics)
+    m.from_above = [seen.photo, *([] if seen.lower is None else [seen.lower])]
     below_m = ceiling_m - 1.0
     others = _unclassified(m, seen)  # obstacles of no building colour
     if (
@@ -110,6 +111,7 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
         yield from m.move((x, y, ceiling_m), seen.photo.pose.heading_deg, f"over {what}, measuring")
         photo = yield from m.photo(tag, -90.0)
         photos.append(photo)
+        m.from_above.append(photo)
         shapes = photo_shapes(m, photo)
         for i, shape in enumerate(seen.shapes):
             if not measured[i]:

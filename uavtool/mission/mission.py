@@ -90,6 +90,10 @@ class SearchMission(FlightMission):
         """Photos straight down from the ceiling beyond that ground
         (:func:`uavtool.mission.peek.peek`): where they show no building near a place or a
         way, it is seen free too."""
+        self.from_above: list[Photo] = []
+        """The photos straight down from the ceiling (the overviews, the tour measuring
+        roofs, the peeks): what parallax against them shows lies on the ground is no
+        building (:func:`~uavtool.mission.ground.standing_regions`)."""
         self.unknown: dict[int, Unknown] = {}
         """Where buildings of unknown height may stand, and the highest each roof may be
         there (by the overview shape's index; an obstacle's is negative): a way near one

@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from uavtool.mission.ground import standing_regions
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level
 from uavtool.mission.search import photo_shapes
@@ -27,6 +28,7 @@ from uavtool.vision.vectorize import not_ground_regions
 if TYPE_CHECKING:
     from uavtool.mission.base import Wait
     from uavtool.mission.mission import SearchMission
+    from uavtool.vision import Shape
 
 Point = tuple[float, float]
 Ring = tuple[Point, ...]
@@ -41,14 +43,20 @@ class Peek:
     buildings: tuple[Ring, ...]
 
     @classmethod
-    def of(cls, photo: Photo, params: VectorizeParams) -> Peek | None:
-        """None for a photo that is not straight down (a pixel above the horizon)."""
+    def of(
+        cls, photo: Photo, params: VectorizeParams, regions: tuple[Shape, ...] | None = None
+    ) -> Peek | None:
+        """None for a photo that is not straight down (a pixel above the horizon).
+        ``regions``: what in it is not ground (by default, everything not of the ground's
+        colour: `not_ground_regions`)."""
         k = photo.intrinsics
+        if regions is None:
+            regions = not_ground_regions(photo.image_rgb, params)
         try:
             frame = frame_on_plane(photo.pose, k)
             buildings = tuple(
                 tuple(ground_point(u, v, photo.pose, k) for u, v in region.polygon_px.tolist())
-                for region in not_ground_regions(photo.image_rgb, params)
+                for region in regions
                 if region.area_px >= params.min_area_px
             )
         except NavError:
@@ -79,7 +87,10 @@ def peek(m: SearchMission, x: float, y: float, what: str, tag: str) -> Wait[bool
     yield from m.travel((x, y, m.ceiling_m), None, m.ceiling_m, f"over the {what}, looking down")
     photo = yield from m.photo(tag, -90.0)
     photo_shapes(m, photo)  # what it shows, as for every photo (viewers, re-analysis)
-    seen = Peek.of(photo, m.params.vectorize)
+    # A road or a lawn is no building: parallax against the photos from the ceiling tells
+    regions = standing_regions(m, photo, m.from_above)
+    m.from_above.append(photo)
+    seen = Peek.of(photo, m.params.vectorize, regions)
     if seen is not None:
         m.peeks.append(seen)
     if m.over_seen_ground(x, y):

@@ -133,6 +133,43 @@ def on_ground(
     return bool(storeys) and ground[1] < GRAIN_RATIO * min(storeys)
 
 
+def stands_out(
+    region: CvArray,
+    colour_rgb: tuple[int, int, int],
+    image: npt.NDArray[np.uint8],
+    pose: CameraPose,
+    other: npt.NDArray[np.uint8],
+    other_pose: CameraPose,
+    intrinsics: Intrinsics,
+    *,
+    least_px: float,
+) -> bool:
+    """Whether a patch of at least ``least_px`` pixels of ``region`` (uint8 mask over
+    ``image``, a photo from above at ``pose``) of colour ``colour_rgb``, where ``other`` (a
+    photo from above at ``other_pose``) shows it, is drawn otherwise in ``other`` carried as
+    the ground (a channel off by more than the colour's tolerance), once slivers a pixel
+    wide along its edges are opened away. :func:`on_ground` weighs a region as a whole: a
+    tower of a road's grey, joined to the road in the photo, is a few of its pixels, and
+    the road lines up. Its patch, drawn elsewhere in the other photo (or hidden there),
+    stands out; so does ground hidden behind a building, which is no evidence either way."""
+    x0, y0, bw, bh = cv2.boundingRect(region)
+    if bw == 0 or bh == 0:
+        return False
+    try:
+        hom = plane_homography(other_pose, pose, intrinsics, 0.0)
+    except NavError:
+        return True  # the ground is not drawn: nothing is told
+    box = (slice(y0, y0 + bh), slice(x0, x0 + bw))
+    here = image[box]
+    mine = cv2.bitwise_and(_near(here, colour_rgb), region[box])
+    ones = np.full(other.shape[:2], 255, np.uint8)
+    carried, inside = _carry(other, ones, hom, (x0, y0), (bw, bh))
+    off = (cv2.absdiff(here, carried).max(axis=2) > _NEAR_DN) & (mine > 0) & (inside > 0)
+    patch = cv2.morphologyEx(off.astype(np.uint8) * 255, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
+    _, _, stats, _ = cv2.connectedComponentsWithStats(patch, connectivity=8)
+    return bool((stats[1:, cv2.CC_STAT_AREA] >= least_px).any())
+
+
 def roof_by_alignment(
     region: CvArray,
     colour_rgb: tuple[int, int, int],
