@@ -11,6 +11,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from uavtool.camera import project
 from uavtool.mission.observations import Photo
 from uavtool.nav.parallax import STOREY_M, least_telling_m, on_ground, stands_out
 from uavtool.vision import Shape
@@ -30,6 +31,9 @@ _WALL_BAND_PX = 3
 """How far around a region its walls are looked for: past its blended edge."""
 _SHADES = 4
 """How many shades of what looks like walls beside a region are told apart (`_painted`)."""
+_HIDDEN_PX = 2
+"""How far around a known building's drawing the ground is taken for hidden: the blended
+edge of its outline."""
 _NEAR_DN = 30
 """A region is one colour when all but a shape's worth of its pixels lie this close (per
 channel) to its colour: flat shading and a ground texture (`uavtool.nav.parallax`)."""
@@ -248,7 +252,12 @@ def regions_off_ground(
     return not_ground_regions(photo.image_rgb, m.params.vectorize, within=keep)
 
 
-def standing_regions(m: SearchMission, photo: Photo, others: Sequence[Photo]) -> tuple[Shape, ...]:
+def standing_regions(
+    m: SearchMission,
+    photo: Photo,
+    others: Sequence[Photo],
+    known: Sequence[tuple[Sequence[tuple[float, float]], float]] = (),
+) -> tuple[Shape, ...]:
     """What is not ground in nadir ``photo`` by its colour (`not_ground_regions`), without
     what parallax against one of ``others`` (nadir photos from elsewhere) shows lies on the
     ground: a road or a lawn beyond the overview's frame, which a look down from the ceiling
@@ -256,11 +265,15 @@ def standing_regions(m: SearchMission, photo: Photo, others: Sequence[Photo]) ->
     (a road joining a field and a building) is told colour by colour, each part of one
     colour on its own, and only where no photo tells it, or a patch of it, stands
     (`_clears`): what such a look clears is cleared for every way through its frame.
-    What stands, and whatever else a part's outline holds, is kept."""
+    What stands, and whatever else a part's outline holds, is kept. ``known``: the roofs
+    measured (footprint, height above home): the ground they hide in ``others`` tells
+    nothing, and in ``photo`` they always stand."""
     p = m.params.vectorize
     regions = not_ground_regions(photo.image_rgb, p)
     if not others:
         return regions
+    grow = np.ones((2 * _HIDDEN_PX + 1, 2 * _HIDDEN_PX + 1), np.uint8)
+    hidden = [cv2.dilate(_prisms(other, known), grow) for other in others]
     keep: CvArray = np.full(photo.image_rgb.shape[:2], 255, np.uint8)
     cut = False
     for region in regions:
@@ -275,19 +288,49 @@ def standing_regions(m: SearchMission, photo: Photo, others: Sequence[Photo]) ->
             shade = (r, g, b)
             part = np.where(left & (_near(photo, shade) > 0), 255, 0).astype(np.uint8)
             for piece in not_ground_regions(photo.image_rgb, p, within=part):
-                if piece.area_px >= p.min_area_px and _clears(m, piece, photo, others):
+                if piece.area_px >= p.min_area_px and _clears(m, piece, photo, others, hidden):
                     flat = cv2.bitwise_and(outline_mask(photo.image_rgb, piece), part)
                     keep = cv2.bitwise_and(keep, cv2.bitwise_not(flat))
                     cut = True
             left &= part == 0
-    return not_ground_regions(photo.image_rgb, p, within=keep) if cut else regions
+    if not cut:
+        return regions
+    keep = cv2.bitwise_or(keep, _prisms(photo, known))
+    return not_ground_regions(photo.image_rgb, p, within=keep)
 
 
-def _clears(m: SearchMission, piece: Shape, photo: Photo, others: Sequence[Photo]) -> bool:
+def _prisms(photo: Photo, known: Sequence[tuple[Sequence[tuple[float, float]], float]]) -> CvArray:
+    """A mask of ``photo`` (uint8), 255 where it draws one of the ``known`` buildings
+    (footprint, roof height): its roof, its base and every wall between them."""
+    mask: CvArray = np.zeros(photo.image_rgb.shape[:2], np.uint8)
+    for footprint, roof_m in known:
+        ring = list(footprint)
+        if len(ring) < 3:
+            continue
+        points = np.array([(x, y, z) for z in (0.0, roof_m) for x, y in ring])
+        uv = project(points, photo.pose, photo.intrinsics)
+        if (uv[:, 2] <= 0.0).any():
+            continue  # not below the camera: a photo from above shows it otherwise
+        px = np.round(uv[:, :2]).astype(np.int32)
+        n = len(ring)
+        faces = [px[:n], px[n:]]
+        faces += [px[[i, (i + 1) % n, n + (i + 1) % n, n + i]] for i in range(n)]
+        for face in faces:  # one at a time: together, fillPoly would leave overlaps out
+            cv2.fillPoly(mask, [face.reshape(-1, 1, 2)], 255)
+    return mask
+
+
+def _clears(
+    m: SearchMission,
+    piece: Shape,
+    photo: Photo,
+    others: Sequence[Photo],
+    hidden: Sequence[CvArray],
+) -> bool:
     """Whether ``piece`` (of one colour, in nadir ``photo``) lies on the ground as a whole:
     one of ``others`` tells it does, none tells it stands (`lies_on_ground`), and in none
     does a patch of it stand out (`stands_out`: what stands on it, joined to it in
-    ``photo``)."""
+    ``photo``) where that photo shows the ground (not ``hidden``: behind known roofs)."""
     if not lies_on_ground(m, piece, photo, others, one_colour=False, unanimous=True):
         return False
     region = outline_mask(photo.image_rgb, piece)
@@ -301,8 +344,9 @@ def _clears(m: SearchMission, piece: Shape, photo: Photo, others: Sequence[Photo
             other.pose,
             photo.intrinsics,
             least_px=m.params.vectorize.min_area_px,
+            hidden=behind,
         )
-        for other in others
+        for other, behind in zip(others, hidden, strict=True)
     )
 
 

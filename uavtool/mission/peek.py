@@ -88,7 +88,7 @@ def peek(m: SearchMission, x: float, y: float, what: str, tag: str) -> Wait[bool
     photo = yield from m.photo(tag, -90.0)
     photo_shapes(m, photo)  # what it shows, as for every photo (viewers, re-analysis)
     # A road or a lawn is no building: parallax against the photos from the ceiling tells
-    regions = standing_regions(m, photo, m.from_above)
+    regions = standing_regions(m, photo, m.from_above, m.roofs)
     m.from_above.append(photo)
     seen = Peek.of(photo, m.params.vectorize, regions)
     if seen is not None:

@@ -143,6 +143,7 @@ def stands_out(
     intrinsics: Intrinsics,
     *,
     least_px: float,
+    hidden: CvArray | None = None,
 ) -> bool:
     """Whether a patch of at least ``least_px`` pixels of ``region`` (uint8 mask over
     ``image``, a photo from above at ``pose``) of colour ``colour_rgb``, where ``other`` (a
@@ -151,7 +152,9 @@ def stands_out(
     wide along its edges are opened away. :func:`on_ground` weighs a region as a whole: a
     tower of a road's grey, joined to the road in the photo, is a few of its pixels, and
     the road lines up. Its patch, drawn elsewhere in the other photo (or hidden there),
-    stands out; so does ground hidden behind a building, which is no evidence either way."""
+    stands out; so does ground hidden behind a building, which is no evidence either way:
+    ``hidden`` (uint8 mask over ``other``) is where ``other`` shows what hides the ground
+    (buildings known to stand there), left out."""
     x0, y0, bw, bh = cv2.boundingRect(region)
     if bw == 0 or bh == 0:
         return False
@@ -162,8 +165,10 @@ def stands_out(
     box = (slice(y0, y0 + bh), slice(x0, x0 + bw))
     here = image[box]
     mine = cv2.bitwise_and(_near(here, colour_rgb), region[box])
-    ones = np.full(other.shape[:2], 255, np.uint8)
-    carried, inside = _carry(other, ones, hom, (x0, y0), (bw, bh))
+    shows: CvArray = np.full(other.shape[:2], 255, np.uint8)
+    if hidden is not None:
+        shows = cv2.bitwise_not(hidden)
+    carried, inside = _carry(other, shows, hom, (x0, y0), (bw, bh))
     off = (cv2.absdiff(here, carried).max(axis=2) > _NEAR_DN) & (mine > 0) & (inside > 0)
     patch = cv2.morphologyEx(off.astype(np.uint8) * 255, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
     _, _, stats, _ = cv2.connectedComponentsWithStats(patch, connectivity=8)
