@@ -48,10 +48,12 @@ def lies_on_ground(
     one_colour: bool,
     beside: Sequence[Shape] = (),
     unanimous: bool = False,
+    hidden: Sequence[CvArray] | None = None,
 ) -> bool:
     """Whether ``shape`` (in nadir ``photo``) is ground, by parallax against one of
     ``others`` (nadir photos from elsewhere): False when none can tell. With ``unanimous``,
-    also when one of them tells it stands. With ``one_colour``
+    also when one of them tells it stands. ``hidden``: per photo of ``others``, where it
+    shows what hides the ground (left out). With ``one_colour``
     (a region of everything that is not ground, which may join a building and a road it
     touches), only a region of one colour may be: else what it holds besides might stand.
     ``beside``: the roofs ``photo`` shows (its shapes), whose own roofs and walls are not
@@ -61,7 +63,7 @@ def lies_on_ground(
     least = m.params.vectorize.min_area_px
     walls = wall_pixels(photo, shape, shape.colour_rgb, beside)
     if _count(walls) >= m.params.vectorize.min_edge_px and not _painted(
-        walls, photo, others, least, m.params.vectorize.min_edge_px, unanimous=unanimous
+        walls, photo, others, least, m.params.vectorize.min_edge_px, unanimous, hidden
     ):
         return False
     region = outline_mask(photo.image_rgb, shape)
@@ -69,7 +71,7 @@ def lies_on_ground(
         other_colour = cv2.bitwise_and(region, cv2.bitwise_not(_near(photo, shape.colour_rgb)))
         if cv2.countNonZero(other_colour) >= least:
             return False
-    return _flat(region, shape.colour_rgb, photo, others, least, unanimous=unanimous)
+    return _flat(region, shape.colour_rgb, photo, others, least, unanimous, hidden)
 
 
 def _flat(
@@ -78,11 +80,11 @@ def _flat(
     photo: Photo,
     others: Sequence[Photo],
     least_px: float,
-    *,
     unanimous: bool = False,
+    hidden: Sequence[CvArray] | None = None,
 ) -> bool:
     """Whether one of ``others`` tells ``region`` (of ``colour_rgb``) lies on the ground
-    (and, ``unanimous``, none tells it stands)."""
+    (and, ``unanimous``, none tells it stands; ``hidden``: as for `lies_on_ground`)."""
     verdicts = (
         on_ground(
             region,
@@ -94,8 +96,9 @@ def _flat(
             photo.intrinsics,
             top_m=other.pose.pos_enu_m[2] - 1.0,
             least_px=least_px,
+            hidden=None if hidden is None else hidden[i],
         )
-        for other in others
+        for i, other in enumerate(others)
     )
     if not unanimous:
         return any(v is True for v in verdicts)
@@ -109,8 +112,8 @@ def _painted(
     others: Sequence[Photo],
     least_px: float,
     few_px: float,
-    *,
     unanimous: bool = False,
+    hidden: Sequence[CvArray] | None = None,
 ) -> bool:
     """Whether what looks like walls beside a region (``walls``) is ground of a shade of
     its colour: a field or a lawn. Shade by shade (the median of what is left), the pixels
@@ -133,7 +136,7 @@ def _painted(
             return False
         joined = (hits > 0)[labels]
         joined_mask = np.where(joined, 255, 0).astype(np.uint8)
-        if not _flat(joined_mask, shade, photo, others, least_px, unanimous=unanimous):
+        if not _flat(joined_mask, shade, photo, others, least_px, unanimous, hidden):
             return False
         left &= ~joined
     return _count(left) < few_px
@@ -331,7 +334,7 @@ def _clears(
     one of ``others`` tells it does, none tells it stands (`lies_on_ground`), and in none
     does a patch of it stand out (`stands_out`: what stands on it, joined to it in
     ``photo``) where that photo shows the ground (not ``hidden``: behind known roofs)."""
-    if not lies_on_ground(m, piece, photo, others, one_colour=False, unanimous=True):
+    if not lies_on_ground(m, piece, photo, others, one_colour=False, unanimous=True, hidden=hidden):
         return False
     region = outline_mask(photo.image_rgb, piece)
     return not any(

@@ -69,6 +69,7 @@ def on_ground(
     *,
     top_m: float,
     least_px: float,
+    hidden: CvArray | None = None,
 ) -> bool | None:
     """Whether ``region`` (uint8 mask over ``image``, a photo from above at ``pose``) of
     colour ``colour_rgb`` lies on the ground: True when ``other`` (a photo from above at
@@ -77,7 +78,8 @@ def on_ground(
     False when some height does better; None when the photos cannot tell: the region is
     near the point below the cameras, ``other`` shows less than ``least_px`` pixels of it
     carried as the ground or as any of those heights, or the photos tell it only from what
-    stands higher than a storey (`STOREY_M`)."""
+    stands higher than a storey (`STOREY_M`). ``hidden`` (uint8 mask over ``other``): where
+    ``other`` shows what hides the ground (buildings known to stand there), left out."""
     least = least_telling_m(region, pose, other_pose, intrinsics, top_m)
     if least is None or least > STOREY_M:
         return None
@@ -87,7 +89,9 @@ def on_ground(
     box = (slice(y0, y1), slice(x0, x1))
     here = image[box]
     mine = cv2.bitwise_and(_near(here, colour_rgb), region[box])
-    ones = np.full(other.shape[:2], 255, np.uint8)
+    ones: CvArray = np.full(other.shape[:2], 255, np.uint8)
+    if hidden is not None:
+        ones = cv2.bitwise_not(hidden)
     size = (x1 - x0, y1 - y0)
 
     def misfit(z: float) -> tuple[float, float] | None:
