@@ -66,11 +66,33 @@ def test_a_tower_merged_with_one_behind_it_is_cut_back_to_where_it_stands() -> N
     assert cut.polygon_px[:, 1].min() > v0 - 0.11 * max(u1 - u0, v1 - v0) - 1.0
 
 
-def test_a_viewpoint_a_look_down_shows_blocked_is_planned_again_around_what_it_showed() -> None:
-    """World scene 50293: a side viewpoint lies beyond the ground the overview saw, and
-    the look down from the ceiling shows a building 2.4 m from it. The side is planned
-    again around what that photo showed, from elsewhere, and the model is built."""
+def test_a_road_a_look_down_shows_beside_a_viewpoint_is_no_building() -> None:
+    """World scene 50293: both side viewpoints lie beyond the ground the overview saw, and
+    the looks down from the ceiling show a grey region 2.4 m from one: road1 and road3,
+    which parallax against the photos from the ceiling tells lie on the ground. (Taken for
+    buildings, they had the side planned again around them, from elsewhere.) Both photos
+    are taken where planned, and the model is built."""
     summary, events = fly_data_scene("world-50293")
-    assert any("planned again around the" in e for e in events), events
+    for side in ("front", "right"):
+        assert f"{side} viewpoint: beyond the overview's ground; no building near it below" in (
+            events
+        )
+    assert not any("planned again" in e for e in events), events
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == summary.evaluation.target_building
+
+
+def test_a_side_photo_that_does_not_show_the_building_is_taken_again_from_elsewhere() -> None:
+    """World scene 50327: the front photo showed nothing of the target's colour where the
+    target stands: a building between, inside a region of unknown height that holds the
+    target too (so no sight line was planned around it). The model was not built ("front:
+    no silhouette of the object in the photo"). No sight line along that one: the front is
+    planned again from elsewhere, and the model is built."""
+    summary, events = fly_data_scene("world-50327")
+    assert (
+        "front photo: the building does not show where it stands; something stands between"
+        in events
+    )
+    assert "front viewpoint: planned again with no sight line along that one" in events
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == summary.evaluation.target_building

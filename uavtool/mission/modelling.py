@@ -22,6 +22,7 @@ from uavtool.mission.survey import (
     same_building,
 )
 from uavtool.nav import (
+    Rect,
     Viewpoint,
     ViewpointFailure,
     ViewpointParams,
@@ -31,7 +32,7 @@ from uavtool.nav import (
     plan_viewpoints,
     top_viewpoint,
 )
-from uavtool.nav.geometry import polygons_overlap
+from uavtool.nav.geometry import point_polygon_distance, polygons_overlap
 from uavtool.nav.heights import fit_altitude_m
 from uavtool.nav.viewpoints import farther, for_building
 from uavtool.vision import Shape
@@ -242,12 +243,26 @@ def photograph_and_model(
             # With the other photo handed over, this one waits where it took its own: the
             # model is built there (any way on, home or the diagonal photo's, climbs first).
             got = yield from side_view(m, sides, vp, obj.colour_rgb, climb=handed is None)
-            if got is not None:
+            if got is not None and got[0].shapes:
                 views[name], taken[name] = got
                 break
-            # the look down from the ceiling showed a building near it: planned again
-            # around what it showed (the right photo still apart from the front's heading)
-            below = _seen_below(m, sides)
+            if got is not None:
+                # Nothing of its colour where the building stands in the photo: something no
+                # photo from above told stands between (a building of unknown height may
+                # stand anywhere in its region, the target's too). Planned again from
+                # elsewhere: no sight line along this one.
+                below = [_sight_line(vp, rect, m.params.viewpoints.safety_margin_m)]
+                m.event(
+                    Level.WARNING,
+                    f"{name} photo: the building does not show where it stands; something "
+                    "stands between",
+                )
+                why = "with no sight line along that one"
+            else:
+                # the look down from the ceiling showed a building near it: planned again
+                # around what it showed (the right photo still apart from the front's heading)
+                below = _seen_below(m, sides)
+                why = f"around the {len(below)} building(s) the look down showed"
             if not below:
                 break
             sides.obstacles += below
@@ -260,8 +275,7 @@ def photograph_and_model(
             planned = {"front": taken.get("front", again[0]), "right": again[1]}
             m.event(
                 Level.INFO,
-                f"{name} viewpoint: planned again around the {len(below)} building(s) the look "
-                "down showed",
+                f"{name} viewpoint: planned again {why}",
             )
 
     missing = [name for name in ("front", "right") if name not in views]
@@ -320,6 +334,23 @@ def _seen_below(m: SearchMission, sides: SidePlan) -> list[tuple[tuple[float, fl
         for ring in m.peeks[-1].buildings
         if len(ring) >= 3 and not polygons_overlap(ring, target) and ring not in sides.obstacles
     ]
+
+
+def _sight_line(vp: Viewpoint, rect: Rect, short_m: float) -> tuple[tuple[float, float], ...]:
+    """The ground under the line of sight from viewpoint ``vp`` to the building of ``rect``,
+    a metre wide, stopping ``short_m`` before it: where a photo showed something stand
+    between, an obstacle of unknown height that blocks every sight line across it."""
+    x, y, _ = vp.pos_enu_m
+    cx, cy = rect.center_en
+    n = math.hypot(cx - x, cy - y)
+    ux, uy = (cx - x) / n, (cy - y) / n
+    length = max(point_polygon_distance((x, y), rect.corners()) - short_m, _HALF_WIDTH_M)
+    ex, ey = x + ux * length, y + uy * length
+    wx, wy = -uy * _HALF_WIDTH_M, ux * _HALF_WIDTH_M
+    return ((x + wx, y + wy), (ex + wx, ey + wy), (ex - wx, ey - wy), (x - wx, y - wy))
+
+
+_HALF_WIDTH_M = 0.5
 
 
 def _side_params(m: SearchMission, roof_m: float) -> ViewpointParams:
