@@ -16,13 +16,14 @@ from tests.mission.scenes import on_grey_ground
 from uavtool.camera import CameraPose, Intrinsics, project
 from uavtool.mission import GoTo, MissionInputs, SearchMission, TakePhoto
 from uavtool.mission.base import Wait
+from uavtool.mission.ground import standing_regions
 from uavtool.mission.observations import Photo
 from uavtool.mission.params import Params
 from uavtool.mission.peek import Peek
 from uavtool.recording import JsonDocument, RecordingReader
 from uavtool.recording.topics import OBSERVATIONS
 from uavtool.runner.fly import FlyConfig, fly
-from uavtool.world import Scene, render
+from uavtool.world import Scene, render, scene_from_dict
 
 DATA = Path(__file__).parent / "data"
 K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
@@ -137,3 +138,55 @@ def test_travel_looks_down_before_descending_beyond_the_seen_ground(
     targets = [o.pos_enu_m for o in flight if isinstance(o, GoTo)]
     assert ((40.0, 0.0, 15.0) in targets) is descends
     assert ((40.0, 0.0, 60.0) in targets) is True
+
+
+@pytest.mark.parametrize("top_m", [3.0, 8.0, 20.0])
+@pytest.mark.parametrize(
+    "paint",
+    [
+        pytest.param((86, 87, 86), id="road-grey"),
+        pytest.param((129, 115, 53), id="field-brown"),
+        pytest.param((48, 128, 55), id="lawn-green"),
+    ],
+)
+def test_a_peek_clears_the_ground_area_a_building_of_its_paint_stands_on_never_the_building(
+    paint: tuple[int, int, int], top_m: float
+) -> None:
+    """A building painted as the ground area it stands at the edge of (a grey block on a
+    road, a brown one on a field, a green one on a lawn), one storey to 20 m: in a look down
+    from the ceiling they are one region of one colour. Parallax against photos from the
+    ceiling elsewhere clears a part of one colour only as a whole (`standing_regions`): the
+    building stays, with the area joined to it, and no place within the safety margin of
+    its walls is clear. (Weighed as a whole by `on_ground` alone, the one-storey blocks
+    were cleared with their areas: `stands_out` finds their patch.)"""
+    rgb = list(paint)
+    scene = scene_from_dict(
+        {
+            "target": "red",
+            "ground": {
+                "color": [118, 90, 66] if paint[1] > paint[0] + 40 else [56, 93, 50],
+                "areas": [{"name": "area", "color": rgb,
+                           "polygon": [[-50, -20], [50, -20], [50, -4], [-50, -4]]}],
+                "texture": {"kind": "grain", "amplitude_dn": 8.0, "scale_m": 0.4, "seed": 5},
+            },
+            "buildings": [
+                {"name": "red", "color": [210, 40, 40],
+                 "blocks": [{"footprint": [[30, 30], [40, 30], [40, 38], [30, 38]], "top_m": 8}]},
+                {"name": "block", "color": rgb,
+                 "blocks": [{"footprint": [[-6, -4], [6, -4], [6, 4], [-6, 4]], "top_m": top_m}]},
+            ],
+        }
+    )  # fmt: skip
+
+    def photo(tag: str, x: float, y: float) -> Photo:
+        pose = CameraPose((x, y, 117.0), 0.0, -90.0)
+        return Photo(0, 0, tag, 0, pose, K, render(scene, pose, K))
+
+    look = photo("peek-1", 10.0, 12.0)
+    others = [photo("overview-2", -30.0, 40.0), photo("measure-1", 40.0, -30.0), photo("m", 0, 0)]
+    m = SearchMission(Params(), MissionInputs(look.image_rgb))
+    peek = Peek.of(look, m.params.vectorize, standing_regions(m, look, others))
+    assert peek is not None
+    margin = m.params.viewpoints.safety_margin_m
+    for x, y in [(0.0, 0.0), (-6.0 - margin / 2, 0.0), (0.0, 4.0 + margin / 2), (6.5, 4.5)]:
+        assert peek.clear_m((x, y)) < margin, (x, y)
