@@ -96,3 +96,19 @@ def test_a_side_photo_that_does_not_show_the_building_is_taken_again_from_elsewh
     assert "front viewpoint: planned again with no sight line along that one" in events
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == summary.evaluation.target_building
+
+
+def test_a_field_the_photos_tell_may_stand_is_planned_around_never_crossed_low() -> None:
+    """World scene 50157: the front viewpoint lies beyond the overview's ground, over a
+    field with buildings of unknown height on it. Two of the photos from the ceiling, which
+    those buildings hide parts of it in, tell the field stands: it is not cleared, the
+    front is planned again around what the look down showed (the one path left that plans
+    around a look down on the 400 world scenes), and refused again. The flight ends an
+    honest partial: found, no front photo."""
+    summary, events = fly_data_scene("world-50157")
+    assert any("front viewpoint: planned again around the" in e for e in events), events
+    refused = [e for e in events if "front viewpoint: beyond the overview's ground, and a" in e]
+    assert len(refused) == 2, events
+    assert summary.outcome.status is Status.PARTIAL, summary.outcome.reason
+    assert summary.outcome.reason == "target found; model not built: no front photo"
+    assert summary.evaluation.matched_building == summary.evaluation.target_building
