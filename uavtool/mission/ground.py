@@ -124,9 +124,7 @@ def _painted(
     for _ in range(_SHADES):
         if _count(left) < few_px:
             return True
-        pixels = np.sort(photo.image_rgb[left], axis=0)  # (np.median imports numpy.ma)
-        r, g, b = (int(c) for c in pixels[len(pixels) // 2])
-        shade = (r, g, b)
+        shade = _median_shade(photo, left)
         near = _near(photo, shade)
         _, labels = cv2.connectedComponents(near, connectivity=8)
         # (np.unique would import numpy.ma: tests/test_imports.py)
@@ -140,6 +138,13 @@ def _painted(
             return False
         left &= ~joined
     return _count(left) < few_px
+
+
+def _median_shade(photo: Photo, mask: npt.NDArray[np.bool_]) -> tuple[int, int, int]:
+    """The median colour, channel by channel, of ``photo``'s pixels under ``mask``."""
+    pixels = np.sort(photo.image_rgb[mask], axis=0)  # (np.median imports numpy.ma)
+    r, g, b = (int(c) for c in pixels[len(pixels) // 2])
+    return r, g, b
 
 
 def _count(mask: npt.NDArray[np.bool_]) -> int:
@@ -286,9 +291,7 @@ def standing_regions(
         for _ in range(_SHADES):
             if _count(left) < p.min_area_px:
                 break
-            pixels = np.sort(photo.image_rgb[left], axis=0)  # (np.median imports numpy.ma)
-            r, g, b = (int(c) for c in pixels[len(pixels) // 2])
-            shade = (r, g, b)
+            shade = _median_shade(photo, left)
             part = np.where(left & (_near(photo, shade) > 0), 255, 0).astype(np.uint8)
             for piece in not_ground_regions(photo.image_rgb, p, within=part):
                 if piece.area_px >= p.min_area_px and _clears(m, piece, photo, others, hidden):

@@ -351,6 +351,8 @@ def _sight_line(vp: Viewpoint, rect: Rect, short_m: float) -> tuple[tuple[float,
 
 
 _HALF_WIDTH_M = 0.5
+"""Half the width of a blocked sight line (`_sight_line`): it stands in for no known
+building, only for the line itself; the safety margin keeps cameras off it."""
 
 
 def _side_params(m: SearchMission, roof_m: float) -> ViewpointParams:

@@ -89,9 +89,7 @@ def on_ground(
     box = (slice(y0, y1), slice(x0, x1))
     here = image[box]
     mine = cv2.bitwise_and(_near(here, colour_rgb), region[box])
-    ones: CvArray = np.full(other.shape[:2], 255, np.uint8)
-    if hidden is not None:
-        ones = cv2.bitwise_not(hidden)
+    ones = _showing(other, hidden)
     size = (x1 - x0, y1 - y0)
 
     def misfit(z: float) -> tuple[float, float] | None:
@@ -169,10 +167,7 @@ def stands_out(
     box = (slice(y0, y0 + bh), slice(x0, x0 + bw))
     here = image[box]
     mine = cv2.bitwise_and(_near(here, colour_rgb), region[box])
-    shows: CvArray = np.full(other.shape[:2], 255, np.uint8)
-    if hidden is not None:
-        shows = cv2.bitwise_not(hidden)
-    carried, inside = _carry(other, shows, hom, (x0, y0), (bw, bh))
+    carried, inside = _carry(other, _showing(other, hidden), hom, (x0, y0), (bw, bh))
     off = (cv2.absdiff(here, carried).max(axis=2) > _NEAR_DN) & (mine > 0) & (inside > 0)
     patch = cv2.morphologyEx(off.astype(np.uint8) * 255, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
     _, _, stats, _ = cv2.connectedComponentsWithStats(patch, connectivity=8)
@@ -220,7 +215,7 @@ def roof_by_alignment(
         return None
     contours, _ = cv2.findContours(region, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
     pts = np.concatenate([c[:, 0, :] for c in contours]).astype(np.float64).reshape(-1, 1, 2)
-    ones = np.full(other.shape[:2], 255, np.uint8)
+    ones = _showing(other, None)
     size = (x1 - x0, y1 - y0)
     try:
         back = cv2.perspectiveTransform(
@@ -266,6 +261,13 @@ def roof_by_alignment(
     answer = max(i for i in range(len(fits)) if fits[i] <= limit or apart(i) < PARALLAX_PX / 2.0)
     told = [i for i in range(answer + 1, len(fits)) if apart(i) - apart(answer) >= PARALLAX_PX]
     return heights[answer] if told else None
+
+
+def _showing(other: npt.NDArray[np.uint8], hidden: CvArray | None) -> CvArray:
+    """255 over ``other`` where it shows the ground (not ``hidden``), for `_carry`."""
+    if hidden is not None:
+        return cv2.bitwise_not(hidden)
+    return np.full(other.shape[:2], 255, np.uint8)
 
 
 def _carry(
