@@ -16,6 +16,7 @@ from uavtool.mission.observations import Photo
 from uavtool.nav.parallax import STOREY_M, least_telling_m, on_ground, stands_out
 from uavtool.vision import Shape
 from uavtool.vision.vectorize import (
+    is_grey,
     near_colour,
     non_ground,
     not_ground_regions,
@@ -244,20 +245,28 @@ def without_ground(
 
 
 def regions_off_ground(
-    m: SearchMission, photo: Photo, regions: tuple[Shape, ...], ground: Sequence[Shape]
+    m: SearchMission,
+    photo: Photo,
+    regions: tuple[Shape, ...],
+    ground: Sequence[Shape],
+    others: Sequence[Photo] = (),
+    known: Sequence[tuple[Sequence[tuple[float, float]], float]] = (),
 ) -> tuple[Shape, ...]:
     """``regions`` (what is not ground in nadir ``photo`` by its colour) without the pixels
     of ``ground`` (shapes of ``photo`` that lie on the ground by parallax) in their own
     colour: a lawn a building stands on is no part of that building, and a building of
     unknown height may stand anywhere in its region. What stands on them, of another
-    colour, stays."""
-    if not ground:
+    colour, stays. With ``others`` (nadir photos from elsewhere), what is left is told
+    colour by colour as `standing_regions` tells it (``known``: the roofs measured): a road
+    joining a building to the frame's border once made the building's region one cut by
+    the frame, which may hold a roof as high as anything (world 50063)."""
+    if not ground and not others:
         return regions
     keep: CvArray = np.full(photo.image_rgb.shape[:2], 255, np.uint8)
     for shape in ground:
         flat = cv2.bitwise_and(outline_mask(photo.image_rgb, shape), _near(photo, shape.colour_rgb))
         keep = cv2.bitwise_and(keep, cv2.bitwise_not(flat))
-    return not_ground_regions(photo.image_rgb, m.params.vectorize, within=keep)
+    return _standing(m, photo, keep, others, known)
 
 
 def standing_regions(
@@ -276,25 +285,45 @@ def standing_regions(
     What stands, and whatever else a part's outline holds, is kept. ``known``: the roofs
     measured (footprint, height above home): the ground they hide in ``others`` tells
     nothing, and in ``photo`` they always stand."""
+    return _standing(m, photo, None, others, known)
+
+
+def _standing(
+    m: SearchMission,
+    photo: Photo,
+    within: CvArray | None,
+    others: Sequence[Photo],
+    known: Sequence[tuple[Sequence[tuple[float, float]], float]],
+) -> tuple[Shape, ...]:
+    """`standing_regions` of the pixels of ``photo`` in ``within`` (None: all of them)."""
     p = m.params.vectorize
-    regions = not_ground_regions(photo.image_rgb, p)
+    regions = not_ground_regions(photo.image_rgb, p, within=within)
     if not others:
         return regions
     grow = np.ones((2 * _HIDDEN_PX + 1, 2 * _HIDDEN_PX + 1), np.uint8)
     hidden = [cv2.dilate(_prisms(other, known), grow) for other in others]
+    paints = _Paints(photo, others, p, grow)
     keep: CvArray = np.full(photo.image_rgb.shape[:2], 255, np.uint8)
     cut = False
     for region in regions:
         if region.area_px < p.min_area_px:
             continue
         left = outline_mask(photo.image_rgb, region) > 0
+        if within is not None:
+            left &= within > 0
         for _ in range(_SHADES):
             if _count(left) < p.min_area_px:
                 break
             shade = _median_shade(photo, left)
             part = np.where(left & (_near(photo, shade) > 0), 255, 0).astype(np.uint8)
             for piece in not_ground_regions(photo.image_rgb, p, within=part):
-                if piece.area_px >= p.min_area_px and _clears(m, piece, photo, others, hidden):
+                if piece.area_px < p.min_area_px:
+                    continue
+                behind = [
+                    cv2.bitwise_or(h, paints.other_than(i, piece.colour_rgb))
+                    for i, h in enumerate(hidden)
+                ]
+                if _clears(m, piece, photo, others, behind):
                     flat = cv2.bitwise_and(outline_mask(photo.image_rgb, piece), part)
                     keep = cv2.bitwise_and(keep, cv2.bitwise_not(flat))
                     cut = True
@@ -302,7 +331,42 @@ def standing_regions(
     if not cut:
         return regions
     keep = cv2.bitwise_or(keep, _prisms(photo, known))
+    if within is not None:
+        keep = cv2.bitwise_and(keep, within)
     return not_ground_regions(photo.image_rgb, p, within=keep)
+
+
+class _Paints:
+    """Where each of ``others`` draws the paint (any shade: `same_paint`) of a roof
+    ``photo`` shows (`non_ground`), grown by ``grow``: a building leaning over a road in
+    another photo from above, its roof and walls drawn where the road lies carried as the
+    ground, hides the road there and tells nothing of it (world 50063: a tower beside a
+    road, of unknown height, kept the road standing and the tower's region cut by the
+    frame). Greys are left out: their paint is every unpainted surface's, the ground's
+    too."""
+
+    def __init__(self, photo: Photo, others: Sequence[Photo], params: Any, grow: CvArray) -> None:
+        self._others = others
+        self._grow = grow
+        roofs = {s.colour_rgb for s in non_ground(photo.image_rgb, params)}
+        self._colours = sorted(c for c in roofs if not is_grey(c))
+        self._masks: dict[tuple[int, tuple[int, int, int]], CvArray] = {}
+
+    def other_than(self, index: int, rgb: tuple[int, int, int]) -> CvArray:
+        """A mask (uint8) of ``others[index]``: where it draws the paint of a roof other
+        than ``rgb``'s."""
+        image = self._others[index].image_rgb
+        mask: CvArray = np.zeros(image.shape[:2], np.uint8)
+        swatch = np.full((3, 3, 3), rgb, np.uint8)  # same_paint takes a frame
+        for colour in self._colours:
+            if bool(same_paint(swatch, colour)[0, 0]):
+                continue  # its own paint: what it shows of it is evidence
+            key = (index, colour)
+            if key not in self._masks:
+                drawn = same_paint(image, colour).astype(np.uint8) * 255
+                self._masks[key] = cv2.dilate(drawn, self._grow)
+            mask = cv2.bitwise_or(mask, self._masks[key])
+        return mask
 
 
 def _prisms(photo: Photo, known: Sequence[tuple[Sequence[tuple[float, float]], float]]) -> CvArray:

@@ -150,8 +150,15 @@ def measure_from_above(m: SearchMission, seen: Survey, order: tuple[int, ...]) -
     # lawn was found to be ground.
     # A building of unknown height stands in its region's part off the ground: a lawn it
     # stands on is no part of it (nor a reason to count it cut by the frame).
+    # What is left of a region, one colour at a time, may lie on the ground too: a road
+    # joining a building to the frame's border is no part of the building.
     on_ground = [*seen.ground, *(seen.shapes[i] for i in ground)]
-    parts = regions_off_ground(m, seen.photo, seen.regions, on_ground)
+    standing = [
+        (footprint_at(s, seen.photo, roofs[i]), roofs[i])
+        for i, s in enumerate(seen.shapes)
+        if measured[i] and roofs[i] > 0.0 and not s.cut_by_border
+    ]
+    parts = regions_off_ground(m, seen.photo, seen.regions, on_ground, photos, standing)
     later = unexplained(
         seen.photo, seen.shapes, roofs, measured, seen.regions, m.params.vectorize, parts
     )

@@ -498,6 +498,13 @@ def same_paint(frame_rgb: U8Array, colour_rgb: tuple[int, int, int]) -> npt.NDAr
     return alike
 
 
+def is_grey(colour_rgb: tuple[int, int, int]) -> bool:
+    """Whether ``colour_rgb`` is a grey: its paint (`same_paint`) is every unpainted
+    surface's, whatever its shade."""
+    own = cv2.cvtColor(np.array([[colour_rgb]], np.uint8), cv2.COLOR_RGB2HSV)[0, 0]
+    return int(own[1]) < _GREY_SATURATION
+
+
 def near_colour(frame_rgb: U8Array, rgb: tuple[int, int, int], tolerance_dn: int) -> CvArray:
     """255 where every channel of ``frame_rgb`` is within ``tolerance_dn`` of ``rgb``."""
     return _near(_check_frame(frame_rgb), rgb, tolerance_dn)
