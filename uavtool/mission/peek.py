@@ -87,8 +87,10 @@ def peek(m: SearchMission, x: float, y: float, what: str, tag: str) -> Wait[bool
     yield from m.travel((x, y, m.ceiling_m), None, m.ceiling_m, f"over the {what}, looking down")
     photo = yield from m.photo(tag, -90.0)
     photo_shapes(m, photo)  # what it shows, as for every photo (viewers, re-analysis)
-    # A road or a lawn is no building: parallax against the photos from the ceiling tells
-    regions = standing_regions(m, photo, m.from_above, m.roofs)
+    # A road or a lawn is no building: parallax against the photos from the ceiling tells.
+    # The roofs measured stand; what was measured at the ground's height is no roof.
+    standing = [(footprint, roof_m) for footprint, roof_m in m.roofs if roof_m > 0.0]
+    regions = standing_regions(m, photo, m.from_above, standing)
     m.from_above.append(photo)
     seen = Peek.of(photo, m.params.vectorize, regions)
     if seen is not None:
