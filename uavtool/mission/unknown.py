@@ -375,7 +375,7 @@ def unexplained(
     the height measured (``roofs_m``, where ``measured``), its walls down to the ground. A
     building of unknown height explains its whole region: it may stand anywhere in it (in
     its part of it, of ``parts``, when given: the regions with what lies on the ground
-    taken out). A taller tier of one colour whose roof lies beyond the frame, or a
+    taken out, which is then no part of what is left unexplained). A taller tier of one colour whose roof lies beyond the frame, or a
     neighbour of a darker shade merged with a building, shows here."""
     p, k = params, photo.intrinsics
     touched = np.zeros((k.height_px, k.width_px), np.uint8)
@@ -396,6 +396,14 @@ def unexplained(
     reach = math.ceil(p.rdp_epsilon_px) + p.denoise_px // 2 + 1
     grown = cv2.dilate(explained, np.ones((2 * reach + 1, 2 * reach + 1), np.uint8))
     rest = cv2.bitwise_and(touched, cv2.bitwise_not(grown))
+    if parts is not None:  # what lies on the ground is in no part, and explains itself
+        off = np.zeros_like(touched)
+        for part in parts:
+            cv2.fillPoly(off, [pixels(part.polygon_px)], 255)
+            for hole in part.holes_px:
+                cv2.fillPoly(off, [pixels(hole)], 0)
+        kernel = np.ones((2 * reach + 1, 2 * reach + 1), np.uint8)
+        rest = cv2.bitwise_and(rest, cv2.dilate(off, kernel))
     if cv2.countNonZero(rest) < p.min_area_px:
         return []
     return [s for s in non_ground(photo.image_rgb, p, within=rest) if s.area_px >= p.min_area_px]
