@@ -170,6 +170,12 @@ def test_a_lawn_on_the_ground_is_no_part_of_the_building_on_it_but_its_neighbour
     )
     top = project(np.array([(14.0, 0.0, 30.0)]), pose, k)[0, :2]
     assert any(shapely.Polygon(r.polygon_px).contains(shapely.Point(*top)) for r in rest)
+    # ground that is no shape (cleared by parallax, `standing_regions`) is in no part, and
+    # nothing it leaves unexplained: only the tower
+    alone = unexplained(photo, (blue,), (25.0,), (False,), regions, VectorizeParams(), parts)
+    grass = project(np.array([(4.0, 5.0, 0.0)]), pose, k)[0, :2]
+    assert any(shapely.Polygon(r.polygon_px).contains(shapely.Point(*top)) for r in alone)
+    assert not any(shapely.Polygon(r.polygon_px).contains(shapely.Point(*grass)) for r in alone)
     # the whole region, lawn and tower, was the building's before
     assert (
         unexplained(photo, (blue, lawn), (25.0, 0.0), (False, True), regions, VectorizeParams())
@@ -257,6 +263,23 @@ def test_a_road_beyond_the_overview_is_no_building_beside_a_side_viewpoint(
     assert summary.evaluation.matched_building == summary.evaluation.target_building == target
 
 
+def test_a_road_joining_a_building_to_the_frame_leaves_it_a_region_of_its_own() -> None:
+    """World scene 50063: a grey road crosses the overview from border to border, and the
+    target's near twin (b03, a stepped cross of its colour) stands at its edge. In the
+    overview they were one region, cut by the frame: a roof as high as the ceiling might
+    stand anywhere the twin might, every look at it stayed at the ceiling, drawn too small
+    to judge, and the flight ended "could not be judged". Told colour by colour against the
+    survey's photos, the road lies on the ground (the towers leaning over it in those
+    photos hide it there, and tell nothing): the twin is looked at from closer, and the
+    flight ends honestly, neither cross told from the other."""
+    summary, events = fly_data_scene("world-50063")
+    assert any("looking again from closer" in e for e in events), events
+    assert not any("could not be judged" in e for e in events), events
+    assert summary.outcome.status is Status.NO_MATCH, summary.outcome.reason
+    assert "both match the target" in summary.outcome.reason
+    assert not summary.evaluation.matched_building
+
+
 def test_a_look_down_clears_a_road_but_not_a_tower_of_its_grey_beside_it() -> None:
     """A grey road, and a 20 m tower of the road's own grey touching it: in a look down from
     the ceiling they are one region of one colour. Parallax against photos from elsewhere
@@ -312,3 +335,47 @@ def test_a_look_down_clears_a_road_but_not_a_tower_of_its_grey_beside_it() -> No
     unseen = standing_regions(m, look, ())  # nothing to tell by: everything stands
     every = not_ground_regions(look.image_rgb, m.params.vectorize)
     assert [r.area_px for r in unseen] == [r.area_px for r in every]
+
+
+def test_a_building_leaning_over_a_road_in_another_photo_does_not_keep_the_road_standing() -> None:
+    """A grey lane, and a 30 m teal tower of unknown height at its edge. From elsewhere the
+    tower leans over the lane: carried as the ground, the lane's pixels there are drawn in
+    teal, and a patch that stands out kept the whole lane standing (world 50063: the road
+    joined a building to the overview's border, and the building's region, cut by the
+    frame, might hold a roof as high as the ceiling, so no look could go lower). Another
+    roof's paint in another photo hides the ground there and tells nothing: the lane is
+    cleared, the tower stands."""
+    grey = [86, 87, 86]
+    scene = scene_from_dict(
+        {
+            "target": "red",
+            "ground": {
+                "color": [56, 93, 50],
+                "areas": [{"name": "lane", "color": grey,
+                           "polygon": [[-60, 14], [60, 14], [60, 20], [-60, 20]]}],
+                "texture": {"kind": "noise", "amplitude_dn": 8.5, "scale_m": 1.1, "seed": 3},
+            },
+            "buildings": [
+                {"name": "red", "color": [210, 40, 40],
+                 "blocks": [{"footprint": [[30, 30], [40, 30], [40, 38], [30, 38]], "top_m": 8}]},
+                {"name": "teal", "color": [40, 190, 170],
+                 "blocks": [{"footprint": [[-10, 20], [-2, 20], [-2, 28], [-10, 28]],
+                             "top_m": 30}]},
+            ],
+        }
+    )  # fmt: skip
+    k = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
+
+    def photo(tag: str, x: float, y: float) -> Photo:
+        pose = CameraPose((x, y, 117.0), 0.0, -90.0)
+        return Photo(0, 0, tag, 0, pose, k, render(scene, pose, k))
+
+    look = photo("peek-1", 0.0, 0.0)
+    # from the north-west the tower leans south-east, over the lane
+    others = [photo("overview-2", -20.0, 45.0), photo("measure-1", 35.0, -25.0)]
+    m = SearchMission(Params(), MissionInputs(look.image_rgb))
+    peek = Peek.of(look, m.params.vectorize, standing_regions(m, look, others))
+    assert peek is not None
+    assert peek.clear_m((-40.0, 17.0)) > 5.0  # the lane lies on the ground
+    assert peek.clear_m((-6.0, 16.0)) > 0.0  # beside the tower too
+    assert peek.clear_m((-6.0, 24.0)) == 0.0  # the tower stands

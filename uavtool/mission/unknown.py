@@ -375,8 +375,9 @@ def unexplained(
     the height measured (``roofs_m``, where ``measured``), its walls down to the ground. A
     building of unknown height explains its whole region: it may stand anywhere in it (in
     its part of it, of ``parts``, when given: the regions with what lies on the ground
-    taken out, which is then no part of what is left unexplained). A taller tier of one colour whose roof lies beyond the frame, or a
-    neighbour of a darker shade merged with a building, shows here."""
+    taken out, which is then no part of what is left unexplained). A taller tier of one
+    colour whose roof lies beyond the frame, or a neighbour of a darker shade merged with a
+    building, shows here."""
     p, k = params, photo.intrinsics
     touched = np.zeros((k.height_px, k.width_px), np.uint8)
     explained = np.zeros_like(touched)
