@@ -15,6 +15,7 @@ from uavtool.camera import project
 from uavtool.mission.observations import Photo
 from uavtool.nav.parallax import STOREY_M, least_telling_m, on_ground, stands_out
 from uavtool.vision import Shape
+from uavtool.vision.params import VectorizeParams
 from uavtool.vision.vectorize import (
     is_grey,
     near_colour,
@@ -345,7 +346,9 @@ class _Paints:
     frame). Greys are left out: their paint is every unpainted surface's, the ground's
     too."""
 
-    def __init__(self, photo: Photo, others: Sequence[Photo], params: Any, grow: CvArray) -> None:
+    def __init__(
+        self, photo: Photo, others: Sequence[Photo], params: VectorizeParams, grow: CvArray
+    ) -> None:
         self._others = others
         self._grow = grow
         roofs = {s.colour_rgb for s in non_ground(photo.image_rgb, params)}
