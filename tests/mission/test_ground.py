@@ -24,7 +24,7 @@ from uavtool.runner.fly import FlyConfig
 from uavtool.runner.fly import fly as fly_scene
 from uavtool.vision.params import VectorizeParams
 from uavtool.vision.vectorize import not_ground_regions
-from uavtool.world import load_scene, render, scene_from_dict
+from uavtool.world import Scene, load_scene, render, scene_from_dict
 from uavtool.world.ground import GroundArea, GroundTexture, TextureKind
 from uavtool.world.scene import dump_scene
 
@@ -280,6 +280,21 @@ def test_a_road_joining_a_building_to_the_frame_leaves_it_a_region_of_its_own() 
     assert not summary.evaluation.matched_building
 
 
+def _looks_from_ceiling(scene: Scene) -> tuple[Photo, list[Photo]]:
+    """Photos of ``scene`` straight down from 117 m: a look down over home, and two others
+    from the ceiling elsewhere (north-west and south-east of it)."""
+    k = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
+
+    def photo(tag: str, x: float, y: float) -> Photo:
+        pose = CameraPose((x, y, 117.0), 0.0, -90.0)
+        return Photo(0, 0, tag, 0, pose, k, render(scene, pose, k))
+
+    return photo("peek-1", 0.0, 0.0), [
+        photo("overview-2", -20.0, 45.0),
+        photo("measure-1", 35.0, -25.0),
+    ]
+
+
 def test_a_look_down_clears_a_road_but_not_a_tower_of_its_grey_beside_it() -> None:
     """A grey road, and a 20 m tower of the road's own grey touching it: in a look down from
     the ceiling they are one region of one colour. Parallax against photos from elsewhere
@@ -308,14 +323,7 @@ def test_a_look_down_clears_a_road_but_not_a_tower_of_its_grey_beside_it() -> No
             ],
         }
     )  # fmt: skip
-    k = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
-
-    def photo(tag: str, x: float, y: float) -> Photo:
-        pose = CameraPose((x, y, 117.0), 0.0, -90.0)
-        return Photo(0, 0, tag, 0, pose, k, render(scene, pose, k))
-
-    look = photo("peek-1", 0.0, 0.0)
-    others = [photo("overview-2", -20.0, 45.0), photo("measure-1", 35.0, -25.0)]
+    look, others = _looks_from_ceiling(scene)
     m = SearchMission(Params(), MissionInputs(look.image_rgb))
     before = Peek.of(look, m.params.vectorize)
     after = Peek.of(look, m.params.vectorize, standing_regions(m, look, others))
@@ -364,15 +372,7 @@ def test_a_building_leaning_over_a_road_in_another_photo_does_not_keep_the_road_
             ],
         }
     )  # fmt: skip
-    k = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
-
-    def photo(tag: str, x: float, y: float) -> Photo:
-        pose = CameraPose((x, y, 117.0), 0.0, -90.0)
-        return Photo(0, 0, tag, 0, pose, k, render(scene, pose, k))
-
-    look = photo("peek-1", 0.0, 0.0)
-    # from the north-west the tower leans south-east, over the lane
-    others = [photo("overview-2", -20.0, 45.0), photo("measure-1", 35.0, -25.0)]
+    look, others = _looks_from_ceiling(scene)  # from the north-west, the tower leans over
     m = SearchMission(Params(), MissionInputs(look.image_rgb))
     peek = Peek.of(look, m.params.vectorize, standing_regions(m, look, others))
     assert peek is not None
