@@ -395,7 +395,8 @@ def unexplained(
     # Outlines are simplified (by up to rdp_epsilon_px) and denoised (a median of
     # denoise_px): a building's own edge may lie that far off.
     reach = math.ceil(p.rdp_epsilon_px) + p.denoise_px // 2 + 1
-    grown = cv2.dilate(explained, np.ones((2 * reach + 1, 2 * reach + 1), np.uint8))
+    kernel = np.ones((2 * reach + 1, 2 * reach + 1), np.uint8)
+    grown = cv2.dilate(explained, kernel)
     rest = cv2.bitwise_and(touched, cv2.bitwise_not(grown))
     if parts is not None:  # what lies on the ground is in no part, and explains itself
         off = np.zeros_like(touched)
@@ -403,7 +404,6 @@ def unexplained(
             cv2.fillPoly(off, [pixels(part.polygon_px)], 255)
             for hole in part.holes_px:
                 cv2.fillPoly(off, [pixels(hole)], 0)
-        kernel = np.ones((2 * reach + 1, 2 * reach + 1), np.uint8)
         rest = cv2.bitwise_and(rest, cv2.dilate(off, kernel))
     if cv2.countNonZero(rest) < p.min_area_px:
         return []

@@ -478,7 +478,7 @@ def same_paint(frame_rgb: U8Array, colour_rgb: tuple[int, int, int]) -> npt.NDAr
     frame = _check_frame(frame_rgb)
     hsv = cv2.cvtColor(frame, cv2.COLOR_RGB2HSV)
     own = cv2.cvtColor(np.array([[colour_rgb]], np.uint8), cv2.COLOR_RGB2HSV)[0, 0]
-    if int(own[1]) < _GREY_SATURATION:
+    if is_grey(colour_rgb):
         grey: npt.NDArray[np.bool_] = hsv[:, :, 1] < _GREY_SATURATION
         return grey
     # Per-pixel tests as look-up tables over the 256 values of one channel: the same
