@@ -15,6 +15,7 @@ from typing import Any
 from tests.sitl.client import Client
 from uavtool.geo import geo_from_enu
 from uavtool.mavlink import mavlink as M
+from uavtool.mavlink.dialect import COPTER_MODES
 from uavtool.sitl import Sitl, SitlConfig
 from uavtool.world import Scene, load_scene
 
@@ -100,7 +101,16 @@ def fly_auto_mission(client: Client, scene: Scene) -> None:
         if msg.seq == len(items) - 1:
             break
     assert client.wait_for("MISSION_ACK").type == M.MAV_MISSION_ACCEPTED
-    client.set_mode("GUIDED")
+    assert client.set_mode("GUIDED").result == M.MAV_RESULT_ACCEPTED
+    # As a pilot would: arm once the vehicle's own heartbeat says GUIDED. At 8x a heartbeat
+    # comes every 125 ms of wall time, and the three commands can all be answered between two;
+    # then no link (the recorder's neither) ever saw the vehicle in GUIDED.
+    guided = COPTER_MODES["GUIDED"]
+    client.wait_until(
+        lambda c: "HEARTBEAT" in c.latest and c.latest["HEARTBEAT"].custom_mode == guided,
+        timeout=10,
+        what="a heartbeat in GUIDED",
+    )
     assert client.command(M.MAV_CMD_COMPONENT_ARM_DISARM, 1).result == M.MAV_RESULT_ACCEPTED
     assert client.command(M.MAV_CMD_MISSION_START, 0, 0).result == M.MAV_RESULT_ACCEPTED
     client.wait_until(
