@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 from uavtool.mission.measure import measure_from_above
 from uavtool.mission.outputs import Level, Plan, Status
-from uavtool.mission.search import search
+from uavtool.mission.search import search, target_hue_first
 from uavtool.mission.survey import Survey, overview_heading_deg, survey
 from uavtool.nav import route_length_m, visit_order
 
@@ -42,7 +42,7 @@ def fly(m: SearchMission) -> Wait[None]:
     seen = yield from measure_from_above(m, seen, visit_order(start, _points(seen)))
     pois = seen.pois
     points = _points(seen)
-    order = visit_order(start, points)
+    order = target_hue_first(m, start, pois)
     m.plan = Plan(seen.photo.frame_index, pois, order, route_length_m(start, points, order))
     m.emit(m.plan)
     m.event(Level.INFO, f"{len(pois)} points of interest; visiting order {list(order)}")

@@ -33,7 +33,7 @@ from uavtool.mission.analysis import (
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest, Recognition, Shapes, Status, Vec3
 from uavtool.mission.unknown import shows_as
-from uavtool.nav import NavError, ground_point, ground_polygon
+from uavtool.nav import NavError, ground_point, ground_polygon, visit_order
 from uavtool.nav.geometry import point_polygon_distance
 from uavtool.nav.heights import fit_altitude_m
 from uavtool.nav.parallax import roof_by_alignment
@@ -606,17 +606,39 @@ def _beats(m: SearchMission, k: int, look: _Look, best: Found) -> bool:
     return here == want
 
 
+def of_target_hue(m: SearchMission, rgb: tuple[int, int, int]) -> bool:
+    """Whether a building of colour ``rgb`` may be the target: its hue within
+    ``mission.match_hue_tolerance_deg`` of the target picture's (any, when that is 0)."""
+    limit = m.params.mission.match_hue_tolerance_deg
+    return limit <= 0 or hue_distance_deg(rgb, m.target.colour_rgb) <= limit
+
+
+def target_hue_first(
+    m: SearchMission, start: tuple[float, float], pois: tuple[PointOfInterest, ...]
+) -> tuple[int, ...]:
+    """The order to visit ``pois`` in from ``start``: the shortest way over those of the
+    target's hue (:func:`of_target_hue`), then on from the last of them over the others; the
+    shortest way over all when every one is visited anyway (``mission.visit_all``). Only a
+    building of the target's hue can match, and once one has, the search looks only at the
+    others of its hue (:func:`_rivals`): a building of another colour visited first is time
+    spent before the match, never a match."""
+    every = list(range(len(pois)))
+    like = [k for k in every if of_target_hue(m, pois[k].colour_rgb)]
+    if m.params.mission.visit_all or not like or len(like) == len(pois):
+        return visit_order(start, [poi.pos_en_m for poi in pois])
+    rest = [k for k in every if k not in like]
+    first = [like[i] for i in visit_order(start, [pois[k].pos_en_m for k in like])]
+    last = pois[first[-1]].pos_en_m
+    return (*first, *(rest[i] for i in visit_order(last, [pois[k].pos_en_m for k in rest])))
+
+
 def _rivals(
     m: SearchMission, pois: tuple[PointOfInterest, ...], todo: list[int], matched: int
 ) -> list[int]:
     """The points of interest still to visit that could be the target as well (its colour,
     within the match's hue gate): a match is final only once none is left unseen, so a slab
     in the target's colour never wins over the courtyard building further on."""
-    limit = m.params.mission.match_hue_tolerance_deg
-    target_rgb = m.target.colour_rgb
-    rivals = [
-        k for k in todo if limit <= 0 or hue_distance_deg(pois[k].colour_rgb, target_rgb) <= limit
-    ]
+    rivals = [k for k in todo if of_target_hue(m, pois[k].colour_rgb)]
     if rivals:
         m.event(
             Level.INFO,
