@@ -547,8 +547,12 @@ def _look_closer(m: SearchMission, f: Found, left: list[Found]) -> Wait[Judgemen
         return None
     extent = math.dist(*_farthest_pair(ring))
     fit = fit_altitude_m(roof_m=f.roof_m, extent_m=extent, intrinsics=k, fill=p.top_fill)
-    alt = max(fit, f.roof_m + p.min_above_roof_m, m.floor_at(x, y))
-    if alt > alt_was - p.recheck_climb_m / 2.0:
+    lower = max(fit, f.roof_m + p.min_above_roof_m)
+    clear = alt_was - p.recheck_climb_m / 2.0
+    if lower <= clear < m.floor_at(x, y):  # held up by roofs of unknown height: the look
+        m.measure_near(x, y, photo, photo_shapes(m, photo))  # that matched may measure them
+    alt = max(lower, m.floor_at(x, y))
+    if alt > clear:
         return None
     others = ", ".join(str(o.poi.index) for o in left if o is not f)
     yield from _shift(
