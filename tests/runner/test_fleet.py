@@ -158,7 +158,7 @@ def test_a_viewpoint_where_another_vehicle_stands_is_planned_again() -> None:
     )  # fmt: skip
     assert s.status is Status.COMPLETED and "model built" in s.reason, s.reason
     replanned = "a side viewpoint lies where another vehicle stands: planned again"
-    assert any(text == replanned for _, text in said)  # by the modeller (2 since ce8e5a1)
+    assert any(text == replanned for _, text in said)  # by the modeller (vehicle 2)
     assert s.closest_approach_m >= 5.0
 
 
