@@ -32,7 +32,7 @@ def test_detections_are_written_beside_the_original(tmp_path: Path) -> None:
     code, text = _run("replay", str(GOLDEN), "--vision", "tests.plugins.detector:red_roofs",
                       "--output", str(out))  # fmt: skip
     assert code == 0, text
-    assert "on 10 photos: 7 detections" in text
+    assert "on 7 photos: 7 detections" in text
     before, after = _messages(GOLDEN), _messages(out)
     kept = [m for m in after if not m[0].startswith("/vision/")]
     assert kept == before  # every original message, unchanged and in order
@@ -48,7 +48,7 @@ def test_detections_are_written_beside_the_original(tmp_path: Path) -> None:
         found = [e.value.payload for e in reader.entries(["/vision/detections"])]
         images = {e.log_time_ns for e in reader.entries(["/camera/image"])}
     assert meta["vision"] == {"function": "tests.plugins.detector:red_roofs", "source": GOLDEN.name}
-    assert len(found) == 10 and sum(len(f["detections"]) for f in found) == 7
+    assert len(found) == 7 and sum(len(f["detections"]) for f in found) == 7
     for payload in found:
         jsonschema.validate(payload, schema)  # a standard validator accepts every message
     annotations = [(t, d) for topic, t, d in after if topic == "/vision/annotations"]
@@ -94,7 +94,7 @@ def test_a_fleets_detections_go_under_each_vehicle(tmp_path: Path) -> None:
     ("function", "code", "words"),
     [
         ("tests.plugins.detector:dicts", 1, "returned a dict, expected uavtool.api.Detection"),
-        ("tests.plugins.detector:raises", 1, "on frame 3 (poi-0) raised ValueError: model weights"),
+        ("tests.plugins.detector:raises", 1, "on frame 3 (top) raised ValueError: model weights"),
         ("tests.plugins.detector:nosuch", 2, "tests.plugins.detector has no function nosuch"),
         ("no_module_here:f", 2, "cannot import no_module_here"),
         ("not a spec", 2, "expected module:function"),

@@ -37,12 +37,12 @@ def test_paper_mission_finds_the_red_building_and_builds_its_model(
     e = summary.evaluation  # type: ignore[attr-defined]
     assert o.status is Status.COMPLETED, o.reason
     assert e.matched_building == "red" == e.target_building
-    # Nearest neighbour from home: purple (north), yellow, blue, then red.
-    assert e.visited == ("purple", "yellow", "blue", "red")
+    # Red alone is of the target's hue: it is visited first, and matches; no other is.
+    assert e.visited == ("red",)
     assert o.model_built
     assert e.model_iou is not None and e.model_iou > 0.85
-    # 2 overviews, 4 looks, top, front, right and a diagonal (red has two tunnels)
-    assert summary.frames == 10  # type: ignore[attr-defined]
+    # 2 overviews, 1 look, top, front, right and a diagonal (red has two tunnels)
+    assert summary.frames == 7  # type: ignore[attr-defined]
 
 
 def test_recording_is_whole_and_replays_identically(paper_flight: tuple[object, Path]) -> None:

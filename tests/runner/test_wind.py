@@ -37,7 +37,7 @@ def test_photos_record_the_pose_they_were_taken_from_in_gusty_wind(
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == summary.evaluation.target_building
     photos = [o for o in load_flight(record).observations if isinstance(o, Photo)]
-    assert len(photos) == len(rendered) >= 10
+    assert len(photos) == len(rendered) >= 7  # 2 overviews, red, top, 3 sides
     for photo, true in zip(photos, rendered, strict=True):
         recorded = photo.pose
         assert math.dist(recorded.pos_enu_m, true.pos_enu_m) < 0.1, photo.tag

@@ -25,7 +25,8 @@ def test_fly_rerun_streams_the_same_entities_as_view(tmp_path: Path) -> None:
     for entity in ("world/scene/ground", "world/vehicle", "world/camera/image", "world/model"):
         assert any(e == entity or e.startswith(entity + "/") for e in entities), entity
     frames = [r for r in data.rows["world/camera/image"] if any("EncodedImage" in k for k in r)]
-    assert len(frames) == 10  # 2 overviews, 4 points of interest, top, front, right, diagonal
+    assert len(frames) == 7  # 2 overviews, red (the only one of the target's hue), top, front,
+    # right, diagonal
     assert blueprint.entities()  # the default layout travels with the stream
 
 
