@@ -114,14 +114,21 @@ def _assert_visited_in_order(flight: Flight, plan: Plan) -> None:
     assert poi_photos == [f"poi-{k}" for k in visited]
 
 
-def test_visit_all_goes_the_shortest_way(visit_all_flight: Flown) -> None:
-    flight = visit_all_flight.flight
+def _plan(flight: Flight) -> tuple[Plan, Point, list[Point]]:
+    """The flight's plan, where it starts (the overview) and its points of interest; the
+    order visits each once, and the route is its length."""
     (plan,) = flight.of_type(Plan)
     start_xyz = _photos(flight)["overview"].pose.pos_enu_m
     start = (start_xyz[0], start_xyz[1])
     points = [poi.pos_en_m for poi in plan.pois]
     assert sorted(plan.order) == list(range(len(points)))
     assert plan.route_m == pytest.approx(_route_m(start, points, plan.order))
+    return plan, start, points
+
+
+def test_visit_all_goes_the_shortest_way(visit_all_flight: Flown) -> None:
+    flight = visit_all_flight.flight
+    plan, start, points = _plan(flight)
     _assert_short(start, points, plan.order)
     _assert_visited_in_order(flight, plan)
 
@@ -131,12 +138,7 @@ def test_the_target_s_colour_is_visited_first_and_alone(paper: Scene, paper_flig
     home), the other three after it by a short way on from it, and once red has matched no
     other is visited."""
     flight = paper_flight.flight
-    (plan,) = flight.of_type(Plan)
-    start_xyz = _photos(flight)["overview"].pose.pos_enu_m
-    start = (start_xyz[0], start_xyz[1])
-    points = [poi.pos_en_m for poi in plan.pois]
-    assert sorted(plan.order) == list(range(len(points)))
-    assert plan.route_m == pytest.approx(_route_m(start, points, plan.order))
+    plan, start, points = _plan(flight)
     names = [_building_at(paper, points[k]) for k in plan.order]
     assert names[0] == "red"
     nearest = min(range(len(points)), key=lambda k: math.dist(start, points[k]))
