@@ -102,15 +102,13 @@ def fly_auto_mission(client: Client, scene: Scene) -> None:
             break
     assert client.wait_for("MISSION_ACK").type == M.MAV_MISSION_ACCEPTED
     assert client.set_mode("GUIDED").result == M.MAV_RESULT_ACCEPTED
-    # As a pilot would: arm once the vehicle's own heartbeat says GUIDED. At 8x a heartbeat
-    # comes every 125 ms of wall time, and the three commands can all be answered between two;
-    # then no link (the recorder's neither) ever saw the vehicle in GUIDED.
+    # Arm after two heartbeats in GUIDED, a second of vehicle time: every link streams its own
+    # 1 Hz heartbeat at its own phase, so one GUIDED heartbeat on this link does not mean the
+    # recorder's link has had one. At 8x the arm and MISSION_START can otherwise both come
+    # between two of its heartbeats, and it rightly logs STABILIZE → AUTO.
     guided = COPTER_MODES["GUIDED"]
-    client.wait_until(
-        lambda c: "HEARTBEAT" in c.latest and c.latest["HEARTBEAT"].custom_mode == guided,
-        timeout=10,
-        what="a heartbeat in GUIDED",
-    )
+    for _ in range(2):
+        client.wait_for("HEARTBEAT", lambda m: m.custom_mode == guided, timeout=10)
     assert client.command(M.MAV_CMD_COMPONENT_ARM_DISARM, 1).result == M.MAV_RESULT_ACCEPTED
     assert client.command(M.MAV_CMD_MISSION_START, 0, 0).result == M.MAV_RESULT_ACCEPTED
     client.wait_until(

@@ -18,8 +18,9 @@ from uavtool.runner.summary import format_summary
 SPEEDUP = 20.0  # the flight takes ~15 s of wall time; the link still loses and reorders
 # The vehicle is wall-paced. On this 2-core machine, with both lossy flights running at once,
 # each took one photo again (8 photos, 412 m) where the clean flight took 7 (389.5 m); alone,
-# a lossy flight flew the clean one's 389.5 m. The decisions and the buildings visited must
-# be the clean flight's; the route within 10 %.
+# a lossy flight flew the clean one's 389.5 m. In CI the clean flight itself once took the 8th
+# (load, not loss, makes the retake). The decisions and the buildings visited must be the
+# clean flight's; the photos within one of its count, the route within 10 %.
 ROUTE_TOLERANCE = 0.10
 
 
@@ -50,7 +51,7 @@ def test_mission_completes_over_a_lossy_reordering_link(
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == "red"
     assert summary.outcome.visited == clean.outcome.visited
-    assert clean.frames <= summary.frames <= clean.frames + 1  # a photo taken again at most
+    assert abs(summary.frames - clean.frames) <= 1  # one photo taken again, in either flight
     assert summary.route_length_m == pytest.approx(clean.route_length_m, rel=ROUTE_TOLERANCE)
     dropped = dict(summary.stale_dropped)
     assert dropped.get("GLOBAL_POSITION_INT", 0) > 0  # reordering happened and was caught
