@@ -193,7 +193,7 @@ def test_a_building_on_a_car_park_beside_a_lawn_is_looked_at_low_enough_to_judge
     own part of the region: the mirror image is looked at from over its roof and ruled
     out, and the target (b06) is found."""
     summary, events = fly_data_scene("world-50217")
-    assert any("as much like the target's mirror image" in e for e in events), events
+    assert any("the target's mirror image" in e for e in events), events
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == summary.evaluation.target_building == "b06"
 

@@ -10,7 +10,7 @@ import pytest
 
 from uavtool.camera import Intrinsics
 from uavtool.mission import Params
-from uavtool.mission.analysis import judge, nadir_shapes, target_shapes
+from uavtool.mission.analysis import Judgement, judge, nadir_shapes, target_shapes
 from uavtool.world.raster import paint_polygon
 
 K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
@@ -35,11 +35,15 @@ def _draw(ring: list[tuple[int, int]], *, turn_deg: float, px_per_unit: float, m
     return image
 
 
-def _decide(ring: list[tuple[int, int]], **pose: float | bool) -> tuple[bool, float, float]:
+def _judge(ring: list[tuple[int, int]], **pose: float | bool) -> Judgement:
     params = Params()
     _, target = target_shapes(params, _draw(ring, turn_deg=0.0, px_per_unit=14.0, mirror=False))
     shapes = nadir_shapes(params, _draw(ring, **pose))  # type: ignore[arg-type]
-    j = judge(params, target, shapes, K)
+    return judge(params, target, shapes, K)
+
+
+def _decide(ring: list[tuple[int, int]], **pose: float | bool) -> tuple[bool, float, float]:
+    j = _judge(ring, **pose)
     return j.matched, j.score, j.mirror_score
 
 
@@ -73,3 +77,23 @@ def test_a_symmetric_target_matches_its_mirror_image() -> None:
     """A rectangle is its own mirror image: the rule does not apply."""
     matched, _, _ = _decide(RECT, turn_deg=40.0, px_per_unit=14.0, mirror=True)
     assert matched
+
+
+@pytest.mark.parametrize("ring", [L_SHAPE, STEP, FLAG], ids=["L", "step", "flag"])
+@pytest.mark.parametrize("px_per_unit", SCALES)
+def test_a_mirror_image_is_told_apart_and_the_target_never_is(
+    ring: list[tuple[int, int]], px_per_unit: float
+) -> None:
+    """Scoring its mirror image well and clearly better than the target, a building is the
+    target's mirror image: another building, not a doubt (the search does not wait on it).
+    The target itself, turned and scaled, never is."""
+    for turn in TURNS:
+        j = _judge(ring, turn_deg=turn, px_per_unit=px_per_unit, mirror=True)
+        assert j.mirror_image, (turn, j.score, j.mirror_score)
+        j = _judge(ring, turn_deg=turn, px_per_unit=px_per_unit, mirror=False)
+        assert not j.mirror_image, (turn, j.score, j.mirror_score)
+
+
+def test_a_symmetric_targets_mirror_image_is_no_other_building() -> None:
+    for turn in TURNS:
+        assert not _judge(RECT, turn_deg=turn, px_per_unit=14.0, mirror=True).mirror_image

@@ -101,6 +101,14 @@ class Judgement:
     """The outlines lie together, but one photo's outline left out a feature (a notch or a
     cut corner drawn under the least edge kept) that the other photo would draw and does
     not (:func:`uavtool.vision.verify.detail_differs`): another footprint."""
+    mirror_image: bool = False
+    """The candidate is the target's mirror image, not the target: judgeable, of the
+    target's hue, its score against the mirror image at the threshold and above its score
+    against the target by the mirror rule's margin and the noise, for a target that differs
+    from its own mirror image by more than noise can blur (twice ``mirror_tolerance``: the
+    target's and its mirror's scores each within it). The mirror rule turned inside out: the
+    target itself loses to its mirror image by no more than noise. A stepped target too: a
+    photo's perspective lowers both scores, it does not draw the target mirrored."""
 
     @property
     def outline_fits(self) -> bool:
@@ -180,6 +188,13 @@ def judge(
     mirrored = mirror_score(target, centre, rp)
     gap = 1.0 - mirror_score(target, target, rp)  # how unlike its mirror image the target is
     not_mirror = score - mirrored >= rp.mirror_margin * gap - rp.mirror_tolerance
+    mirror_image = (
+        judgeable
+        and same_hue
+        and gap > 2.0 * rp.mirror_tolerance
+        and mirrored >= rp.threshold
+        and mirrored - score >= rp.mirror_margin * gap + rp.mirror_tolerance
+    )
     # courtyards are part of the footprint: one more or fewer than the target picture shows
     # is another building, however well the outer outlines agree
     same_holes = len(centre.holes_px) == len(target.holes_px)
@@ -216,6 +231,7 @@ def judge(
         tiers,
         too_small,
         differs,
+        mirror_image,
     )
 
 

@@ -358,7 +358,10 @@ def _doubtful(m: SearchMission, looks: list[_Look]) -> tuple[_Look, bool] | None
       parts stand at several heights (False);
     - or its outline was told apart from the target's only by a look whose outline may
       hold the building's own walls (`_walls_inside`): a wall lit within the vectorizer's
-      shade tolerance of the roof joins the roof's outline (True)."""
+      shade tolerance of the roof joins the roof's outline (True).
+
+    A look that drew it as the target's mirror image (`Judgement.mirror_image`) tells it
+    apart: no doubt."""
     threshold = m.params.recognize.threshold
     least = m.params.mission.recheck_min_score
     judged = [
@@ -368,6 +371,8 @@ def _doubtful(m: SearchMission, looks: list[_Look]) -> tuple[_Look, bool] | None
     ]
     if any(look.judgement.matched for look in judged):
         return None
+    if any(look.judgement.mirror_image for look in judged):
+        return None  # the target's mirror image: another building, whatever it scored
     apart = [look for look in judged if _other_outline(look.judgement)]
     if apart:
         if all(_walls_inside(m, look) for look in apart):
@@ -722,7 +727,7 @@ def _look(
         chosen=chosen,
     )
     if find is not None:  # as small as the look that could not judge it: to measure only
-        j = replace(j, matched=False, judgeable=False, too_small=True)
+        j = replace(j, matched=False, judgeable=False, too_small=True, mirror_image=False)
     m.emit(
         Recognition(photo.frame_index, k, j.scores, j.candidate, j.score, j.matched, j.mirror_score)
     )
@@ -733,6 +738,8 @@ def _look(
         why = "; drawn too small here to tell the target's outline, not judged"
     elif not j.judgeable:
         why = "; outline cut by the image border, not judged"
+    elif j.mirror_image:
+        why = f"; the target's mirror image, scored {j.mirror_score:.3f}: another building"
     elif not j.not_mirror and j.score >= m.params.recognize.threshold:
         why = f"; as much like the target's mirror image: {j.mirror_score:.3f}"
     elif j.stepped:
