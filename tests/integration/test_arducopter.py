@@ -59,7 +59,8 @@ def test_with_a_mount_the_mission_completes_and_every_photo_is_where_its_pose_sa
         result = _fly(port, tmp_path)
     assert result.returncode == 0, result.stdout + result.stderr
     assert "outcome        completed" in result.stdout
-    check_photo_poses(tmp_path / "f.mcap", at_least=9)
+    # two overviews, the look at red (the target's hue first), the top, front, right, diagonal
+    check_photo_poses(tmp_path / "f.mcap", at_least=7)
 
 
 def test_a_vehicle_elsewhere_flies_the_scene_at_its_home(tmp_path: Path) -> None:

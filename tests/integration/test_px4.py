@@ -66,7 +66,8 @@ def test_with_a_gimbal_the_mission_completes_and_every_photo_is_where_its_pose_s
     assert "(PX4)" in result.stdout + result.stderr
     assert "outcome        completed" in result.stdout
     assert "correct: the target is 'red'" in result.stdout
-    check_photo_poses(tmp_path / "f.mcap", at_least=9)
+    # two overviews, the look at red (the target's hue first), the top, front, right, diagonal
+    check_photo_poses(tmp_path / "f.mcap", at_least=7)
 
 
 def test_without_a_gimbal_no_gimbal_flies_the_search(tmp_path: Path) -> None:
