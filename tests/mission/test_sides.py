@@ -138,3 +138,23 @@ def test_a_building_a_look_down_shows_beside_a_viewpoint_is_planned_around(
     assert summary.outcome.status in (Status.COMPLETED, Status.PARTIAL), summary.outcome.reason
     assert "no front" not in summary.outcome.reason
     assert summary.evaluation.matched_building == summary.evaluation.target_building
+
+
+def test_a_side_that_only_its_roof_line_shows_over_its_neighbours_is_photographed() -> None:
+    """World scene 50102: the target (b03, a 22.8 m courtyard L) stands among neighbours as
+    tall as it (22.8 m) and others whose height no photo measured. From no side does a
+    camera within the pitch limit see the upper half of its walls over them, and the flight
+    ended without a right photo, so without a model. The model carves nothing below what a
+    side photo sees of the building: a camera that sees its roof line over the neighbours
+    is planned last, and the model is built (IoU 0.99 here)."""
+    summary, events = fly_data_scene("world-50102")
+    o, e = summary.outcome, summary.evaluation
+    assert o.status is Status.COMPLETED, o.reason
+    assert e.matched_building == e.target_building == "b03"
+    assert any(
+        ev.startswith("right viewpoint:") and ev.endswith("over its neighbours to its roof line")
+        for ev in events
+    ), events
+    assert "right photo: the building's foot is hidden behind its neighbours" in events
+    assert e.model_iou is not None and e.model_iou > 0.9
+    assert summary.clearance_m is not None and summary.clearance_m > 4.0

@@ -378,6 +378,38 @@ def test_walls_round_a_building_are_seen_over_from_as_high_as_needed() -> None:
                 assert _clear((x, y, z), (cx, cy, at), walls, heights)
 
 
+def test_walls_hiding_half_of_a_building_leave_its_roof_line_to_be_seen() -> None:
+    """The 12 m box inside a ring of 11.5 m walls a metre from its sides: within the pitch
+    limit no camera sees half its walls' height over them (worlds 50088, 50102: a neighbour
+    as tall as the target beside it, and no side photo was planned). The model carves
+    nothing below what a photo sees, so asked to (``roof_line``), a last round plans a
+    camera that sees every roof corner over the walls; its fallback says so."""
+    walls = [
+        [(-7.0, -6.0), (7.0, -6.0), (7.0, -5.0), (-7.0, -5.0)],
+        [(-7.0, 5.0), (7.0, 5.0), (7.0, 6.0), (-7.0, 6.0)],
+        [(-7.0, -5.0), (-6.0, -5.0), (-6.0, 5.0), (-7.0, 5.0)],
+        [(6.0, -5.0), (7.0, -5.0), (7.0, 5.0), (6.0, 5.0)],
+    ]
+    heights = [11.5] * 4
+    front, right = plan_viewpoints(BOX, walls, K, P, heights)
+    assert isinstance(front, ViewpointFailure) and isinstance(right, ViewpointFailure)
+    front, right = plan_viewpoints(BOX, walls, K, P, heights, roof_line=True)
+    tall = P.assumed_height_m
+    for vp in (front, right):
+        assert isinstance(vp, Viewpoint), vp
+        assert "over its neighbours to its roof line" in vp.fallback
+        assert -P.max_pitch_down_deg <= vp.pitch_deg < 0.0
+        x, y, z = vp.pos_enu_m
+        assert all(point_polygon_distance((x, y), w) >= P.safety_margin_m for w in walls)
+        near = [c for c in BOX.corners() if math.dist(c, (x, y)) < math.dist(BOX.center_en, (x, y))]
+        assert all(_clear((x, y, z), (cx, cy, tall), walls, heights) for cx, cy in near)
+        assert not all(_clear((x, y, z), (cx, cy, tall / 2.0), walls, heights) for cx, cy in near)
+    # walls taller than the building: not even its roof line shows over them
+    front, right = plan_viewpoints(BOX, walls, K, P, [tall + 20.0] * 4, roof_line=True)
+    assert isinstance(front, ViewpointFailure) and isinstance(right, ViewpointFailure)
+    assert "over its neighbours to its roof line: no line of sight" in front.reason
+
+
 def test_a_tower_too_tall_for_the_distance_limit_is_planned_from_farther() -> None:
     """A 57 m tower: a level camera halfway up must stand 82.7 m off to hold it with the
     margin, beyond the 60 m limit, so no level view is planned. ``farther`` stretches the

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from uavtool.mission.analysis import aimed_shape, judge, roof_between
 from uavtool.mission.observations import Photo
@@ -45,6 +45,7 @@ from uavtool.vision.model3d import (
 )
 
 if TYPE_CHECKING:
+    from uavtool.camera import Intrinsics
     from uavtool.mission.base import Wait
     from uavtool.mission.mission import SearchMission
 
@@ -95,6 +96,27 @@ def still_the_target(
         f"point of interest {found.poi.index} matched, but the top photo, closer, shows it "
         f"{why}: not the target",
     )
+
+
+def _roof_line(
+    rect: Rect,
+    obstacles: list[Any],
+    k: Intrinsics,
+    params: ViewpointParams,
+    heights: list[float],
+    apart: float,
+    planned: tuple[Viewpoint | ViewpointFailure, Viewpoint | ViewpointFailure],
+) -> tuple[Viewpoint | ViewpointFailure, Viewpoint | ViewpointFailure]:
+    """``planned``, or where a side has no viewpoint that sees the upper half of the walls
+    over the neighbours, one that sees the roof line over them (`plan_viewpoints`'
+    ``roof_line``): a coarser model than none. A front planned stays; a right planned
+    stays unless the front was not."""
+    if not any(isinstance(v, ViewpointFailure) for v in planned):
+        return planned
+    again = plan_viewpoints(rect, obstacles, k, params, heights, apart, roof_line=True)
+    if isinstance(planned[0], Viewpoint):  # the same front: the right is apart from it
+        return planned[0], again[1]
+    return again  # a new front: the right apart from it
 
 
 def photograph_and_model(
@@ -198,6 +220,9 @@ def photograph_and_model(
         )
         if sum(isinstance(v, ViewpointFailure) for v in (front_far, right_far)) < failed:
             front, right, vp_params = front_far, right_far, far
+    front, right = _roof_line(
+        rect, obstacles, top_photo.intrinsics, vp_params, heights, apart, (front, right)
+    )
     m.viewpoints = Viewpoints(footprint, top, front, right)
     m.emit(m.viewpoints)
 
@@ -271,6 +296,15 @@ def photograph_and_model(
                 sides.heights += [math.inf] * len(below)
             again = plan_viewpoints(
                 rect, sides.obstacles, top_photo.intrinsics, sides.params, sides.heights, apart
+            )
+            again = _roof_line(
+                rect,
+                sides.obstacles,
+                top_photo.intrinsics,
+                sides.params,
+                sides.heights,
+                apart,
+                again,
             )
             planned = {"front": taken.get("front", again[0]), "right": again[1]}
             m.event(

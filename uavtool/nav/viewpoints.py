@@ -36,6 +36,21 @@ from uavtool.nav.rect import Rect
 _OPPOSITE = {"long-a": "long-b", "long-b": "long-a", "short-a": "short-b", "short-b": "short-a"}
 
 
+def _stages(heights: Sequence[float] | None, *, roof_line: bool) -> tuple[tuple[bool, bool], ...]:
+    """The rounds of cameras turned round or looking down, as ``(rise, roof_only)``: each at
+    its lowest; with ``heights``, then rising to see over lower neighbours; with
+    ``roof_line`` too, last rising until it sees every roof corner over them, no more. The
+    model carves nothing below what a side photo sees of the building
+    (`uavtool.vision.model3d.View.foot_hidden`), so a photo of its roof line alone still
+    carves its roof's outline; the lower walls it does not show are left standing, bounded
+    by the top photo's footprint (a coarser model, never a wrong one)."""
+    if heights is None:
+        return ((False, False),)
+    if not roof_line:
+        return ((False, False), (True, False))
+    return ((False, False), (True, False), (True, True))
+
+
 @dataclass(frozen=True, slots=True)
 class ViewpointParams:
     """Parameters of :func:`plan_viewpoints`; lengths in metres."""
@@ -212,6 +227,8 @@ def _plan_one(
     params: ViewpointParams,
     heights: Sequence[float] | None = None,
     apart_from: tuple[float, float] | None = None,
+    *,
+    roof_line: bool = False,
 ) -> Viewpoint | ViewpointFailure:
     """Try the first side, then the opposite one, at growing distances; first clear wins.
     ``apart_from``: (heading, least separation), both degrees: a camera turned round the
@@ -258,11 +275,20 @@ def _plan_one(
     base_too_far = not tried
     # Every camera turned round or looking down at its lowest first; only then one that
     # rises higher to see over lower neighbours (steeper, it sees less of the walls).
-    for rise in (False, True) if heights is not None else (False,):
+    for rise, roof_only in _stages(heights, roof_line=roof_line):
         for offset in params.oblique_deg if not base_too_far else ():  # none fit: say so below
             for side in (first_side, _OPPOSITE[first_side]):
                 found = _oblique(
-                    name, rect, side, offset, obstacles, intrinsics, params, heights, rise=rise
+                    name,
+                    rect,
+                    side,
+                    offset,
+                    obstacles,
+                    intrinsics,
+                    params,
+                    heights,
+                    rise=rise,
+                    roof_only=roof_only,
                 )
                 if isinstance(found, Viewpoint) and apart_from is not None:
                     apart = _apart_deg(found.heading_deg, apart_from[0])
@@ -295,6 +321,7 @@ def _plan_one(
                     params,
                     heights,
                     rise=rise,
+                    roof_only=roof_only,
                 )
                 if isinstance(found, Viewpoint):
                     return found
@@ -318,13 +345,15 @@ def _looking_down(
     heights: Sequence[float] | None = None,
     *,
     rise: bool = False,
+    roof_only: bool = False,
 ) -> Viewpoint | str:
     """A camera out along ``normal`` from ``mid`` (the middle of the near wall) that rises
     and looks down (:func:`tilted_cameras`), at the first distance from the horizontal need
     (``across_m`` wide) or the safety margin, growing, where it keeps the margin and sees
     the points ``seen`` (the wall's ends, or every corner; with ``heights``, from their tops
-    down to half their height) past the obstacles, at its lowest altitude (with ``rise``, at
-    the lowest altitude that does); else what stopped it. Without ``heights`` the obstacles
+    down to half their height, or with ``roof_only`` their tops alone) past the obstacles,
+    at its lowest altitude (with ``rise``, at the lowest altitude that does); else what
+    stopped it. Without ``heights`` the obstacles
     are as tall as any (a level camera's rule); with them (``math.inf``: unknown), the
     camera may see the building's top over a lower obstacle, its lower part hidden
     (:func:`foot_hidden` says so)."""
@@ -351,13 +380,13 @@ def _looking_down(
                 )
             else:
                 # The upper half of the walls, whose silhouette the model is carved from: a
-                # photo that sees only their tops shows a sliver.
+                # photo that sees only their tops shows a sliver. Last, the roof line alone.
                 tall = params.assumed_height_m
                 hidden = any(
                     _sight_blocked((cam[0], cam[1], z), (q[0], q[1], at), poly, h)
                     for poly, h in zip(obstacles, heights, strict=True)
                     for q in seen
-                    for at in (tall, tall / 2.0)
+                    for at in ((tall,) if roof_only else (tall, tall / 2.0))
                 )
             if not hidden:
                 return Viewpoint(
@@ -371,13 +400,15 @@ def _looking_down(
                         f"looking down {-pitch:.0f}° from {z:.1f} m"
                         if pitch < 0.0
                         else f"level from {z:.1f} m, {distance:.1f} m off"
-                    ),
+                    )
+                    + (", over its neighbours to its roof line" if roof_only else ""),
                     pitch_deg=pitch,
                 )
             why = "no line of sight"
             if heights is None or not rise:
                 break  # the lowest only (obstacles as tall as any: none sees over them)
-    return f"{side} looking down{', rising' if rise else ''}: {why}"
+    over = ", over its neighbours to its roof line" if roof_only else ""
+    return f"{side} looking down{', rising' if rise else ''}{over}: {why}"
 
 
 def _sight_blocked(
@@ -445,6 +476,7 @@ def _oblique(
     heights: Sequence[float] | None = None,
     *,
     rise: bool = False,
+    roof_only: bool = False,
 ) -> Viewpoint | str:
     """A camera on ``side``'s normal turned ``offset_deg`` around the building's centre, at
     the first distance (growing as square-on ones do) where it keeps the safety margin and
@@ -467,6 +499,7 @@ def _oblique(
         params,
         heights,
         rise=rise,
+        roof_only=roof_only,
     )
     if isinstance(found, Viewpoint):
         return found
@@ -485,6 +518,7 @@ def _from_direction(
     heights: Sequence[float] | None = None,
     *,
     rise: bool = False,
+    roof_only: bool = False,
 ) -> Viewpoint | str:
     """A camera out from the rectangle's centre along the unit vector ``u``, looking back at
     it, at the first distance (growing as square-on ones do) where it keeps the safety
@@ -541,6 +575,7 @@ def _from_direction(
         params,
         heights,
         rise=rise,
+        roof_only=roof_only,
     )
     if isinstance(down, Viewpoint):
         return dataclasses.replace(down, fallback=f"{label}, {down.fallback}")
@@ -560,6 +595,8 @@ def plan_viewpoints(
     params: ViewpointParams | None = None,
     heights: Sequence[float] | None = None,
     min_apart_deg: float = 0.0,
+    *,
+    roof_line: bool = False,
 ) -> tuple[Viewpoint | ViewpointFailure, Viewpoint | ViewpointFailure]:
     """The front and right viewpoints of ``target``, clear of ``obstacles``.
 
@@ -570,7 +607,8 @@ def plan_viewpoints(
     then both sides at distances grown by ``distance_step`` up to ``max_distance_m``, then
     cameras turned round the building, last cameras that rise and look down at it. With
     ``heights`` (each obstacle's, ``math.inf`` where unknown) a camera looking down may see
-    the building's top over lower obstacles.
+    the building's top over lower obstacles: the upper half of its walls; with
+    ``roof_line``, last its roof line alone (`_stages`).
     When the front has no position, the right photo is planned against the first-choice
     front heading. A right camera turned round the building looks at least
     ``min_apart_deg`` away from the front camera's direction (the model's
@@ -578,13 +616,17 @@ def plan_viewpoints(
     """
     params = params or ViewpointParams()
     polys = [as_points(p, what=f"obstacles[{i}]") for i, p in enumerate(obstacles)]
-    front = _plan_one("front", target, "long-a", polys, intrinsics, params, heights)
+    front = _plan_one(
+        "front", target, "long-a", polys, intrinsics, params, heights, roof_line=roof_line
+    )
     front_side = front.side if isinstance(front, Viewpoint) else "long-a"
     # long-a looks along θ − 90, so its right camera looks along θ − 180: it faces short-a
     # (outward normal θ); symmetrically long-b → short-b.
     right_side = "short-a" if front_side == "long-a" else "short-b"
     apart = (front.heading_deg, min_apart_deg) if isinstance(front, Viewpoint) else None
-    right = _plan_one("right", target, right_side, polys, intrinsics, params, heights, apart)
+    right = _plan_one(
+        "right", target, right_side, polys, intrinsics, params, heights, apart, roof_line=roof_line
+    )
     return front, right
 
 
@@ -597,20 +639,33 @@ def plan_towards(
     params: ViewpointParams,
     label: str,
     heights: Sequence[float] | None = None,
+    *,
+    roof_line: bool = False,
 ) -> Viewpoint | ViewpointFailure:
     """A camera out from ``target``'s centre along ``direction_en`` (east, north; any
     length), looking back at it, at the first distance where it keeps the safety margin and
     sees every corner past the obstacles (``label`` becomes its ``fallback`` note); with
-    ``heights``, last one that rises higher to see over lower ones."""
+    ``heights``, last one that rises higher to see over lower ones (with ``roof_line``, up
+    to where it sees only the roof line over them)."""
     n = math.hypot(*direction_en)
     if not n > 0.0:
         return ViewpointFailure(name, f"{name}: no direction to look from")
     polys = [as_points(p, what=f"obstacles[{i}]") for i, p in enumerate(obstacles)]
     u = (direction_en[0] / n, direction_en[1] / n)
     found: Viewpoint | str = ""
-    for rise in (False, True) if heights is not None else (False,):
+    for rise, roof_only in _stages(heights, roof_line=roof_line):
         found = _from_direction(
-            name, target, u, name, label, polys, intrinsics, params, heights, rise=rise
+            name,
+            target,
+            u,
+            name,
+            label,
+            polys,
+            intrinsics,
+            params,
+            heights,
+            rise=rise,
+            roof_only=roof_only,
         )
         if isinstance(found, Viewpoint):
             return found
