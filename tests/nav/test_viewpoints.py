@@ -353,18 +353,24 @@ def _clear(
     return True
 
 
+def _ring(*, gap_m: float, thick_m: float) -> list[list[tuple[float, float]]]:
+    """Four walls round BOX, ``gap_m`` from its sides and ``thick_m`` thick."""
+    x, y, t = 5.0 + gap_m, 4.0 + gap_m, thick_m
+    return [
+        [(-x - t, -y - t), (x + t, -y - t), (x + t, -y), (-x - t, -y)],
+        [(-x - t, y), (x + t, y), (x + t, y + t), (-x - t, y + t)],
+        [(-x - t, -y), (-x, -y), (-x, y), (-x - t, y)],
+        [(x, -y), (x + t, -y), (x + t, y), (x, y)],
+    ]
+
+
 def test_walls_round_a_building_are_seen_over_from_as_high_as_needed() -> None:
     """The 12 m box inside a ring of 9 m walls 8 m out from its sides, 2 m thick: no level
     camera sees it, and the lowest camera that holds the box looking down sees only the top
     of its walls over them. The camera rises until it sees every corner of its side from
     the top down to half the box's height (the silhouette the model is carved from), never
     steeper than ``max_pitch_down_deg``, and keeps the safety margin from the walls."""
-    walls = [
-        [(-15.0, -14.0), (15.0, -14.0), (15.0, -12.0), (-15.0, -12.0)],
-        [(-15.0, 12.0), (15.0, 12.0), (15.0, 14.0), (-15.0, 14.0)],
-        [(-15.0, -12.0), (-13.0, -12.0), (-13.0, 12.0), (-15.0, 12.0)],
-        [(13.0, -12.0), (15.0, -12.0), (15.0, 12.0), (13.0, 12.0)],
-    ]
+    walls = _ring(gap_m=8.0, thick_m=2.0)
     heights = [9.0] * 4
     front, right = plan_viewpoints(BOX, walls, K, P, heights)
     for vp in (front, right):
@@ -384,12 +390,7 @@ def test_walls_hiding_half_of_a_building_leave_its_roof_line_to_be_seen() -> Non
     as tall as the target beside it, and no side photo was planned). The model carves
     nothing below what a photo sees, so asked to (``roof_line``), a last round plans a
     camera that sees every roof corner over the walls; its fallback says so."""
-    walls = [
-        [(-7.0, -6.0), (7.0, -6.0), (7.0, -5.0), (-7.0, -5.0)],
-        [(-7.0, 5.0), (7.0, 5.0), (7.0, 6.0), (-7.0, 6.0)],
-        [(-7.0, -5.0), (-6.0, -5.0), (-6.0, 5.0), (-7.0, 5.0)],
-        [(6.0, -5.0), (7.0, -5.0), (7.0, 5.0), (6.0, 5.0)],
-    ]
+    walls = _ring(gap_m=1.0, thick_m=1.0)
     heights = [11.5] * 4
     front, right = plan_viewpoints(BOX, walls, K, P, heights)
     assert isinstance(front, ViewpointFailure) and isinstance(right, ViewpointFailure)

@@ -276,19 +276,11 @@ def _plan_one(
     # Every camera turned round or looking down at its lowest first; only then one that
     # rises higher to see over lower neighbours (steeper, it sees less of the walls).
     for rise, roof_only in _stages(heights, roof_line=roof_line):
+        how = {"rise": rise, "roof_only": roof_only}
         for offset in params.oblique_deg if not base_too_far else ():  # none fit: say so below
             for side in (first_side, _OPPOSITE[first_side]):
                 found = _oblique(
-                    name,
-                    rect,
-                    side,
-                    offset,
-                    obstacles,
-                    intrinsics,
-                    params,
-                    heights,
-                    rise=rise,
-                    roof_only=roof_only,
+                    name, rect, side, offset, obstacles, intrinsics, params, heights, **how
                 )
                 if isinstance(found, Viewpoint) and apart_from is not None:
                     apart = _apart_deg(found.heading_deg, apart_from[0])
@@ -309,20 +301,9 @@ def _plan_one(
                 depth = rect.width_m if side.startswith("long") else rect.length_m
                 mid = ((end1[0] + end2[0]) / 2.0, (end1[1] + end2[1]) / 2.0)
                 found = _looking_down(
-                    name,
-                    side,
-                    mid,
-                    (end1, end2),
-                    normal,
-                    depth,
-                    side_len,
-                    obstacles,
-                    intrinsics,
-                    params,
-                    heights,
-                    rise=rise,
-                    roof_only=roof_only,
-                )
+                    name, side, mid, (end1, end2), normal, depth, side_len,
+                    obstacles, intrinsics, params, heights, **how,
+                )  # fmt: skip
                 if isinstance(found, Viewpoint):
                     return found
                 tried.append(found)
