@@ -107,16 +107,13 @@ def _roof_line(
     apart: float,
     planned: tuple[Viewpoint | ViewpointFailure, Viewpoint | ViewpointFailure],
 ) -> tuple[Viewpoint | ViewpointFailure, Viewpoint | ViewpointFailure]:
-    """``planned``, or where a side has no viewpoint that sees the upper half of the walls
-    over the neighbours, one that sees the roof line over them (`plan_viewpoints`'
-    ``roof_line``): a coarser model than none. A front planned stays; a right planned
-    stays unless the front was not."""
+    """``planned`` (by `plan_viewpoints` on these arguments), or where a side has no
+    viewpoint that sees the upper half of the walls over the neighbours, planned again
+    with one that sees the roof line over them as the last round (``roof_line``): a coarser
+    model than none. A side planned is planned the same again."""
     if not any(isinstance(v, ViewpointFailure) for v in planned):
         return planned
-    again = plan_viewpoints(rect, obstacles, k, params, heights, apart, roof_line=True)
-    if isinstance(planned[0], Viewpoint):  # the same front: the right is apart from it
-        return planned[0], again[1]
-    return again  # a new front: the right apart from it
+    return plan_viewpoints(rect, obstacles, k, params, heights, apart, roof_line=True)
 
 
 def photograph_and_model(
@@ -298,14 +295,9 @@ def photograph_and_model(
                 rect, sides.obstacles, top_photo.intrinsics, sides.params, sides.heights, apart
             )
             again = _roof_line(
-                rect,
-                sides.obstacles,
-                top_photo.intrinsics,
-                sides.params,
-                sides.heights,
-                apart,
+                rect, sides.obstacles, top_photo.intrinsics, sides.params, sides.heights, apart,
                 again,
-            )
+            )  # fmt: skip
             planned = {"front": taken.get("front", again[0]), "right": again[1]}
             m.event(
                 Level.INFO,

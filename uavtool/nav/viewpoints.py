@@ -620,33 +620,21 @@ def plan_towards(
     params: ViewpointParams,
     label: str,
     heights: Sequence[float] | None = None,
-    *,
-    roof_line: bool = False,
 ) -> Viewpoint | ViewpointFailure:
     """A camera out from ``target``'s centre along ``direction_en`` (east, north; any
     length), looking back at it, at the first distance where it keeps the safety margin and
     sees every corner past the obstacles (``label`` becomes its ``fallback`` note); with
-    ``heights``, last one that rises higher to see over lower ones (with ``roof_line``, up
-    to where it sees only the roof line over them)."""
+    ``heights``, last one that rises higher to see over lower ones."""
     n = math.hypot(*direction_en)
     if not n > 0.0:
         return ViewpointFailure(name, f"{name}: no direction to look from")
     polys = [as_points(p, what=f"obstacles[{i}]") for i, p in enumerate(obstacles)]
     u = (direction_en[0] / n, direction_en[1] / n)
     found: Viewpoint | str = ""
-    for rise, roof_only in _stages(heights, roof_line=roof_line):
+    for rise, roof_only in _stages(heights, roof_line=False):
+        how = {"rise": rise, "roof_only": roof_only}
         found = _from_direction(
-            name,
-            target,
-            u,
-            name,
-            label,
-            polys,
-            intrinsics,
-            params,
-            heights,
-            rise=rise,
-            roof_only=roof_only,
+            name, target, u, name, label, polys, intrinsics, params, heights, **how
         )
         if isinstance(found, Viewpoint):
             return found
