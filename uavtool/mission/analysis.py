@@ -25,12 +25,11 @@ from uavtool.nav.heights import (
 from uavtool.vision import Shape, best_match, mirror_score, vectorize
 from uavtool.vision.merge import merge_touching
 from uavtool.vision.model3d import central_shape
-from uavtool.vision.shapes import edge_lengths_px, perimeter
+from uavtool.vision.shapes import perimeter
 from uavtool.vision.vectorize import ground_mask, hue_distance_deg, inner_walls
 from uavtool.vision.verify import (
     detail_differs,
     hides_detail,
-    kept_edge_px,
     outline_accuracy_px,
     outline_gap,
     outline_tolerance,
@@ -180,8 +179,11 @@ def judge(
     if judgeable and not too_small and same_hue and not target_stepped and score < rp.threshold:
         # corners under the threshold rule a building of the target's hue out only where
         # every edge of the target would be kept: one edge lost turns the target's own
-        # corners into another sequence (world 50076: the target, 16 px across, scored 0)
-        too_small = edge_share(target, shortest=True) * size < kept_edge_px(params.vectorize)
+        # corners into another sequence (world 50076: the target, 16 px across, scored 0).
+        # The colour classes' median filter rounds each corner, shortening an edge by up to
+        # half its aperture at either end.
+        kept = least + max(params.vectorize.denoise_px - 1, 0)
+        too_small = edge_share(target, shortest=True) * size < kept
     judgeable = judgeable and not too_small
     mirrored = mirror_score(target, centre, rp)
     gap = 1.0 - mirror_score(target, target, rp)  # how unlike its mirror image the target is
@@ -200,7 +202,7 @@ def judge(
     # its corners are the target's, but does its outline leave out (`Shape.detail_px`) what
     # the target picture would draw as an edge? A notch or a cut corner drawn too small to
     # keep may be what makes it another building: not judged from here, a closer look may
-    if matched and hides_detail(target, centre, least, kept_edge_px(params.vectorize)):
+    if matched and hides_detail(target, centre, params.vectorize.min_edge_px):
         matched, judgeable, too_small = False, False, True
     outline, tolerance, tiers, differs = 0.0, 0.0, False, False
     if matched:
@@ -213,7 +215,7 @@ def judge(
             accuracy = outline_accuracy_px(params.vectorize)
             outline = outline_gap(target, centre, matches[candidate])
             tolerance = outline_tolerance(target, centre, accuracy, accuracy)
-            differs = detail_differs(target, centre, kept_edge_px(params.vectorize))
+            differs = detail_differs(target, centre)
             matched = outline <= tolerance and not differs
     return Judgement(
         scores,
@@ -245,7 +247,12 @@ def quartile_edge_share(shape: Shape) -> float:
 def edge_share(shape: Shape, *, shortest: bool) -> float:
     """The shortest (or, not ``shortest``, the lower quartile) of the edges of ``shape``'s
     outline, holes included, over the square root of its area."""
-    edges = edge_lengths_px(shape)
+    edges = sorted(
+        float(e)
+        for ring in (shape.polygon_px, *shape.holes_px)
+        if len(ring) >= 2
+        for e in np.hypot(*np.diff(np.vstack([ring, ring[:1]]), axis=0).T)
+    )
     if not edges:
         return 0.0
     edge = edges[0] if shortest else edges[(len(edges) - 1) // 4]

@@ -116,16 +116,6 @@ def perimeter(ring: FloatArray) -> float:
     return math.fsum(np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]).tolist())
 
 
-def edge_lengths_px(shape: Shape) -> list[float]:
-    """The lengths of the edges of ``shape``'s outline, holes included, shortest first."""
-    return sorted(
-        float(e)
-        for ring in (shape.polygon_px, *shape.holes_px)
-        if len(ring) >= 2
-        for e in np.hypot(*np.diff(np.vstack([ring, ring[:1]]), axis=0).T)
-    )
-
-
 EDGE_PX = 1.0  # an outline this close to the frame's edge touches it
 
 

@@ -26,13 +26,11 @@ import shapely
 
 from uavtool.vision.align import Match
 from uavtool.vision.params import VectorizeParams
-from uavtool.vision.shapes import STAIRCASE_PX, FloatArray, Shape, edge_lengths_px
+from uavtool.vision.shapes import STAIRCASE_PX, FloatArray, Shape
 
 __all__ = [
     "detail_differs",
     "hides_detail",
-    "keeps_every_corner",
-    "kept_edge_px",
     "outline_accuracy_px",
     "outline_fits",
     "outline_gap",
@@ -88,9 +86,7 @@ LEGS_PER_DETAIL = 2.0
 `hides_detail`)."""
 
 
-def hides_detail(
-    reference: Shape, candidate: Shape, reference_min_edge_px: float, candidate_kept_px: float
-) -> bool:
+def hides_detail(reference: Shape, candidate: Shape, reference_min_edge_px: float) -> bool:
     """Whether ``candidate``'s outline leaves out (``Shape.detail_px``) a feature the
     reference's photo would have drawn as an edge of its outline: at least
     ``reference_min_edge_px`` long at the reference's scale (a notch or a cut corner this
@@ -103,47 +99,17 @@ def hides_detail(
     kept, the most length for the least detail of any corner cut (a square notch of side
     ``k`` leaves out ``k``). A candidate drawn at least as large as the reference hides
     nothing from it: what its outline left out, the reference's, drawn smaller by the same
-    vectorizer, leaves out too.
-
-    Nor does a candidate drawn smaller whose photo would draw every corner the reference's
-    does (`keeps_every_corner`): what it left out is then a feature the reference lacks, or
-    nothing, and `detail_differs` tells which."""
+    vectorizer, leaves out too."""
     if candidate.detail_px <= 0.0:
         return False
     drawn = math.sqrt(max(candidate.area_px, 0.0))
     scale = math.sqrt(max(reference.area_px, 0.0))
-    if drawn >= scale or keeps_every_corner(reference, candidate, candidate_kept_px):
+    if drawn >= scale:
         return False
     return LEGS_PER_DETAIL * candidate.detail_px * scale >= reference_min_edge_px * drawn
 
 
-def keeps_every_corner(reference: Shape, candidate: Shape, candidate_kept_px: float) -> bool:
-    """Whether ``candidate``'s photo, were it of the reference's footprint, would draw every
-    corner the reference's outline has and leave out nothing: the reference's outline left
-    out nothing (`STAIRCASE_PX`), and its shortest edge, at the candidate's scale, is at
-    least ``candidate_kept_px`` long (what the candidate's vectorizer keeps whatever its
-    turn, `kept_edge_px`)."""
-    edges = edge_lengths_px(reference)
-    drawn = math.sqrt(max(candidate.area_px, 0.0))
-    scale = math.sqrt(max(reference.area_px, 0.0))
-    return (
-        bool(edges)
-        and scale > 0.0
-        and reference.left_out_px <= STAIRCASE_PX
-        and edges[0] * drawn >= candidate_kept_px * scale
-    )
-
-
-def kept_edge_px(params: VectorizeParams) -> float:
-    """How long an edge the vectorizer keeps whatever its turn: ``min_edge_px``, and the
-    colour classes' median filter rounds each corner, shortening an edge by up to half its
-    aperture at either end."""
-    return params.min_edge_px + max(params.denoise_px - 1, 0)
-
-
-def detail_differs(
-    reference: Shape, candidate: Shape, candidate_kept_px: float | None = None
-) -> bool:
+def detail_differs(reference: Shape, candidate: Shape) -> bool:
     """Whether one photo's outline left out a feature (``Shape.left_out_px`` beyond the
     pixel grid's `STAIRCASE_PX`: a notch or a cut corner drawn under the least edge kept)
     that the other photo, were it of the same footprint, would draw and does not: the other
@@ -151,25 +117,12 @@ def detail_differs(
     feature, carried to its scale (the ratio of the two shapes' ``sqrt(area)``), would stand
     beyond its staircase. When both left something out they may have left out the same
     feature, drawn apart by each photo's perspective (a step between a building's tiers):
-    its size then tells nothing.
-
-    A candidate drawn smaller whose photo would draw every corner the reference's does
-    (`keeps_every_corner`, given what the candidate's vectorizer keeps,
-    ``candidate_kept_px``) would stray from its outline by nothing either: a short step it
-    kept counts as much as what it left out (``Shape.detail_px``), for the reference has no
-    edge that short there."""
+    its size then tells nothing."""
     scale = math.sqrt(max(reference.area_px, 0.0))
     drawn = math.sqrt(max(candidate.area_px, 0.0))
     if not (scale > 0.0 and drawn > 0.0):
         return False
-    strays = candidate.left_out_px
-    if (
-        candidate_kept_px is not None
-        and drawn < scale
-        and keeps_every_corner(reference, candidate, candidate_kept_px)
-    ):
-        strays = candidate.detail_px
-    return _missing(strays, reference.left_out_px, scale / drawn) or _missing(
+    return _missing(candidate.left_out_px, reference.left_out_px, scale / drawn) or _missing(
         reference.left_out_px, candidate.left_out_px, drawn / scale
     )
 
@@ -197,10 +150,7 @@ def outline_fits(
     does not (`detail_differs`)."""
     p = params if params is not None else VectorizeParams()
     q = reference_params if reference_params is not None else p
-    kept = kept_edge_px(p)
-    if hides_detail(reference, candidate, q.min_edge_px, kept) or detail_differs(
-        reference, candidate, kept
-    ):
+    if hides_detail(reference, candidate, q.min_edge_px) or detail_differs(reference, candidate):
         return False
     tolerance = outline_tolerance(
         reference, candidate, outline_accuracy_px(p), outline_accuracy_px(q)
