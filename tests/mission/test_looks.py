@@ -432,3 +432,70 @@ def test_a_roof_drawn_too_small_to_place_by_its_outline_is_measured_by_lining_ph
     assert any("drawn too small to judge; its roof measured" in e for e in events), events
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == summary.evaluation.target_building == "b00"
+
+
+NOTCHED = {
+    "target": "z",
+    "ground": {"color": [55, 102, 32]},
+    "lighting": {"sun_azimuth_deg": 55.3, "sun_elevation_deg": 66.6, "ambient": 0.72},
+    "buildings": [
+        {
+            "name": "z",
+            "color": [217, 54, 171],
+            "blocks": [
+                {
+                    "footprint": [
+                        [-27.86, 1.9], [-25.75, -7.42], [-13.18, -4.58], [-13.67, -2.41],
+                        [-21.2, -4.11], [-22.27, 0.65], [-14.74, 2.35], [-15.28, 4.74],
+                    ],
+                    "top_m": 13.0,
+                }
+            ],
+        },
+        {
+            "name": "notched",
+            "color": [217, 54, 171],
+            "blocks": [
+                {
+                    "footprint": [
+                        [26.43, -31.97], [20.59, -24.41], [10.8, -31.98], [11.11, -32.39],
+                        [10.7, -32.7], [11.75, -34.05], [17.86, -29.33], [20.84, -33.2],
+                        [14.73, -37.92], [16.23, -39.85],
+                    ],
+                    "top_m": 13.0,
+                }
+            ],
+        },
+    ],
+}  # fmt: skip
+"""World scene 50072's target (a Z of 16 m) and its near shape of the target's colour, the Z
+with a corner notched 0.5 m deep."""
+
+
+@pytest.mark.parametrize(("above_roof_m", "judged"), [(28.0, True), (30.0, True), (40.0, False)])
+def test_a_notched_near_shape_is_judged_only_as_large_as_the_target_picture_draws_the_target(
+    above_roof_m: float, judged: bool
+) -> None:
+    """Each drawn from straight above: from as far as the target picture (30 m over the
+    roof) or closer, the notch is told (another building) and the target matches; from
+    further, drawn smaller, the notch its outline leaves out might be one the target picture
+    would draw: not judged. So a closer look must reach the picture's scale: in world 50072,
+    with the ground's texture, the closest look a fill of `mission.top_fill` allowed was
+    30.8 m over this roof (97 % of the picture's scale), the notch was not judged from it,
+    and the target, found, was never reported."""
+    params = Params()
+    scene = scene_from_dict(NOTCHED)
+    _, target = target_shapes(params, png_decode(target_picture(scene, K)))
+    for name, is_target in (("z", True), ("notched", False)):
+        building = scene.building(name)
+        xs = [x for b in building.blocks for x, _ in b.footprint_enu_m]
+        ys = [y for b in building.blocks for _, y in b.footprint_enu_m]
+        centre = ((min(xs) + max(xs)) / 2.0, (min(ys) + max(ys)) / 2.0, 13.0 + above_roof_m)
+        alone = replace(scene, buildings=(building,), ground_areas=())
+        image = render(alone, CameraPose(centre, 0.0, -90.0), K)
+        j = judge(params, target, nadir_shapes(params, image), K, building.color_rgb)
+        if is_target:
+            assert j.matched, above_roof_m
+        else:
+            assert not j.matched
+            assert j.judgeable is judged and j.too_small is not judged, above_roof_m
