@@ -368,9 +368,11 @@ def main() -> None:
     # the recognizer's whole verdict: a pair whose outline does not fit is no match at any
     # threshold (its score counts as 0); at the threshold the mission flies with, and at the
     # matcher's own
-    flown = _mission_threshold()
+    true = np.array([r[2] if r[3] else 0.0 for r in rows if r[1] == "true"])
+    near = np.array([r[2] if r[3] else 0.0 for r in rows if r[1] != "true"])
+    flown = Params().recognize.threshold
     for label, cut in (("the mission's", flown), ("the matcher's", threshold)):
-        true, near = _verdict(rows, cut, label)
+        _verdict(rows, true, near, cut, label)
     corners_true = np.array([r[2] for r in rows if r[1] == "true"])
     corners_near = np.array([r[2] for r in rows if r[1] != "true"])
     print(f"  the corners alone at the threshold {threshold}: true matches "
@@ -403,19 +405,16 @@ def main() -> None:
     print(f"  ROC: {args.png}")
 
 
-def _mission_threshold() -> float:
-    """The corners' threshold the mission flies with (`uavtool.mission.Params`), lower than
-    the matcher's default."""
-    return Params().recognize.threshold
-
-
 def _verdict(
-    rows: list[tuple[str, str, float, bool, float]], threshold: float, label: str
-) -> tuple[np.ndarray, np.ndarray]:
-    """The recognizer's true- and false-match rates at ``threshold``, against the goals; its
-    scores of the true and the near pairs (0 where the outline does not fit)."""
-    true = np.array([r[2] if r[3] else 0.0 for r in rows if r[1] == "true"])
-    near = np.array([r[2] if r[3] else 0.0 for r in rows if r[1] != "true"])
+    rows: list[tuple[str, str, float, bool, float]],
+    true: np.ndarray,
+    near: np.ndarray,
+    threshold: float,
+    label: str,
+) -> None:
+    """The recognizer's true- and false-match rates at ``threshold`` (``true``, ``near``: its
+    scores of the true and the near pairs, 0 where the outline does not fit), against the
+    goals, and per near class."""
     print(f"  the recognizer at {label} threshold: corners at {threshold} and the outline "
           "within the photos' accuracy (`uavtool.vision.verify`)")  # fmt: skip
     tmr = float((true >= threshold).mean())
@@ -425,7 +424,6 @@ def _verdict(
     goal = f"goal <= {GOAL_FALSE * 100:.1f} %"
     print(f"    false matches  {fmr * 100:7.2f} %  ({goal}): {_met(fmr <= GOAL_FALSE)}")
     _outline_check(rows, threshold)
-    return true, near
 
 
 def _outline_check(rows: list[tuple[str, str, float, bool, float]], threshold: float) -> None:
