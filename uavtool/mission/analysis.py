@@ -143,6 +143,22 @@ def stepped(image_rgb: U8Array, shape: Shape, nadir: tuple[float, float] | None 
     return bool(inner_walls(image_rgb, shape, nadir_px=nadir))
 
 
+def shows_higher_part(
+    params: Params, image_rgb: U8Array, shape: Shape, nadir: tuple[float, float]
+) -> bool:
+    """Whether ``shape``'s roof (a photo from above, ``nadir`` its point straight below the
+    camera) shows a higher part's walls (`inner_walls`) along at least
+    ``vectorize.min_edge_px``, the least length the vectorizer keeps as an edge: a shorter
+    strip may be the roof's own outline cutting across one of its outer walls at a corner
+    (world 50320: 4.5 px of a near shape's wall, 7.8 px inside its outline, seen from 45 m
+    over its roof)."""
+    least = params.vectorize.min_edge_px
+    return any(
+        float(np.hypot(*(strip.max(axis=0) - strip.min(axis=0)))) >= least
+        for strip in inner_walls(image_rgb, shape, nadir_px=nadir)
+    )
+
+
 def judge(
     params: Params,
     target: Shape,

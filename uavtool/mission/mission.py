@@ -13,7 +13,7 @@ import math
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from uavtool.camera import Intrinsics
-from uavtool.mission.analysis import stepped, target_shapes
+from uavtool.mission.analysis import shows_higher_part, stepped, target_shapes
 from uavtool.mission.base import Envelope, FlightMission, MissionInputs, Wait
 from uavtool.mission.errors import MissionInputError
 from uavtool.mission.outputs import (
@@ -73,6 +73,16 @@ class SearchMission(FlightMission):
         self.target_stepped = stepped(inputs.target_rgb, self.target)
         """Whether the target picture shows parts at several heights (then a match's outline
         is not compared with it: `uavtool.mission.analysis.judge`)."""
+        h, w = inputs.target_rgb.shape[:2]
+        self.target_nadir_px = ((w - 1) / 2.0, (h - 1) / 2.0)
+        """The target picture's point straight below its camera: its centre (a picture
+        taken looking straight down)."""
+        self.target_tiers = shows_higher_part(
+            params, inputs.target_rgb, self.target, self.target_nadir_px
+        )
+        """Whether the target picture shows a higher part's walls inside its roof, as long
+        as an edge (`shows_higher_part`): a building that matches as well and, photographed
+        as the picture was, shows none is not the target (`uavtool.mission.search`)."""
         self.target_openings = enclosed_openings(
             inputs.target_rgb, self.target, least_px=params.vectorize.min_hole_area_px
         )

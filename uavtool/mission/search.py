@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 import cv2
 import numpy as np
+import shapely
 
 from uavtool.camera import Intrinsics
 from uavtool.mission.analysis import (
@@ -28,6 +29,7 @@ from uavtool.mission.analysis import (
     quartile_edge_share,
     roof_between,
     same_roof_aside,
+    shows_higher_part,
     side_shapes,
 )
 from uavtool.mission.observations import Photo
@@ -35,9 +37,9 @@ from uavtool.mission.outputs import Level, PointOfInterest, Recognition, Shapes,
 from uavtool.mission.unknown import shows_as
 from uavtool.nav import NavError, ground_point, ground_polygon, visit_order
 from uavtool.nav.geometry import point_polygon_distance
-from uavtool.nav.heights import fit_altitude_m
+from uavtool.nav.heights import fit_altitude_m, nadir_px
 from uavtool.nav.parallax import roof_by_alignment
-from uavtool.vision import Shape
+from uavtool.vision import Shape, best_match
 from uavtool.vision.shapes import perimeter
 from uavtool.vision.vectorize import (
     enclosed_openings,
@@ -45,7 +47,7 @@ from uavtool.vision.vectorize import (
     outline_mask,
     same_paint,
 )
-from uavtool.vision.verify import outline_accuracy_px
+from uavtool.vision.verify import carried_point, outline_accuracy_px
 
 if TYPE_CHECKING:
     from uavtool.mission.base import Wait
@@ -482,6 +484,8 @@ def _settle(m: SearchMission, best: Found, matches: list[Found]) -> Wait[Found]:
                     "target's: not the target",
                 )
         left = closer
+    elif m.target_tiers and len(left) > 1:
+        left = yield from _by_tiers(m, left)
     if len(left) == 1:
         return left[0]
     if not left:
@@ -501,6 +505,123 @@ def _settle(m: SearchMission, best: Found, matches: list[Found]) -> Wait[Found]:
         f"target (scores {first.score:.3f} and {rival.score:.3f}) and {why}: which is "
         "the target is not known",
     )
+
+
+def _by_tiers(m: SearchMission, left: list[Found]) -> Wait[list[Found]]:
+    """The buildings among ``left`` (all matched a target picture that shows a higher
+    part's walls inside its roof, their outlines not compared) that may still be the target.
+    One whose roof shows no higher part in a photo taken as the picture was (`_tier_look`)
+    is not: seen from over the same point of it, drawn at least as large, a higher part's
+    walls would show at least as long as the picture shows them. A building almost the
+    target but flat (its outline's near shape at one height) shows none. When one alone
+    shows them and every other was seen without, it is the target; else ``left`` is left as
+    it is (a photo could not be taken, or several show them, or none does): one never seen
+    to show a higher part is not called the target for the others having shown none."""
+    shown: list[Found] = []
+    flat: list[Found] = []
+    for f in left:
+        nadir = nadir_px(f.photo.pose, f.photo.intrinsics)
+        if shows_higher_part(m.params, f.photo.image_rgb, f.shape, nadir):
+            shown.append(f)
+            continue
+        seen = yield from _tier_look(m, f, left)
+        if seen is None:
+            continue
+        if seen:
+            shown.append(f)
+            continue
+        flat.append(f)
+        m.event(
+            Level.INFO,
+            f"point of interest {f.poi.index}: photographed as the target picture was, its "
+            "roof shows no higher part where the picture shows one: not the target",
+        )
+    if len(shown) == 1 and len(flat) == len(left) - 1:
+        m.event(
+            Level.INFO,
+            f"point of interest {shown[0].poi.index}: the only one whose roof shows a higher "
+            "part, as the target picture does",
+        )
+        return shown
+    # one left but never seen to show a higher part: the photo that ruled the others out
+    # may have hidden the target's walls (the light, the way it was reached); no conclusion
+    return left
+
+
+def _tier_look(m: SearchMission, f: Found, left: list[Found]) -> Wait[bool | None]:
+    """Whether ``f``'s roof shows a higher part's walls (`shows_higher_part`) in a photo
+    straight down from over the point of it the target picture was taken from over (the
+    picture's centre, carried onto ``f``'s outline by the match), drawn at least as large
+    as the picture draws the target. Lower than the look that matched only as far as that
+    size needs (`_resolving_altitude_m`): were ``f`` the target, the camera would stand as
+    far above each of its parts as the picture's did. None when no such photo can be taken
+    (the floor over roofs of unknown height, the ceiling), it does not show the roof whole,
+    or it shows no higher part but draws the roof smaller than the picture draws the target
+    (the way there may have held it higher): then it says nothing."""
+    p = m.params
+    photo, k = f.photo, f.photo.intrinsics
+    _, matches = best_match(m.target, (f.shape,), p.recognize)
+    at = carried_point(m.target, f.shape, matches[0], m.target_nadir_px)
+    alt_was = photo.pose.pos_enu_m[2]
+    plane = min(f.roof_m, alt_was - 1.0)
+    if at is None:
+        return None
+    try:
+        x, y = ground_point(*at, photo.pose, k, plane_z_m=plane)
+        ring = ground_polygon(f.shape.polygon_px, photo.pose, k, plane_z_m=plane)
+    except NavError:
+        return None
+    as_large = _resolving_altitude_m(m, f.shape, alt_was, plane, ring, (x, y), k)
+    whole = _whole_altitude_m(m, plane, ring, (x, y), k)
+    alt = max(min(alt_was, as_large), whole, plane + p.mission.min_above_roof_m, m.floor_at(x, y))
+    if m.ceiling_m is not None and alt > m.ceiling_m:
+        return None
+    others = ", ".join(str(o.poi.index) for o in left if o is not f)
+    what = (
+        f"point of interest {f.poi.index}: over where the target picture was taken from, "
+        f"to tell it from {others} by a higher part"
+    )
+    yield from _shift(m, (x, y, alt), what)
+    # the way may have crossed roofs of unknown height higher than the floor here: down
+    # again, straight, to the altitude that draws it as large as the picture
+    here = m.last.pos_enu_m if m.last is not None else (x, y, alt)
+    if here[2] > alt + p.mission.arrive_radius_m:
+        yield from m.move((x, y, alt), None, f"{what}: down to {alt:.1f} m")
+    there = yield from m.photo(f"poi-{f.poi.index}-tiers", -90.0)
+    shapes = photo_shapes(m, there)
+    roof = [
+        s
+        for s in shapes
+        if of_target_hue(m, s.colour_rgb) and not s.cut_by_border and _inside_roof(f, there, s)
+    ]
+    if not roof:
+        return None
+    shape = max(roof, key=lambda s: s.area_px)
+    if shows_higher_part(p, there.image_rgb, shape, nadir_px(there.pose, there.intrinsics)):
+        return True  # seen, at whatever size
+    # none seen: that says it has none only if drawn as large as the picture, each drawing
+    # known to its outline's accuracy all round
+    off = outline_accuracy_px(p.vectorize)
+    drawn = math.sqrt(max(shape.area_px, 1.0))
+    if 2.0 * drawn - _less_accuracy(shape, off) < _less_accuracy(m.target, off):
+        return None
+    return False
+
+
+def _inside_roof(f: Found, photo: Photo, shape: Shape) -> bool:
+    """Whether a point inside ``shape`` (in ``photo``), on ``f``'s roof's plane, lies on
+    that roof: `_on_roof` with a point the outline holds, where an L's centroid may fall
+    in its notch."""
+    u, v = shapely.Polygon(shape.polygon_px).representative_point().coords[0]
+    inside = replace(shape, centroid_px=(float(u), float(v)))
+    return _on_roof(f, photo, inside)
+
+
+def _less_accuracy(shape: Shape, off_px: float) -> float:
+    """``shape``'s size (``sqrt(area_px)``) less its outline's pixel accuracy all round:
+    the least its footprint may be drawn."""
+    drawn = math.sqrt(max(shape.area_px, 1.0))
+    return max(drawn - perimeter(shape.polygon_px) * off_px / (2.0 * drawn), 1.0)
 
 
 def _rivals_of(m: SearchMission, best: Found, matches: list[Found]) -> list[Found]:
@@ -965,22 +1086,32 @@ def _resolving_altitude_m(
         math.sqrt(max(m.target.area_px, 0.0)),
         p.vectorize.min_edge_px / max(quartile_edge_share(m.target), 1e-9),
     )
-    drawn_px = math.sqrt(max(shape.area_px, 1.0))
     # as large at the least: its outline is known to the pixel grid's accuracy all round
     # (world 50072: aimed at the picture's scale by its drawing, a look drew it at 99.6 %
     # of it). Not to what it left out: a stepped building's tiers, drawn apart, would send
     # the look so close that perspective draws them further apart still (hard scene 89)
-    off_px = outline_accuracy_px(p.vectorize)
-    least_px = max(drawn_px - perimeter(shape.polygon_px) * off_px / (2.0 * drawn_px), 1.0)
+    least_px = _less_accuracy(shape, outline_accuracy_px(p.vectorize))
     resolving = roof_m + (alt_m - roof_m) * least_px / need_px
+    return max(resolving, _whole_altitude_m(m, roof_m, ring, aim, k))
+
+
+def _whole_altitude_m(
+    m: SearchMission,
+    roof_m: float,
+    ring: tuple[tuple[float, float], ...],
+    aim: tuple[float, float],
+    k: Intrinsics,
+) -> float:
+    """The lowest altitude from which a photo straight down over ``aim`` holds every corner
+    of ``ring`` (a roof's outline at ``roof_m``, on the ground) with the arrival radius to
+    spare on the photo's shorter side."""
     reach = max((math.dist(aim, corner) for corner in ring), default=0.0)
-    tightest = fit_altitude_m(
+    return fit_altitude_m(
         roof_m=roof_m,
-        extent_m=2.0 * (reach + p.mission.arrive_radius_m),
+        extent_m=2.0 * (reach + m.params.mission.arrive_radius_m),
         intrinsics=k,
         fill=1.0,
     )
-    return max(resolving, tightest)
 
 
 def _other_outline(j: Judgement) -> bool:

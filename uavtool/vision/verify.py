@@ -163,10 +163,37 @@ def outline_gap(reference: Shape, candidate: Shape, match: Match) -> float:
     centroids together and the candidate turned (mirrored if the match was) onto the
     reference as well as any turn near the match's allows; ``inf`` when either is
     degenerate."""
+    return _laid(reference, candidate, match)[0]
+
+
+def carried_point(
+    reference: Shape, candidate: Shape, match: Match, point_px: tuple[float, float]
+) -> tuple[float, float] | None:
+    """Where ``point_px`` of the reference's photo falls in the candidate's: carried with
+    the reference's outline onto the candidate's as `outline_gap` lays them together
+    (centroids together, turned and, if the match was, mirrored, at the ratio of their
+    sizes). None when either outline is degenerate."""
+    gap, deg = _laid(reference, candidate, match)
+    if not math.isfinite(gap):
+        return None
+    ref, cand = shapely.Polygon(reference.polygon_px), shapely.Polygon(candidate.polygon_px)
+    unit = (np.array(point_px, dtype=np.float64) - ref.centroid.coords[0]) / math.sqrt(ref.area)
+    t = math.radians(deg)
+    c, s = math.cos(t), math.sin(t)
+    # the candidate, turned by ``deg`` (`_gap`), lies on the reference: turn back
+    there = unit @ np.array([[c, s], [-s, c]]).T
+    if match.mirrored:
+        there = there * np.array([-1.0, 1.0])
+    u, v = np.asarray(cand.centroid.coords[0]) + math.sqrt(cand.area) * there
+    return float(u), float(v)
+
+
+def _laid(reference: Shape, candidate: Shape, match: Match) -> tuple[float, float]:
+    """`outline_gap` and the turn (degrees, `_gap`'s) that gives it."""
     ref = _unit(reference.polygon_px)
     cand = _unit(candidate.polygon_px)
     if ref is None or cand is None:
-        return math.inf
+        return math.inf, 0.0
     if match.mirrored:
         cand = cand * np.array([-1.0, 1.0])
     ref_line = shapely.LinearRing(ref)
@@ -184,7 +211,7 @@ def outline_gap(reference: Shape, candidate: Shape, match: Match) -> float:
             gap = _gap(ref_line, cand, deg)
             if gap < best:
                 best_deg, best = deg, gap
-    return best
+    return best, best_deg
 
 
 def _gap(ref_line: shapely.LinearRing, cand: FloatArray, deg: float) -> float:
