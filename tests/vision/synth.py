@@ -55,6 +55,16 @@ def place(
     return (poly @ rot.T) * size_px + np.array(centre)
 
 
+def unit_point(
+    point: tuple[float, float], *, angle_deg: float, size_px: float, centre: tuple[float, float]
+) -> tuple[float, float]:
+    """Where `place` puts a point of the unit polygon's frame."""
+    u, v = place(
+        np.array([point], dtype=np.float64), angle_deg=angle_deg, size_px=size_px, centre=centre
+    )[0]
+    return float(u), float(v)
+
+
 def draw(
     polys: list[tuple[FloatArray, tuple[int, int, int]]],
     *,

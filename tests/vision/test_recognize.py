@@ -7,13 +7,14 @@ from hypothesis import strategies as st
 from uavtool.vision import RecognizeParams, Shape, best_match, match, match_shapes, vectorize
 from uavtool.vision.params import VectorizeParams
 from uavtool.vision.verify import (
+    carried_point,
     outline_accuracy_px,
     outline_fits,
     outline_gap,
     outline_tolerance,
 )
 
-from .synth import FAMILIES, draw, family_shape, place
+from .synth import FAMILIES, draw, family_shape, place, unit_point
 
 THRESHOLD = RecognizeParams().threshold
 WORST_PX = 6.0
@@ -53,6 +54,31 @@ def test_a_rotated_scaled_render_matches_its_original(
     # in a thousand (bench_near_shapes.py measures how many), never beyond the worst error
     # the vectorizer was measured to make (`--accuracy`: under 6 px from 100 px across)
     assert outline_gap(ref, cand, m) <= outline_tolerance(ref, cand, WORST_PX, WORST_PX)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    family=st.sampled_from(("L", "T", "U", "house")),  # none turns onto itself
+    angle=st.floats(0.0, 360.0),
+    scale=st.floats(0.5, 2.0),
+    at=st.tuples(st.floats(-0.6, 0.6), st.floats(-0.6, 0.6)),
+)
+def test_a_point_is_carried_with_the_outline_onto_a_turned_scaled_render(
+    family: str, angle: float, scale: float, at: tuple[float, float]
+) -> None:
+    """A point of the reference's photo (the target picture's centre, in the mission) falls
+    where the same point of the footprint falls in the candidate's photo: within a pixel of
+    the outlines' accuracy per unit of the candidate's size."""
+    base = family_shape(family, 0.7, 0.4)
+    size = 130.0
+    ref = _vectorized(place(base, angle_deg=0, size_px=size, centre=(500, 500)), 1000)
+    turned = {"angle_deg": angle, "size_px": size * scale, "centre": (480.0, 520.0)}
+    cand = _vectorized(place(base, **turned), 1000)  # type: ignore[arg-type]
+    point = unit_point(at, angle_deg=0, size_px=size, centre=(500, 500))
+    want = unit_point(at, **turned)  # type: ignore[arg-type]
+    got = carried_point(ref, cand, match_shapes(ref, cand), point)
+    assert got is not None
+    assert np.hypot(got[0] - want[0], got[1] - want[1]) <= 1.0 + 0.02 * size * scale
 
 
 @settings(max_examples=40, deadline=None)
