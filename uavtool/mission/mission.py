@@ -104,6 +104,10 @@ class SearchMission(FlightMission):
         """The photos straight down from the ceiling (the overviews, the tour measuring
         roofs, the peeks): what parallax against them shows lies on the ground is no
         building (:func:`~uavtool.mission.ground.standing_regions`)."""
+        self.higher_parts: dict[int, bool | None] = {}
+        """Whether each point of interest's roof was seen to show a higher part's walls
+        (None: no photo could tell), once the target picture shows one and it had to be
+        told from another building (`uavtool.mission.search`)."""
         self.unknown: dict[int, Unknown] = {}
         """Where buildings of unknown height may stand, and the highest each roof may be
         there (by the overview shape's index; an obstacle's is negative): a way near one

@@ -214,9 +214,10 @@ def search(
     # a match by score alone (its outline not compared) leaves any doubt standing; one
     # whose outline lies on the target's, only a doubt of walls (its rival's outline was
     # told apart from the target's, but may hold walls)
-    _judged_all(
-        m, best, [(k, look) for k, look, walls in doubtful if walls or not best.outline_compared]
-    )
+    doubts = [(k, look) for k, look, walls in doubtful if walls or not best.outline_compared]
+    if doubts and m.target_tiers and not best.outline_compared:
+        doubts = yield from _doubts_by_tiers(m, best, doubts, pois)
+    _judged_all(m, best, doubts)
     best = yield from _settle(m, best, matches)
     m.event(
         Level.INFO,
@@ -517,26 +518,11 @@ def _by_tiers(m: SearchMission, left: list[Found]) -> Wait[list[Found]]:
     shows them and every other was seen without, it is the target; else ``left`` is left as
     it is (a photo could not be taken, or several show them, or none does): one never seen
     to show a higher part is not called the target for the others having shown none."""
-    shown: list[Found] = []
-    flat: list[Found] = []
-    for f in left:
-        nadir = nadir_px(f.photo.pose, f.photo.intrinsics)
-        if shows_higher_part(m.params, f.photo.image_rgb, f.shape, nadir):
-            shown.append(f)
-            continue
-        seen = yield from _tier_look(m, f, left)
-        if seen is None:
-            continue
-        if seen:
-            shown.append(f)
-            continue
-        flat.append(f)
-        m.event(
-            Level.INFO,
-            f"point of interest {f.poi.index}: photographed as the target picture was, its "
-            "roof shows no higher part where the picture shows one: not the target",
-        )
-    if len(shown) == 1 and len(flat) == len(left) - 1:
+    seen: list[bool | None] = []
+    for f in left:  # a comprehension may not yield
+        seen.append((yield from _higher_part(m, f, left)))  # noqa: PERF401
+    shown = [f for f, s in zip(left, seen, strict=True) if s]
+    if len(shown) == 1 and seen.count(False) == len(left) - 1:
         m.event(
             Level.INFO,
             f"point of interest {shown[0].poi.index}: the only one whose roof shows a higher "
@@ -546,6 +532,48 @@ def _by_tiers(m: SearchMission, left: list[Found]) -> Wait[list[Found]]:
     # one left but never seen to show a higher part: the photo that ruled the others out
     # may have hidden the target's walls (the light, the way it was reached); no conclusion
     return left
+
+
+def _doubts_by_tiers(
+    m: SearchMission,
+    best: Found,
+    doubts: list[tuple[int, _Look]],
+    pois: tuple[PointOfInterest, ...],
+) -> Wait[list[tuple[int, _Look]]]:
+    """The buildings of the target's hue left in doubt (``doubts``: scored under the
+    threshold from too far to tell, their outlines not compared) that may still be the
+    target, when the target picture shows a higher part's walls and ``best``'s roof shows
+    one: not those whose roof, photographed as the picture was, shows none (`_by_tiers`)."""
+    if not (yield from _higher_part(m, best, [best])):
+        return doubts
+    left = []
+    for k, look in doubts:
+        f = _found(pois[k], look, None)
+        if (yield from _higher_part(m, f, [best, f])) is not False:
+            left.append((k, look))
+    return left
+
+
+def _higher_part(m: SearchMission, f: Found, among: list[Found]) -> Wait[bool | None]:
+    """Whether ``f``'s roof shows a higher part's walls: in the look that matched it, else
+    in a photo taken as the target picture was (`_tier_look`; None when that tells
+    nothing). Each building is photographed so once (``SearchMission.higher_parts``);
+    ``among``: the buildings it is to be told from."""
+    k = f.poi.index
+    if k in m.higher_parts:
+        return m.higher_parts[k]
+    nadir = nadir_px(f.photo.pose, f.photo.intrinsics)
+    seen: bool | None = True
+    if not shows_higher_part(m.params, f.photo.image_rgb, f.shape, nadir):
+        seen = yield from _tier_look(m, f, among)
+    if seen is False:
+        m.event(
+            Level.INFO,
+            f"point of interest {k}: photographed as the target picture was, its roof shows "
+            "no higher part where the picture shows one: not the target",
+        )
+    m.higher_parts[k] = seen
+    return seen
 
 
 def _tier_look(m: SearchMission, f: Found, left: list[Found]) -> Wait[bool | None]:
