@@ -271,14 +271,17 @@ def test_a_road_joining_a_building_to_the_frame_leaves_it_a_region_of_its_own() 
     to judge, and the flight ended "could not be judged". Told colour by colour against the
     survey's photos, the road lies on the ground (the towers leaning over it in those
     photos hide it there, and tell nothing): a cross is looked at again from below the
-    ceiling (117 m), and the flight ends honestly, neither cross told from the other."""
+    ceiling (117 m). Both crosses then match, their outlines not compared (the target
+    picture shows a higher part); photographed as the picture was, the twin's roof shows
+    none, the target's does, and the target is found (before, the flight ended NO_MATCH,
+    neither told from the other)."""
     summary, events = fly_data_scene("world-50063")
     again = [float(e.rsplit("at ", 1)[1].split(" m")[0]) for e in events if "looking again" in e]
     assert again and min(again) < 110.0, events
     assert not any("could not be judged" in e for e in events), events
-    assert summary.outcome.status is Status.NO_MATCH, summary.outcome.reason
-    assert "both match the target" in summary.outcome.reason
-    assert not summary.evaluation.matched_building
+    assert any("the only one whose roof shows a higher part" in e for e in events), events
+    assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
+    assert summary.evaluation.matched_building == summary.evaluation.target_building
 
 
 def _looks_from_ceiling(scene: Scene) -> tuple[Photo, list[Photo]]:

@@ -467,11 +467,15 @@ def _settle(m: SearchMission, best: Found, matches: list[Found]) -> Wait[Found]:
     its corners, sometimes higher. A closer look shrinks its photo's part of the tolerance:
     each is looked at again from where it fills ``mission.top_fill`` of the photo (its roof
     measured, so the descent is safe), and one whose outline then lies off the target's is
-    out. When more than one is left, the mission ends NO_MATCH naming two of them: naming one
-    would be a guess."""
+    out. When the target picture shows a higher part's walls, what tells them apart (and
+    tells a lone match from a flat near shape) is instead whether their roofs show one
+    (`_by_tiers`). When more than one is left, the mission ends NO_MATCH naming two of them:
+    naming one would be a guess."""
     left = [best, *_rivals_of(m, best, matches)]
+    if m.target_tiers and not best.outline_compared:
+        left = yield from _by_tiers(m, left)
     if len(left) == 1:
-        return best
+        return left[0]
     if all(f.outline_compared for f in left):
         closer = []
         for f in left:
@@ -485,8 +489,6 @@ def _settle(m: SearchMission, best: Found, matches: list[Found]) -> Wait[Found]:
                     "target's: not the target",
                 )
         left = closer
-    elif m.target_tiers and len(left) > 1:
-        left = yield from _by_tiers(m, left)
     if len(left) == 1:
         return left[0]
     if not left:
@@ -514,15 +516,32 @@ def _by_tiers(m: SearchMission, left: list[Found]) -> Wait[list[Found]]:
     One whose roof shows no higher part in a photo taken as the picture was (`_tier_look`)
     is not: seen from over the same point of it, drawn at least as large, a higher part's
     walls would show at least as long as the picture shows them. A building almost the
-    target but flat (its outline's near shape at one height) shows none. When one alone
-    shows them and every other was seen without, it is the target; else ``left`` is left as
-    it is (a photo could not be taken, or several show them, or none does): one never seen
-    to show a higher part is not called the target for the others having shown none."""
+    target but flat (its outline's near shape at one height) shows none; the mission ends
+    NO_MATCH when every one is such (world 50350: the best match, a near shape with an arm
+    shorter, was flat). When one alone shows a higher part and every other was seen
+    without, it is the target; else ``left`` is left as it is (a photo could not be taken,
+    or several show one): one never seen to show a higher part is not called the target for
+    the others having shown none."""
     seen: list[bool | None] = []
     for f in left:  # a comprehension may not yield
         seen.append((yield from _higher_part(m, f, left)))  # noqa: PERF401
+    if all(s is False for s in seen):
+        where = "where the picture shows one"
+        if len(left) == 1:
+            raise m.end(
+                Status.NO_MATCH,
+                f"point of interest {left[0].poi.index} matches the target (score "
+                f"{left[0].score:.3f}), but its roof, photographed as the target picture was, "
+                f"shows no higher part {where}: it is not the target",
+            )
+        raise m.end(
+            Status.NO_MATCH,
+            f"points of interest {', '.join(str(f.poi.index) for f in left)} match the "
+            "target, but none of their roofs, photographed as the target picture was, shows a "
+            f"higher part {where}: none is the target",
+        )
     shown = [f for f, s in zip(left, seen, strict=True) if s]
-    if len(shown) == 1 and seen.count(False) == len(left) - 1:
+    if len(left) > 1 and len(shown) == 1 and seen.count(False) == len(left) - 1:
         m.event(
             Level.INFO,
             f"point of interest {shown[0].poi.index}: the only one whose roof shows a higher "
