@@ -6,21 +6,19 @@ shape from the stepped target (`uavtool.mission.search`)."""
 from __future__ import annotations
 
 from dataclasses import replace
-from pathlib import Path
 
 import shapely  # type: ignore[import-untyped]
 
 from tests.mission.driver import fly
+from tests.mission.scenes import fly_data_scene
 from uavtool.camera import CameraPose, Intrinsics
 from uavtool.images import png_decode
 from uavtool.mission import Params, Plan, Status
 from uavtool.mission.analysis import nadir_shapes, shows_higher_part, target_shapes
-from uavtool.runner.fly import FlyConfig, target_picture
-from uavtool.runner.fly import fly as fly_scene
+from uavtool.runner.fly import target_picture
 from uavtool.world import Scene, building_footprint, render, scene_from_dict
 
 K = Intrinsics.from_hfov(width_px=640, height_px=480, hfov_deg=60.0)
-DATA = Path(__file__).parent / "data"
 
 T_BASE = [
     [-8.79, -28.04], [-11.1, -26.35], [-14.79, -31.41], [-15.98, -30.54],
@@ -125,11 +123,7 @@ def test_a_rival_left_in_doubt_is_no_doubt_once_its_roof_shows_no_higher_part() 
     score under the threshold from too far to tell (their outlines not compared) and cannot
     be looked at from closer. Photographed as the target picture was, their roofs show no
     higher part: no doubt is left and the target is found (before, NO_MATCH)."""
-    texts: list[str] = []
-    summary = fly_scene(
-        FlyConfig(scene=str(DATA / "world-50240.yaml"), no_record=True),
-        progress=lambda text, _t: texts.append(text),
-    )
+    summary, texts = fly_data_scene("world-50240")
     assert summary.outcome.status is Status.COMPLETED, summary.outcome.reason
     assert summary.evaluation.matched_building == summary.evaluation.target_building
     flat = [t for t in texts if "roof shows no higher part where the picture shows one" in t]
