@@ -254,7 +254,8 @@ def test_a_look_again_names_why(score: float, mirror: float, reason: str) -> Non
     again for that reason, not as one scoring just below the threshold."""
 
     from uavtool.mission.analysis import Judgement
-    from uavtool.mission.search import _Look, _look_again
+    from uavtool.mission.looks import Look
+    from uavtool.mission.search import _look_again
 
     params = Params()
     assert params.recognize.threshold <= 0.95
@@ -263,7 +264,7 @@ def test_a_look_again_names_why(score: float, mirror: float, reason: str) -> Non
     photo = SimpleNamespace(pose=CameraPose((0.0, 0.0, 40.0), 0.0, -90.0), intrinsics=k)
     shape = SimpleNamespace(centroid_px=(330.0, 250.0))
     j = Judgement((score,), 0, score, False, mirror_score=mirror, not_mirror=mirror == 0.0)
-    look = _Look(photo, (shape,), j, 40.0)  # type: ignore[arg-type]
+    look = Look(photo, (shape,), j, 40.0)  # type: ignore[arg-type]
     again = _look_again(SimpleNamespace(params=params), look, 10.0, 100.0)  # type: ignore[arg-type]
     assert again is not None
     pos, why = again

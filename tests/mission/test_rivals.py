@@ -17,8 +17,8 @@ from tests.mission.fakes import INTRINSICS
 from tests.mission.scenes import fly_data_scene
 from uavtool.mission import MissionInputs, Params, Photo, SearchMission, Status
 from uavtool.mission.base import MissionEnd
+from uavtool.mission.looks import Found
 from uavtool.mission.modelling import still_the_target
-from uavtool.mission.search import Found
 from uavtool.runner.fly import FlyConfig
 from uavtool.runner.fly import fly as fly_scene
 from uavtool.vision import VectorizeParams, vectorize

@@ -30,15 +30,14 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from uavtool.mission.airspace import Claim
 from uavtool.mission.analysis import roof_between
 from uavtool.mission.fleet import FAILED, WORST, Crew, FleetMember, FleetParams
+from uavtool.mission.looks import Found, Look
 from uavtool.mission.mission import SearchMission
 from uavtool.mission.modelling import photograph_and_model
 from uavtool.mission.outputs import Level, Outcome, Status
 from uavtool.mission.params import Params
 from uavtool.mission.search import (
-    Found,
     Inspection,
     Inspector,
-    Look,
     inspect,
     measure_from_another_altitude,
 )

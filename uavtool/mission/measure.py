@@ -25,9 +25,9 @@ import numpy as np
 
 from uavtool.mission.analysis import not_flat, placed_roof, roof_between
 from uavtool.mission.ground import lies_on_ground, regions_off_ground, without_ground
+from uavtool.mission.looks import photo_shapes
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
-from uavtool.mission.search import photo_shapes
 from uavtool.mission.survey import (
     Obstacle,
     Survey,

@@ -38,9 +38,10 @@ from uavtool.nav.geometry import (
 from uavtool.vision.vectorize import enclosed_openings
 
 if TYPE_CHECKING:
+    from uavtool.mission.looks import Found, Look
     from uavtool.mission.observations import Photo
     from uavtool.mission.outputs import PointOfInterest
-    from uavtool.mission.search import Found, Inspector, Look
+    from uavtool.mission.search import Inspector
     from uavtool.mission.sides import HandedSide, SidePlan
     from uavtool.mission.survey import Survey
     from uavtool.nav import Viewpoint
@@ -82,7 +83,7 @@ class SearchMission(FlightMission):
         )
         """Whether the target picture shows a higher part's walls inside its roof, as long
         as an edge (`shows_higher_part`): a building that matches as well and, photographed
-        as the picture was, shows none is not the target (`uavtool.mission.search`)."""
+        as the picture was, shows none is not the target (`uavtool.mission.settle`)."""
         self.target_openings = enclosed_openings(
             inputs.target_rgb, self.target, least_px=params.vectorize.min_hole_area_px
         )
@@ -107,7 +108,7 @@ class SearchMission(FlightMission):
         self.higher_parts: dict[int, bool | None] = {}
         """Whether each point of interest's roof was seen to show a higher part's walls
         (None: no photo could tell), once the target picture shows one and it had to be
-        told from another building (`uavtool.mission.search`)."""
+        told from another building (`uavtool.mission.settle`)."""
         self.unknown: dict[int, Unknown] = {}
         """Where buildings of unknown height may stand, and the highest each roof may be
         there (by the overview shape's index; an obstacle's is negative): a way near one

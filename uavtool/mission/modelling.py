@@ -9,9 +9,9 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from uavtool.mission.analysis import aimed_shape, judge, roof_between
+from uavtool.mission.looks import Found, photo_shapes
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import DiagonalView, Level, ModelBuilt, Status, Viewpoints
-from uavtool.mission.search import Found, photo_shapes
 from uavtool.mission.sides import SidePlan, side_view
 from uavtool.mission.survey import (
     Survey,

@@ -17,9 +17,9 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from uavtool.mission.ground import standing_regions
+from uavtool.mission.looks import photo_shapes
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level
-from uavtool.mission.search import photo_shapes
 from uavtool.nav import NavError, frame_on_plane, ground_point
 from uavtool.nav.geometry import point_in_polygon, segment_polygon_distance
 from uavtool.vision.params import VectorizeParams

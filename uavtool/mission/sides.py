@@ -27,10 +27,10 @@ import numpy as np
 import shapely
 
 from uavtool.camera import CameraPose, Intrinsics, project
+from uavtool.mission.looks import photo_shapes
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level
 from uavtool.mission.peek import peek
-from uavtool.mission.search import photo_shapes
 from uavtool.nav import Rect, Viewpoint, ViewpointFailure, ViewpointParams, plan_towards
 from uavtool.nav.geometry import point_polygon_distance
 from uavtool.nav.viewpoints import farther, foot_hidden, for_building

@@ -15,10 +15,10 @@ from typing import TYPE_CHECKING
 from uavtool.camera import Intrinsics
 from uavtool.mission.analysis import roof_between
 from uavtool.mission.ground import lies_on_ground, measured_flat
+from uavtool.mission.looks import photo_shapes
 from uavtool.mission.observations import Photo
 from uavtool.mission.outputs import Level, PointOfInterest
 from uavtool.mission.params import MissionParams
-from uavtool.mission.search import photo_shapes
 from uavtool.mission.unknown import Unknown, footprint_at, unknown_place
 from uavtool.nav import ground_point, min_area_rect
 from uavtool.nav.geometry import convex_hull, point_polygon_distance
