@@ -106,12 +106,17 @@ def less_accuracy(shape: Shape, off_px: float) -> float:
 def on_roof(best: Found, photo: Photo, shape: Shape) -> bool:
     """Whether ``shape``'s centre (in ``photo``), on the matched roof's plane, lies on that
     roof."""
+    return point_on_roof(best, photo, shape.centroid_px)
+
+
+def point_on_roof(best: Found, photo: Photo, point_px: tuple[float, float]) -> bool:
+    """Whether ``point_px`` (in ``photo``), on the matched roof's plane, lies on that roof."""
     plane_m = min(best.roof_m, best.photo.pose.pos_enu_m[2] - 1.0, photo.pose.pos_enu_m[2] - 1.0)
     try:
         ring = ground_polygon(
             best.shape.polygon_px, best.photo.pose, best.photo.intrinsics, plane_z_m=plane_m
         )
-        here = ground_point(*shape.centroid_px, photo.pose, photo.intrinsics, plane_z_m=plane_m)
+        here = ground_point(*point_px, photo.pose, photo.intrinsics, plane_z_m=plane_m)
     except NavError:
         return False
     return point_polygon_distance(here, ring) == 0.0

@@ -7,7 +7,6 @@ mission ends NO_MATCH naming both: naming one would be a guess."""
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import shapely
@@ -22,6 +21,7 @@ from uavtool.mission.looks import (
     of_target_hue,
     on_roof,
     photo_shapes,
+    point_on_roof,
     resolving_altitude_m,
     shift,
     take_look,
@@ -191,10 +191,10 @@ def _tier_look(m: SearchMission, f: Found, left: list[Found]) -> Wait[bool | Non
     photo, k = f.photo, f.photo.intrinsics
     _, matches = best_match(m.target, (f.shape,), p.recognize)
     at = carried_point(m.target, f.shape, matches[0], m.target_nadir_px)
-    alt_was = photo.pose.pos_enu_m[2]
-    plane = min(f.roof_m, alt_was - 1.0)
     if at is None:
         return None
+    alt_was = photo.pose.pos_enu_m[2]
+    plane = min(f.roof_m, alt_was - 1.0)
     try:
         x, y = ground_point(*at, photo.pose, k, plane_z_m=plane)
         ring = ground_polygon(f.shape.polygon_px, photo.pose, k, plane_z_m=plane)
@@ -242,8 +242,7 @@ def _inside_roof(f: Found, photo: Photo, shape: Shape) -> bool:
     that roof: `on_roof` with a point the outline holds, where an L's centroid may fall
     in its notch."""
     u, v = shapely.Polygon(shape.polygon_px).representative_point().coords[0]
-    inside = replace(shape, centroid_px=(float(u), float(v)))
-    return on_roof(f, photo, inside)
+    return point_on_roof(f, photo, (float(u), float(v)))
 
 
 def _rivals_of(m: SearchMission, best: Found, matches: list[Found]) -> list[Found]:
